@@ -1,0 +1,183 @@
+"""The polygonal mesh: plain arrays, nothing else.
+
+A mesh is
+- ``vertices``: ``(N, 2)`` float64 coordinates;
+- ``cell_offsets`` ``(M + 1,)`` and ``cell_vertices`` ``(offsets[-1],)`` int64: polygon ``K`` has the
+  vertices ``cell_vertices[cell_offsets[K]:cell_offsets[K + 1]]`` in counter-clockwise order
+  (CSR form). Every vertex of a polygon is listed, hanging nodes included (SPEC §3);
+- ``boundary``: named boundary parts, each a ``(k, 2)`` int64 array of boundary edges given as
+  vertex pairs ``(a, b)`` in the counter-clockwise order in which they appear in their cell;
+- ``meta``: how the mesh was made (family, n, seed, ...), stored with every result.
+
+Derived topology (``edges``, ``edge_cells``, ...) is computed on demand and cached.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+UNIT_SQUARE_SIDES = ("left", "right", "bottom", "top")
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    vertices: np.ndarray
+    cell_offsets: np.ndarray
+    cell_vertices: np.ndarray
+    boundary: dict = field(default_factory=dict)
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "vertices", np.ascontiguousarray(self.vertices, dtype=np.float64))
+        object.__setattr__(self, "cell_offsets", np.ascontiguousarray(self.cell_offsets, dtype=np.int64))
+        object.__setattr__(self, "cell_vertices", np.ascontiguousarray(self.cell_vertices, dtype=np.int64))
+        object.__setattr__(
+            self,
+            "boundary",
+            {str(k): np.asarray(v, dtype=np.int64).reshape(-1, 2) for k, v in self.boundary.items()},
+        )
+
+    # -- sizes -----------------------------------------------------------------------------
+    @property
+    def n_vertices(self) -> int:
+        return self.vertices.shape[0]
+
+    @property
+    def n_cells(self) -> int:
+        return self.cell_offsets.shape[0] - 1
+
+    @property
+    def n_dofs(self) -> int:
+        """Two displacement components per vertex, interleaved: dof = 2 * vertex + component."""
+        return 2 * self.n_vertices
+
+    @cached_property
+    def cell_sizes(self) -> np.ndarray:
+        return np.diff(self.cell_offsets)
+
+    def cell(self, k: int) -> np.ndarray:
+        return self.cell_vertices[self.cell_offsets[k] : self.cell_offsets[k + 1]]
+
+    # -- derived topology --------------------------------------------------------------------
+    @cached_property
+    def half_edges(self) -> np.ndarray:
+        """``(H, 2)`` directed edges ``(a, b)`` of every cell, in cell order (CCW)."""
+        nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)
+        last = self.cell_offsets[1:] - 1
+        nxt[last] = self.cell_offsets[:-1]
+        return np.stack([self.cell_vertices, self.cell_vertices[nxt]], axis=1)
+
+    @cached_property
+    def half_edge_cells(self) -> np.ndarray:
+        return np.repeat(np.arange(self.n_cells, dtype=np.int64), self.cell_sizes)
+
+    @cached_property
+    def _edge_table(self):
+        he = self.half_edges
+        lo = np.minimum(he[:, 0], he[:, 1])
+        hi = np.maximum(he[:, 0], he[:, 1])
+        key = lo * np.int64(self.n_vertices) + hi
+        order = np.argsort(key, kind="stable")
+        skey = key[order]
+        first = np.ones(skey.size, dtype=bool)
+        first[1:] = skey[1:] != skey[:-1]
+        edge_of_sorted = np.cumsum(first) - 1
+        half_edge_edge = np.empty_like(edge_of_sorted)
+        half_edge_edge[order] = edge_of_sorted
+        return half_edge_edge, order[first]
+
+    @cached_property
+    def half_edge_edge(self) -> np.ndarray:
+        """Edge index of every half-edge."""
+        return self._edge_table[0]
+
+    @cached_property
+    def edges(self) -> np.ndarray:
+        """``(E, 2)`` undirected edges, each oriented as in its first cell."""
+        return self.half_edges[self._edge_table[1]]
+
+    @cached_property
+    def edge_cells(self) -> np.ndarray:
+        """``(E, 2)`` the one or two cells of every edge; ``-1`` where there is no second cell.
+
+        Column 0 is the cell in which the edge runs as in ``edges``.
+        """
+        ne = self.edges.shape[0]
+        out = np.full((ne, 2), -1, dtype=np.int64)
+        first = self._edge_table[1]
+        out[:, 0] = self.half_edge_cells[first]
+        other = np.ones(self.half_edges.shape[0], dtype=bool)
+        other[first] = False
+        out[self.half_edge_edge[other], 1] = self.half_edge_cells[other]
+        return out
+
+    @cached_property
+    def boundary_edges(self) -> np.ndarray:
+        """``(B, 2)`` edges that belong to one cell only, oriented CCW as in that cell."""
+        return self.edges[self.edge_cells[:, 1] < 0]
+
+    # -- geometry -------------------------------------------------------------------------
+    @cached_property
+    def cell_areas(self) -> np.ndarray:
+        """Signed (shoelace) area of every cell: positive for counter-clockwise polygons."""
+        he = self.half_edges
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        cross = x[he[:, 0]] * y[he[:, 1]] - x[he[:, 1]] * y[he[:, 0]]
+        return 0.5 * np.add.reduceat(cross, self.cell_offsets[:-1]) if self.n_cells else np.zeros(0)
+
+    @cached_property
+    def cell_diameters(self) -> np.ndarray:
+        """h_K = diam(K): the largest vertex-to-vertex distance of each cell."""
+        out = np.zeros(self.n_cells)
+        for size in np.unique(self.cell_sizes):
+            cells = np.flatnonzero(self.cell_sizes == size)
+            idx = self.cell_offsets[cells][:, None] + np.arange(size)
+            pts = self.vertices[self.cell_vertices[idx]]
+            d = np.linalg.norm(pts[:, :, None, :] - pts[:, None, :, :], axis=-1)
+            out[cells] = d.reshape(len(cells), -1).max(axis=1)
+        return out
+
+    @property
+    def h(self) -> float:
+        return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+    def boundary_vertices(self, name: str) -> np.ndarray:
+        """Sorted unique vertices of a named boundary part."""
+        return np.unique(self.boundary[name])
+
+    def with_boundary(self, **parts) -> "Mesh":
+        b = dict(self.boundary)
+        b.update(parts)
+        return Mesh(self.vertices, self.cell_offsets, self.cell_vertices, b, dict(self.meta))
+
+
+def from_polygons(vertices, polygons, boundary=None, meta=None) -> Mesh:
+    """Build a mesh from a list of vertex-index sequences (one per polygon)."""
+    sizes = np.array([len(p) for p in polygons], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    flat = np.concatenate([np.asarray(p, dtype=np.int64) for p in polygons]) if len(polygons) else np.zeros(0, np.int64)
+    return Mesh(np.asarray(vertices, float), offsets, flat, boundary or {}, meta or {})
+
+
+def tag_box_boundary(mesh: Mesh, lower=(0.0, 0.0), upper=(1.0, 1.0), tol=1e-12) -> Mesh:
+    """Name the boundary edges of a mesh of the box [lower, upper]: left, right, bottom, top.
+
+    An edge belongs to a side when both its vertices lie on that side.
+    """
+    be = mesh.boundary_edges
+    p, q = mesh.vertices[be[:, 0]], mesh.vertices[be[:, 1]]
+    scale = tol * max(1.0, float(np.max(np.abs(np.subtract(upper, lower)))))
+    sides = {
+        "left": (0, lower[0]),
+        "right": (0, upper[0]),
+        "bottom": (1, lower[1]),
+        "top": (1, upper[1]),
+    }
+    parts = {}
+    for name, (axis, value) in sides.items():
+        on = (np.abs(p[:, axis] - value) <= scale) & (np.abs(q[:, axis] - value) <= scale)
+        parts[name] = be[on]
+    return mesh.with_boundary(**parts)
