@@ -1,0 +1,65 @@
+"""Contact laws (5.1): p(t) = k (t)_+^m for the normal compliance p_nu and the friction bound p_tau.
+
+Convention for m = 0: p(t) = k for every t, the paper's reduced law m_tau = 0 ("the friction
+bound is k_tau, independent of u", Section 5). For m > 0, p vanishes for t <= 0 ((2.10)(d)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def power_law(t, k: float, m: float):
+    t = np.asarray(t, dtype=float)
+    if m == 0.0:
+        return np.full_like(t, k)
+    return k * np.maximum(t, 0.0) ** m
+
+
+def power_law_derivative(t, k: float, m: float):
+    """dp/dt; at t = 0 the right derivative for m = 1 is taken only where t > 0 (semismooth choice)."""
+    t = np.asarray(t, dtype=float)
+    if m == 0.0:
+        return np.zeros_like(t)
+    tp = np.maximum(t, 0.0)
+    return np.where(t > 0.0, k * m * tp ** (m - 1.0), 0.0)
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    k_normal: float
+    m_normal: float
+    k_friction: float
+    m_friction: float
+
+    def __post_init__(self):
+        for name in ("k_normal", "m_normal", "k_friction", "m_friction"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ValueError(f"contact law {name} = {value}: must be a finite number >= 0")
+
+    def normal_pressure(self, penetration):
+        """p_nu(u_nu - g_a)."""
+        return power_law(penetration, self.k_normal, self.m_normal)
+
+    def normal_stiffness(self, penetration):
+        """d p_nu / d u_nu."""
+        return power_law_derivative(penetration, self.k_normal, self.m_normal)
+
+    def friction_bound(self, penetration):
+        """p_tau(u_nu - g_a)."""
+        return power_law(penetration, self.k_friction, self.m_friction)
+
+    def friction_bound_derivative(self, penetration):
+        return power_law_derivative(penetration, self.k_friction, self.m_friction)
+
+    @property
+    def frictionless(self) -> bool:
+        return self.k_friction == 0.0
+
+    @property
+    def reduced(self) -> bool:
+        """The friction bound does not depend on u (m_tau = 0 or k_tau = 0)."""
+        return self.m_friction == 0.0 or self.k_friction == 0.0
