@@ -12,13 +12,10 @@ from vemkit.mesh import Mesh
 from vemkit.scene import Scene
 from vemkit.system import DiscreteProblem, discrete_problem
 
-MESH_OPTION_KEYS = ("kind", "seed", "levels", "rule", "fraction", "lloyd_iterations")
-
-
 def scene_mesh(scene: Scene) -> Mesh:
     opts = scene.mesh_options
     family, n = opts.pop("family"), opts.pop("n")
-    return build_mesh(family, n, **{k: v for k, v in opts.items() if k in MESH_OPTION_KEYS})
+    return build_mesh(family, n, **opts)  # options were checked by the scene schema and build_mesh
 
 
 def _pair(expressions):
