@@ -1,0 +1,14 @@
+"""Rule figure_contact: pressure, tangential stress, slip and zones along Gamma_C."""
+
+from _helpers import logged
+
+smk = snakemake  # noqa: F821 - the snakemake object of the job
+with logged(smk):
+    from vemkit import plots
+    from vemkit.convergence import read_solution
+
+    _, ds = read_solution(smk.input[0])
+    spec = smk.params.spec
+    title = rf"contact boundary $\Gamma_C$: {spec['mesh']} mesh, n = {spec['n']} ({ds.attrs['stabilization']})"
+    fig = plots.contact_figure(ds, title=title)
+    plots.save(fig, smk.output.png, smk.output.pdf)
