@@ -54,6 +54,7 @@ class AMGSolver:
             postsmoother=("gauss_seidel", {"sweep": "backward"}),
             improve_candidates=None,
             max_coarse=500,
+            coarse_solver="splu",  # pinv (the default) costs seconds when coarsening stalls above max_coarse
             keep=False,
         )
         self.preconditioner = self.hierarchy.aspreconditioner(cycle="V")
@@ -116,7 +117,15 @@ class DirectSolver:
 
 
 def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000):
-    """One solver object for repeated solves with A: ``method`` is amg, direct or auto."""
+    """One solver object for repeated solves with A: ``method`` is amg, direct or auto.
+
+    ``method`` may also be a solver built earlier for the same matrix (a sweep over contact
+    parameters keeps the stiffness matrix): it is returned as it is, set-up reused.
+    """
+    if isinstance(method, (AMGSolver, DirectSolver)):
+        if method.A.shape != A.shape or method.A.nnz != A.nnz:
+            raise ValueError("the prebuilt linear solver was made for another stiffness matrix")
+        return method
     if method == "auto":
         method = "direct" if A.shape[0] <= DIRECT_LIMIT else "amg"
     if method == "amg":

@@ -23,8 +23,9 @@ def power_law_derivative(t, k: float, m: float):
     t = np.asarray(t, dtype=float)
     if m == 0.0:
         return np.zeros_like(t)
-    tp = np.maximum(t, 0.0)
-    return np.where(t > 0.0, k * m * tp ** (m - 1.0), 0.0)
+    positive = t > 0.0
+    base = np.where(positive, t, 1.0)  # no 0 ** (m - 1) for m < 1
+    return np.where(positive, k * m * base ** (m - 1.0), 0.0)
 
 
 @dataclass(frozen=True)

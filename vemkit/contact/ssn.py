@@ -50,6 +50,7 @@ is returned with iterations = 0.
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
@@ -58,7 +59,6 @@ import scipy.sparse.linalg as spla
 from vemkit.contact.solution import (
     ContactSolution,
     ConvergenceError,
-    contact_force_vector,
     contact_residual,
     history_arrays,
     residual_scale,
@@ -130,45 +130,53 @@ class _ReducedSolver:
         self.baseline = baseline  # CG iterations per decade of residual reduction with K
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True):
-        b = Z.T @ rhs
-        A_red = (Z.T @ A @ Z).tocsr()
+        """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs)."""
+        b = rhs if Z is None else Z.T @ rhs
+        A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
+        lift = (lambda y: y) if Z is None else (lambda y: Z @ y)
         if self.method == "direct":
             if symmetric:
-                return Z @ linear_solver(A_red, "direct").solve(b), 1
+                return lift(linear_solver(A_red, "direct").solve(b)), 1
             y = spla.splu(A_red.tocsc()).solve(b)
             if not np.all(np.isfinite(y)):
                 raise LinearSolveError("the direct solve of the Newton step produced non-finite values")
-            return Z @ y, 1
+            return lift(y), 1
         if np.linalg.norm(b) == 0.0:
             return np.zeros(A.shape[0]), 0
-        self.krylov = spla.cg if symmetric else _gmres
-        y, its = self._cg(A_red, Z, b, eta)
+        krylov = spla.cg if symmetric else _gmres
+        y, its = self._krylov(krylov, A_red, Z, b, eta)
         decades = max(np.log10(1.0 / eta), 1.0)
         if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
-            hierarchy = linear_solver(A + penalty, "amg", near_nullspace=self.problem.near_nullspace)
+            hierarchy = linear_solver(A + penalty(), "amg", near_nullspace=self.problem.near_nullspace)
             self.preconditioner = hierarchy.preconditioner
             self.rebuilds += 1
-            y, more = self._cg(A_red, Z, b, eta, x0=y)
+            y, more = self._krylov(krylov, A_red, Z, b, eta, x0=y)
             its += more
-        return Z @ y, its
+        return lift(y), its
 
-    def _cg(self, A_red, Z, b, eta, x0=None):
-        M = self.preconditioner
-        M_red = spla.LinearOperator(A_red.shape, matvec=lambda v: Z.T @ (M @ (Z @ v)), dtype=float)
+    def _krylov(self, krylov, A_red, Z, b, eta, x0=None):
+        full, M = self.preconditioner, self.preconditioner
+        if Z is not None:
+            M = spla.LinearOperator(A_red.shape, matvec=lambda v: Z.T @ (full @ (Z @ v)), dtype=float)
         count = [0]
 
         def callback(_):
             count[0] += 1
 
-        y, info = self.krylov(A_red, b, x0=x0, rtol=eta, atol=0.0, maxiter=5000, M=M_red, callback=callback)
+        y, info = krylov(A_red, b, x0=x0, rtol=eta, atol=0.0, maxiter=5000, M=M, callback=callback)
         if info != 0 or not np.all(np.isfinite(y)):
-            raise LinearSolveError(f"AMG-CG of the Newton step stopped after {count[0]} iterations; try solver.linear=direct")
+            raise LinearSolveError(
+                f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
+                f"try solver.linear=direct"
+            )
         return y, count[0]
 
 
 def _gmres(A, b, x0, rtol, atol, maxiter, M, callback):
     """GMRES (restart 50) with the cg call signature; callback once per inner iteration."""
-    return spla.gmres(A, b, x0=x0, rtol=rtol, atol=atol, restart=50, maxiter=maxiter, M=M, callback=callback, callback_type="pr_norm")
+    return spla.gmres(
+        A, b, x0=x0, rtol=rtol, atol=atol, restart=50, maxiter=maxiter, M=M, callback=callback, callback_type="pr_norm"
+    )
 
 
 def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None) -> ContactSolution:
@@ -210,7 +218,9 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
     kd_nu = _direction_diagonal(K, cb, cb.normal)
     reduced = _ReducedSolver(problem, base, baseline)
     short_steps = 0
-    contrast = float(np.max(cb.weight * law.normal_stiffness(np.abs(t)) / kd_nu))
+    # p_nu' is unbounded at 0 only for m_nu < 1: cap it there (a modified Newton step)
+    stiffness_cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if 0.0 < law.m_normal < 1.0 else np.inf
+    contrast = float(np.max(cb.weight * np.minimum(law.normal_stiffness(np.abs(t)), stiffness_cap) / kd_nu))
     info["contact_stiffness_contrast"] = contrast
     if reduced.method == "amg" and contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
         reduced.method = info["fallback"] = "direct"
@@ -219,13 +229,11 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
     b_ref = b_ref if b_ref > 0.0 else 1.0
     gamma = GAMMA_FACTOR * kd_tau / (np.sum(cb.weight) * b_ref)
     merit_weight = cb.weight * b_ref
-    # p_nu' is unbounded at 0 only for m_nu < 1: cap it there (a modified Newton step)
-    stiffness_cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if 0.0 < law.m_normal < 1.0 else np.inf
     zero = np.zeros(n_c)
 
     def evaluate(u, lam):
         """Everything the step and the line search need at (u, lambda)."""
-        point = _Point(u, lam)
+        point = SimpleNamespace(u=u, lam=lam, energy=0.0, floor=0.0)
         point.t = cb.normal_displacement(u) - cb.gap
         point.slip = cb.tangential_displacement(u)
         Ku = K @ u
@@ -238,9 +246,8 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
         point.theta = float(point.R @ point.R + C @ C)
         point.scale = residual_scale(f_norm, float(np.linalg.norm(normal_force + friction_force)))
         if energy_merit:
-            point.energy = float(
-                0.5 * (u @ Ku) - f @ u + cb.weight @ _normal_energy(law, point.t) + law.k_friction * (cb.weight @ np.abs(point.slip))
-            )
+            friction = law.k_friction * (cb.weight @ np.abs(point.slip))
+            point.energy = float(0.5 * (u @ Ku) - f @ u + cb.weight @ _normal_energy(law, point.t) + friction)
         return point
 
     K_abs = abs(K)
@@ -281,38 +288,36 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
         stick_shift = cb.scatter(zero, np.where(stick, -point.slip, 0.0), n)
         friction_now = cb.scatter(zero, cb.weight * bound * lam, n)
         slip_force = cb.scatter(zero, np.where(slip, cb.weight * bound * sign, 0.0), n)
-        Z = _stick_basis(cb, np.flatnonzero(stick), n)
-        penalty = _rank_one_blocks(cb, np.where(stick, STICK_PENALTY * kd_tau, 0.0), cb.tangent, n)
+        Z = _stick_basis(cb, np.flatnonzero(stick), n) if np.any(stick) else None
 
-        def direction(slope_nu, eta):
-            """Newton step (du, dlambda) for the current sets."""
-            A = K + _rank_one_blocks(cb, cb.weight * slope_nu, cb.normal, n)
-            if not law.reduced:  # d/du of w p_tau(t) lambda tau: w p_tau'(t) lambda tau nu^T (unsymmetric)
-                lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
-                A = A + _rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(t) * lam_hat, cb.tangent, n, cb.normal)
-            A = A.tocsr()
-            rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
-            eta_floor = 0.1 * tol * point.scale / max(np.linalg.norm(rhs), np.finfo(float).tiny)
-            eta = min(max(eta, eta_floor, 1e-14), ETA_MAX)
-            try:
-                correction, its = reduced.solve(A, Z, rhs, eta, penalty, symmetric=law.reduced)
-            except LinearSolveError as exc:
-                raise ConvergenceError(f"ssn: {exc}") from None
-            du = stick_shift + correction
-            stick_force = cb.tangential_displacement(rhs - A @ correction)
-            lam_new = np.where(slip, sign, lam)
-            lam_new = np.where(stick, stick_force / (cb.weight * np.where(stick, bound, 1.0)), lam_new)
-            slip_new = point.slip + cb.tangential_displacement(du)
-            lam_new = np.where(frictional, lam_new, np.where(slip_new != 0.0, np.sign(slip_new), lam))
-            if not (np.all(np.isfinite(du)) and np.all(np.isfinite(lam_new))):
-                _fail(problem, k, "non-finite Newton step", records, max(contrast, 2 * CONTRAST_WARNING))
-            return du, lam_new - lam, its, eta
+        def penalty():  # for a rebuilt AMG hierarchy: stick tangents nearly clamped
+            return _rank_one_blocks(cb, np.where(stick, STICK_PENALTY * kd_tau, 0.0), cb.tangent, n)
 
+        # the Newton system: K + J (+ the friction-bound derivative w p_tau' lambda tau nu^T, m_tau > 0)
+        A = K + _rank_one_blocks(cb, cb.weight * np.minimum(law.normal_stiffness(t), stiffness_cap), cb.normal, n)
+        if not law.reduced:
+            lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
+            A = A + _rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(t) * lam_hat, cb.tangent, n, cb.normal)
+        A = A.tocsr()
+        rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
         if base.method == "amg" and k > 1:
             eta = min(ETA_MAX, 0.9 * point.theta / theta_previous)  # Eisenstat-Walker, choice 2
-        du, dlam, its, eta = direction(np.minimum(law.normal_stiffness(t), stiffness_cap), eta)
-        full = evaluate(u + du, lam + dlam)
+        eta = min(max(eta, 0.1 * tol * point.scale / max(np.linalg.norm(rhs), np.finfo(float).tiny), 1e-14), ETA_MAX)
+        try:
+            correction, its = reduced.solve(A, Z, rhs, eta, penalty, symmetric=law.reduced)
+        except LinearSolveError as exc:
+            raise ConvergenceError(f"ssn: {exc}") from None
         linear_total += its
+        du = stick_shift + correction
+        stick_force = cb.tangential_displacement(rhs - A @ correction)
+        lam_new = np.where(slip, sign, lam)
+        lam_new = np.where(stick, stick_force / (cb.weight * np.where(stick, bound, 1.0)), lam_new)
+        slip_new = point.slip + cb.tangential_displacement(du)
+        lam_new = np.where(frictional, lam_new, np.where(slip_new != 0.0, np.sign(slip_new), lam))
+        if not (np.all(np.isfinite(du)) and np.all(np.isfinite(lam_new))):
+            _fail(problem, k, "non-finite Newton step", records, max(contrast, 2 * CONTRAST_WARNING))
+        dlam = lam_new - lam
+        full = evaluate(u + du, lam_new)
         du_tau = cb.tangential_displacement(du)
 
         def trial(alpha):
@@ -333,23 +338,15 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
             "step": alpha,
             "active_changes": changes,
             "linear_iterations": its,
-            "eta": eta,
         }
+        if base.method == "amg":
+            record["eta"] = eta
         records.append(record)
         if progress is not None:
             progress(k, record)
     if converged(point):
         return finish(point.u, point.lam, max_iterations, records)
     _fail(problem, max_iterations, f"residual {np.sqrt(point.theta) / point.scale:.1e} > tol {tol:.0e}", records, contrast)
-
-
-class _Point:
-    """An iterate (u, lambda) with its residuals (and energy, for the reduced law)."""
-
-    def __init__(self, u, lam):
-        self.u, self.lam = u, lam
-        self.energy = 0.0
-        self.floor = 0.0
 
 
 def _normal_energy(law, t):
