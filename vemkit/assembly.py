@@ -127,7 +127,7 @@ def vertex_adjacency(offsets, cell_vertices, vc_ptr, vc, free_vertices):
     return indptr, indices
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def dof_pattern(vindptr, vindices):
     """Expand the vertex pattern to 2 x 2 blocks: row 2r + a holds (2c, 2c + 1) for each c."""
     n = vindptr.shape[0] - 1
@@ -138,7 +138,7 @@ def dof_pattern(vindptr, vindices):
         indptr[2 * r + 1] = indptr[2 * r] + 2 * deg
         indptr[2 * r + 2] = indptr[2 * r + 1] + 2 * deg
     indices = np.empty(indptr[2 * n], dtype=np.int32)
-    for r in range(n):
+    for r in numba.prange(n):
         for a in range(2):
             k = indptr[2 * r + a]
             for t in range(vindptr[r], vindptr[r + 1]):

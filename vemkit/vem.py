@@ -146,24 +146,30 @@ def element_stiffness(px, py, lam, mu, stab, K, B, P, R):
         alpha = 2.0 * mu
     else:
         alpha = tr / m
-    # R = I - Pi_D, Pi_D evaluates the projection at the vertices
-    for i in range(n):
-        d1 = px[i] - xb
-        d2 = py[i] - yb
-        for j in range(m):
-            R[2 * i, j] = -(P[0, j] + P[3, j] * d1 + P[5, j] * d2 - P[2, j] * d2)
-            R[2 * i + 1, j] = -(P[1, j] + P[5, j] * d1 + P[4, j] * d2 + P[2, j] * d1)
-        R[2 * i, 2 * i] += 1.0
-        R[2 * i + 1, 2 * i + 1] += 1.0
+    # R holds (I - Pi_D)^T: row j is the vertex values of phi_j - Pi phi_j (contiguous for the product)
+    for j in range(m):
+        c1 = P[0, j]
+        c2 = P[1, j]
+        om = P[2, j]
+        e11 = P[3, j]
+        e22 = P[4, j]
+        e12 = P[5, j]
+        for i in range(n):
+            d1 = px[i] - xb
+            d2 = py[i] - yb
+            R[j, 2 * i] = -(c1 + e11 * d1 + (e12 - om) * d2)
+            R[j, 2 * i + 1] = -(c2 + (e12 + om) * d1 + e22 * d2)
+        R[j, j] += 1.0
     # stabilization alpha (I - Pi)^T (I - Pi)
     for i in range(m):
         for j in range(i, m):
             acc = 0.0
             for k in range(m):
-                acc += R[k, i] * R[k, j]
-            K[i, j] += alpha * acc
+                acc += R[i, k] * R[j, k]
+            acc *= alpha
+            K[i, j] += acc
             if j != i:
-                K[j, i] += alpha * acc
+                K[j, i] += acc
     return area
 
 
