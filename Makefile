@@ -26,4 +26,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/contact.py
 
 clean-results:
-	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes
+	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs

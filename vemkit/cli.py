@@ -134,6 +134,9 @@ def main(argv=None) -> int:
         message = " ".join(str(error).split()) or type(error).__name__
         print(f"vemkit: error: {message}", file=sys.stderr)
         return EXIT_FAILURE
+    except BaseException:  # a bug: keep the traceback, but leave no output behind
+        _remove(*outputs)
+        raise
 
 
 if __name__ == "__main__":

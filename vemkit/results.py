@@ -62,17 +62,18 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
         )
         ds["contact_vertex"] = (c, cb.vertices[order], {"long_name": "mesh2d node index of the contact vertex"})
         ds["contact_weight"] = (c, cb.weight[order], {"long_name": "nodal quadrature weight on Gamma_C", "units": "mm"})
-        for name, key, long_name, units in (
-            ("normal_pressure", "normal_pressure", "p_nu(u_nu - g_a) (2.6)", "daN/mm2"),
-            ("tangential_stress", "tangential_stress", "sigma_tau = -p_tau lambda (2.7)-(2.8)", "daN/mm2"),
-            ("friction_multiplier", "multiplier", "lambda in [-1, 1] (5.3)", "1"),
-            ("slip", "slip", "tangential displacement u_tau", "mm"),
-            ("penetration", "penetration", "u_nu - g_a (> 0: penetration)", "mm"),
+        for name, values, long_name, units in (
+            ("normal_pressure", st.normal_pressure, "p_nu(u_nu - g_a) (2.6)", "daN/mm2"),
+            ("tangential_stress", st.tangential_stress, "sigma_tau = -p_tau lambda (2.7)-(2.8)", "daN/mm2"),
+            ("friction_bound", st.friction_bound, "p_tau(u_nu - g_a)", "daN/mm2"),
+            ("friction_multiplier", solution.multiplier, "lambda in [-1, 1] (5.3)", "1"),
+            ("slip", st.slip, "tangential displacement u_tau", "mm"),
+            ("penetration", st.penetration, "u_nu - g_a (> 0: penetration)", "mm"),
         ):
-            ds[name] = (c, np.asarray(st[key])[order], {"long_name": long_name, "units": units})
+            ds[name] = (c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
         ds["contact_state"] = (
-            c, np.asarray(st["state"], dtype=np.int8)[order],
-            {"long_name": "contact state", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
+            c, np.asarray(st.state, dtype=np.int8)[order],
+            {"long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
         )
     for key, values in solution.history.items():
         ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
@@ -109,6 +110,9 @@ def write_netcdf(ds: xr.Dataset, path) -> Path:
     os.close(fd)
     try:
         ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
