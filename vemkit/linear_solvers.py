@@ -49,7 +49,9 @@ class AMGSolver:
             B=near_nullspace,
             symmetry="hermitian",
             strength=("symmetric", {"theta": 0.0}),
-            smooth=("jacobi", {"omega": 4.0 / 3.0, "degree": 1}),
+            # "local" weighting bounds rho(D^-1 A) by row sums: the default Lanczos estimate
+            # was 70 % of the set-up at 512^2 squares, for 4 fewer CG iterations
+            smooth=("jacobi", {"omega": 4.0 / 3.0, "degree": 1, "weighting": "local"}),
             presmoother=("gauss_seidel", {"sweep": "forward"}),
             postsmoother=("gauss_seidel", {"sweep": "backward"}),
             improve_candidates=None,
