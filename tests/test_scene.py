@@ -68,7 +68,7 @@ def test_paper_scene_has_the_paper_numbers(paper):
     assert paper.mesh_options == {"family": "square", "n": 16}
     assert isinstance(paper.mesh_options["n"], int)
     assert paper.stabilization == "dofi-2mu" and paper.contact_quadrature == "nodal"
-    assert paper.solver_options == {"method": "ssn", "tol": 1e-10, "max_iterations": 200,
+    assert paper.solver_options == {"method": "ssn", "tol": 1e-10, "max_iterations": None,
                                     "linear": "auto", "rho": None, "eps_u": None,
                                     "eps_lambda": None, "stop": "either"}
 

@@ -13,7 +13,7 @@ import numpy as np
 import pyamg
 import scipy.sparse.linalg as spla
 
-DIRECT_LIMIT = 60_000  # "auto" picks the direct solver below this many unknowns
+DIRECT_LIMIT = 20_000  # "auto" picks the direct solver below this many unknowns (measured crossover)
 
 
 class LinearSolveError(RuntimeError):
