@@ -21,6 +21,10 @@ include: "workflow/rules/solves.smk"
 include: "workflow/rules/errors.smk"
 include: "workflow/rules/tables.smk"
 include: "workflow/rules/figures.smk"
+# beyond the paper (not in `rule all`): `snakemake -j2 extras` -- sweeps, speed-accuracy, stability
+include: "workflow/rules/sweeps.smk"
+include: "workflow/rules/tradeoff.smk"
+include: "workflow/rules/stability.smk"
 
 
 rule all:

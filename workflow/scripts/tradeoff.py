@@ -1,0 +1,58 @@
+"""Rules tradeoff_family (every run of one mesh family) and tradeoff (gather, Pareto, answer, plot)."""
+
+import os
+import sys
+
+# The rule asks for 2 threads only to keep other jobs off the core it times; Snakemake sets the BLAS
+# and OpenMP thread counts to the rule's threads, but vemkit's solves are meant single-threaded
+# (multi-threaded BLAS slows the sparse solves down): back to 1 before numpy loads.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS",
+             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
+    os.environ[_var] = "1"
+_NUMPY_EARLY = "numpy" in sys.modules
+
+from _helpers import logged  # noqa: E402
+
+smk = snakemake  # noqa: F821 - the snakemake object of the job
+with logged(smk):
+    import json
+
+    from vemkit import tradeoff
+    from vemkit.scene import load_scene
+
+    if _NUMPY_EARLY:
+        print("warning: numpy was loaded before the thread counts were set to 1", flush=True)
+    s = smk.params.settings
+    scene = load_scene(s["scene"], s["overrides"])
+    if smk.rule == "tradeoff_family":
+        from vemkit.convergence import ReferenceSolution, write_records
+
+        reference = ReferenceSolution(smk.input.reference)
+        tradeoff.check_reference_scene(scene, reference.dataset.attrs.get("scene", ""))
+
+        def progress(r):
+            print(f"{r['family']} {r['solver']:<5} tol {r['tol']:.0e} {r['stabilization']:<8} n={r['n']:<4} "
+                  f"{r['n_dofs']:>6} dofs  error {r['error_h1']:.4e}  {r['cost_time']:.3f} s  status {r['status']} "
+                  f"{r['message']}", flush=True)
+
+        records = tradeoff.run_family(
+            scene, smk.wildcards.family, dict(smk.params.spec), reference, levels=s["levels"], solvers=s["solvers"],
+            tolerances=s["tolerances"], stabilizations=s["stabilizations"], repeats=s["repeats"],
+            time_budget=s["time_budget"], reference_n=s["reference"]["n"], max_iterations=s["max_iterations"],
+            progress=progress)
+        write_records(records, smk.output[0])
+    else:
+        from vemkit.convergence import read_records
+        from vemkit.plots import save
+        from vemkit.sweep_plots import pareto_figure
+        from vemkit.sweeps import write_dataset
+
+        ds = tradeoff.tradeoff_dataset(read_records(smk.input), targets=s["targets"], gains=s["refinement_gain"],
+                                       scene_yaml=scene.to_yaml(), settings=s)
+        write_dataset(ds, smk.output.nc)
+        text = tradeoff.tradeoff_markdown(ds)
+        with open(smk.output.md, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        save(pareto_figure(ds, ds.attrs["error"], s["targets"]), smk.output.png)
+        print(text)
+        print(json.dumps(json.loads(ds.attrs["refinement_gain"]), indent=1))
