@@ -24,6 +24,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/assembly.py
 	$(BIN)/python benchmarks/contact.py
+	$(BIN)/python benchmarks/sweep.py
 
 clean-results:
 	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs
