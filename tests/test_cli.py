@@ -105,3 +105,9 @@ def test_mesh_command(tmp_path):
     assert mesh.n_cells > 16 and mesh.cell_sizes.max() > 4
     run = vemkit("mesh", "square", 4, "-o", out, "--option", "seed=2")
     assert run.returncode != 0 and "seed" in run.stderr
+
+
+def test_unimplemented_contact_quadrature_is_refused_not_ignored(tmp_path):
+    out = tmp_path / "g.nc"
+    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.contact_quadrature=gauss")
+    assert run.returncode != 0 and "contact_quadrature" in run.stderr and not out.exists()
