@@ -26,8 +26,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-FLOAT_FILL = -9999.0
-INT_FILL = -1
+from vemkit.results import FLOAT_FILL, INT_FILL  # noqa: E402,F401  (one fill scheme for every table file)
 VERSIONED_PACKAGES = ("numpy", "scipy", "numba", "pyamg", "xarray", "netCDF4", "vemkit")
 
 #: keys of one error record, with their meaning and units
@@ -365,39 +364,18 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
     return ds
 
 
-def write_convergence(ds: xr.Dataset, path) -> Path:
-    """Write a convergence Dataset atomically (netCDF4). A float variable holding NaN is written
-    with ``_FillValue = -9999.0`` in their place, an integer one holding -1 with ``_FillValue = -1``;
-    variables without undefined entries carry no ``_FillValue`` at all."""
-    from vemkit.results import write_netcdf
+def write_convergence(ds: xr.Dataset, path):
+    """Write atomically; undefined entries as declared fill values (``vemkit.results.write_with_fill_values``)."""
+    from vemkit.results import write_with_fill_values
 
-    out = ds.copy()
-    for key in list(out.variables):
-        var = out[key]
-        var.encoding.pop("_FillValue", None)
-        attrs = {k: v for k, v in var.attrs.items() if k != "_FillValue"}
-        if np.issubdtype(var.dtype, np.floating) and np.isnan(var.values).any():
-            out[key] = var.copy(data=np.where(np.isnan(var.values), FLOAT_FILL, var.values))
-            out[key].attrs = {**attrs, "_FillValue": FLOAT_FILL}
-        elif key in ("n_dofs", "n_cells", "iterations") and (var.values == INT_FILL).any():
-            out[key].attrs = {**attrs, "_FillValue": INT_FILL}
-        else:
-            out[key].attrs = attrs
-            out[key].encoding["_FillValue"] = None
-    return write_netcdf(out, path)
+    return write_with_fill_values(ds, path)
 
 
 def read_convergence(path) -> xr.Dataset:
-    """A convergence file, fill values masked to NaN (floats) and kept as -1 (integers)."""
-    with xr.open_dataset(path, mask_and_scale=False) as ds:
-        ds = ds.load()
-    for key in list(ds.data_vars):
-        var = ds[key]
-        fill = var.attrs.get("_FillValue")
-        if np.issubdtype(var.dtype, np.floating) and fill is not None:
-            ds[key] = var.where(var != fill)
-            ds[key].attrs = {k: v for k, v in var.attrs.items() if k != "_FillValue"}
-    return ds
+    """Read a file written by :func:`write_convergence`: float fill values back to NaN, integer ones kept as -1."""
+    from vemkit.results import read_with_fill_values
+
+    return read_with_fill_values(path)
 
 
 def square_rows(ds: xr.Dataset, family: str = "square") -> xr.Dataset:

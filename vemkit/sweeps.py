@@ -37,8 +37,7 @@ import xarray as xr
 
 from vemkit.stability import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outcome, failed, guarded_solve
 
-FLOAT_FILL = -9999.0
-INT_FILL = -1
+from vemkit.results import FLOAT_FILL, INT_FILL  # noqa: E402,F401  (one fill scheme for every table file)
 #: short dimension names of common scene keys (others: the key with "." -> "_")
 DIMENSION_NAMES = {
     "contact.normal.k": "k_nu", "contact.normal.m": "m_nu", "contact.friction.k": "k_tau",
@@ -318,42 +317,17 @@ def run_sweep(scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CH
 
 
 def write_dataset(ds: xr.Dataset, path):
-    """Write atomically (``vemkit.results.write_netcdf``) with the fill scheme of the module docstring.
+    """Write atomically; undefined entries as declared fill values (``vemkit.results.write_with_fill_values``)."""
+    from vemkit.results import write_with_fill_values
 
-    Float variables holding NaN get ``_FillValue = -9999.0`` in their place, integer variables
-    holding -1 ``_FillValue = -1``; the others no fill value. Strings are stored as netCDF strings.
-    """
-    from vemkit.results import write_netcdf
-
-    out = ds.copy()
-    for key in list(out.variables):
-        var = out[key]
-        attrs = {k: v for k, v in var.attrs.items() if k != "_FillValue"}
-        var.encoding.pop("_FillValue", None)
-        if np.issubdtype(var.dtype, np.floating) and np.isnan(var.values).any():
-            out[key] = var.copy(data=np.where(np.isnan(var.values), FLOAT_FILL, var.values))
-            out[key].attrs = {**attrs, "_FillValue": FLOAT_FILL}
-        elif np.issubdtype(var.dtype, np.integer) and key not in out.dims and (var.values == INT_FILL).any():
-            out[key].attrs = {**attrs, "_FillValue": var.dtype.type(INT_FILL)}
-        else:
-            out[key].attrs = attrs
-            if var.dtype != object:
-                out[key].encoding["_FillValue"] = None
-    return write_netcdf(out, path)
+    return write_with_fill_values(ds, path)
 
 
 def read_dataset(path) -> xr.Dataset:
-    """A file of write_dataset: float fill values back to NaN, integer ones kept as -1."""
-    with xr.open_dataset(path, mask_and_scale=False) as ds:
-        ds = ds.load()
-    for key in list(ds.variables):
-        var = ds[key]
-        fill = var.attrs.get("_FillValue")
-        if fill is not None:
-            attrs = {k: v for k, v in var.attrs.items() if k != "_FillValue"}
-            ds[key] = var.where(var != fill) if np.issubdtype(var.dtype, np.floating) else var
-            ds[key].attrs = attrs
-    return ds
+    """Read a file written by :func:`write_dataset`: float fill values back to NaN, integer ones kept as -1."""
+    from vemkit.results import read_with_fill_values
+
+    return read_with_fill_values(path)
 
 
 def combine_parts(parts) -> xr.Dataset:
