@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from vemkit.mesh import Mesh
-from vemkit.vem import polygon_area, projection_coefficients, strain_operator
+from vemkit.vem import cell_coordinates, polygon_area, projection_coefficients, strain_operator
 
 
 @numba.njit(cache=True)
@@ -23,11 +23,7 @@ def _cell_projections(vertices, offsets, cell_vertices, u, coef, center):
     for c in range(n_cells):
         s = offsets[c]
         n = offsets[c + 1] - s
-        px = np.empty(n)
-        py = np.empty(n)
-        for i in range(n):
-            px[i] = vertices[cell_vertices[s + i], 0]
-            py[i] = vertices[cell_vertices[s + i], 1]
+        px, py = cell_coordinates(vertices, offsets, cell_vertices, c)
         B = np.empty((3, 2 * n))
         P = np.empty((6, 2 * n))
         strain_operator(px, py, polygon_area(px, py), B)

@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from vemkit.mesh import Mesh
-from vemkit.vem import projection_coefficients, strain_operator
+from vemkit.vem import cell_coordinates, projection_coefficients, strain_operator
 
 # 7-point degree-5 rule on the reference triangle (barycentric a, b, c; weights sum to 1)
 _A1, _B1 = 0.059715871789770, 0.470142064105115
@@ -80,11 +80,7 @@ def _body_force_scatter(vertices, offsets, cell_vertices, force, out):
     for c in range(n_cells):
         s = offsets[c]
         n = offsets[c + 1] - s
-        px = np.empty(n)
-        py = np.empty(n)
-        for i in range(n):
-            px[i] = vertices[cell_vertices[s + i], 0]
-            py[i] = vertices[cell_vertices[s + i], 1]
+        px, py = cell_coordinates(vertices, offsets, cell_vertices, c)
         area = 0.0
         cx = 0.0
         cy = 0.0

@@ -44,6 +44,19 @@ def elasticity_matrix(lam: float, mu: float) -> np.ndarray:
 # Numba kernel
 # --------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
+def cell_coordinates(vertices, offsets, cell_vertices, c):
+    """(px, py): the vertex coordinates of cell c, in its (counter-clockwise) order."""
+    s = offsets[c]
+    n = offsets[c + 1] - s
+    px = np.empty(n)
+    py = np.empty(n)
+    for i in range(n):
+        px[i] = vertices[cell_vertices[s + i], 0]
+        py[i] = vertices[cell_vertices[s + i], 1]
+    return px, py
+
+
+@numba.njit(cache=True)
 def polygon_area(px, py):
     n = px.shape[0]
     a = 0.0
