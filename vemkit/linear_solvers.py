@@ -41,7 +41,7 @@ class AMGSolver:
         self.A = A.tocsr()
         self.tol = tol
         self.maxiter = maxiter
-        # Settings measured on the paper scene (benchmarks/assembly.py): scalar CSR aggregation with
+        # Settings measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR aggregation with
         # the rigid-body modes converges in as few CG iterations as 2 x 2 BSR blocks and its
         # Gauss-Seidel sweeps are cheaper; improving the candidates doubles the setup for nothing.
         self.hierarchy = pyamg.smoothed_aggregation_solver(
@@ -55,7 +55,7 @@ class AMGSolver:
             presmoother=("gauss_seidel", {"sweep": "forward"}),
             postsmoother=("gauss_seidel", {"sweep": "backward"}),
             improve_candidates=None,
-            max_coarse=500,
+            max_coarse=2000,
             coarse_solver="splu",  # pinv (the default) costs seconds when coarsening stalls above max_coarse
             keep=False,
         )
