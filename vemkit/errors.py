@@ -14,6 +14,7 @@ import numba
 import numpy as np
 
 from vemkit.fields import ProjectedSolution
+from vemkit.grid_bins import bin_boxes
 from vemkit.mesh import Mesh
 
 # degree-2 rule on triangles (barycentric coordinates, weights summing to 1)
@@ -22,9 +23,9 @@ _DEGREE2_WEIGHTS = np.full(3, 1 / 3)
 
 
 @numba.njit(cache=True)
-def _bucket_cells(vertices, offsets, cell_vertices, lo, inv, nb):
+def _cell_bin_boxes(vertices, offsets, cell_vertices, lo, inv, nb):
+    """(M, 4) bins (i0, i1, j0, j1) covered by the bounding box of every cell."""
     n_cells = offsets.shape[0] - 1
-    count = np.zeros(nb * nb + 1, dtype=np.int64)
     boxes = np.empty((n_cells, 4), dtype=np.int64)
     for c in range(n_cells):
         x0 = 1e300
@@ -37,24 +38,11 @@ def _bucket_cells(vertices, offsets, cell_vertices, lo, inv, nb):
             x1 = max(x1, vertices[v, 0])
             y0 = min(y0, vertices[v, 1])
             y1 = max(y1, vertices[v, 1])
-        i0 = min(nb - 1, max(0, int((x0 - lo[0]) * inv[0])))
-        i1 = min(nb - 1, max(0, int((x1 - lo[0]) * inv[0])))
-        j0 = min(nb - 1, max(0, int((y0 - lo[1]) * inv[1])))
-        j1 = min(nb - 1, max(0, int((y1 - lo[1]) * inv[1])))
-        boxes[c, 0], boxes[c, 1], boxes[c, 2], boxes[c, 3] = i0, i1, j0, j1
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                count[j * nb + i + 1] += 1
-    for b in range(nb * nb):
-        count[b + 1] += count[b]
-    members = np.empty(count[nb * nb], dtype=np.int64)
-    fill = count[:-1].copy()
-    for c in range(n_cells):
-        for j in range(boxes[c, 2], boxes[c, 3] + 1):
-            for i in range(boxes[c, 0], boxes[c, 1] + 1):
-                members[fill[j * nb + i]] = c
-                fill[j * nb + i] += 1
-    return count, members
+        boxes[c, 0] = min(nb - 1, max(0, int((x0 - lo[0]) * inv[0])))
+        boxes[c, 1] = min(nb - 1, max(0, int((x1 - lo[0]) * inv[0])))
+        boxes[c, 2] = min(nb - 1, max(0, int((y0 - lo[1]) * inv[1])))
+        boxes[c, 3] = min(nb - 1, max(0, int((y1 - lo[1]) * inv[1])))
+    return boxes
 
 
 @numba.njit(cache=True)
@@ -100,7 +88,7 @@ def locate_points(mesh: Mesh, points: np.ndarray) -> np.ndarray:
     hi = mesh.vertices.max(axis=0)
     nb = max(1, int(np.sqrt(mesh.n_cells)))
     inv = nb / np.maximum(hi - lo, 1e-300) * (1 - 1e-12)
-    count, members = _bucket_cells(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb)
+    count, members = bin_boxes(_cell_bin_boxes(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb), nb)
     out = np.empty(points.shape[0], dtype=np.int64)
     _locate(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb, count, members, points, out)
     return out

@@ -26,6 +26,7 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
+from vemkit.grid_bins import bin_boxes
 from vemkit.mesh import Mesh
 
 
@@ -287,23 +288,10 @@ def _segment_bin_box(v, seg, s, lo, inv_cell, g, pad):
 @numba.njit(cache=True)
 def _bin_segments(v, seg, lo, inv_cell, g, pad):
     """CSR of the segments whose (padded) bounding box touches each of the g x g grid bins."""
-    counts = np.zeros(g * g + 1, dtype=np.int64)
+    boxes = np.empty((seg.shape[0], 4), dtype=np.int64)
     for s in range(seg.shape[0]):
-        i0, i1, j0, j1 = _segment_bin_box(v, seg, s, lo, inv_cell, g, pad)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                counts[j * g + i + 1] += 1
-    for i in range(g * g):
-        counts[i + 1] += counts[i]
-    items = np.empty(counts[g * g], dtype=np.int64)
-    fill = counts[:-1].copy()
-    for s in range(seg.shape[0]):
-        i0, i1, j0, j1 = _segment_bin_box(v, seg, s, lo, inv_cell, g, pad)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
-                items[fill[j * g + i]] = s
-                fill[j * g + i] += 1
-    return counts, items
+        boxes[s, 0], boxes[s, 1], boxes[s, 2], boxes[s, 3] = _segment_bin_box(v, seg, s, lo, inv_cell, g, pad)
+    return bin_boxes(boxes, g)
 
 
 @numba.njit(cache=True)
