@@ -36,9 +36,9 @@ def best_of(fn, repeat):
 
 
 def assembly_case(kind: str, n: int, repeat: int) -> dict:
-    from vemkit.assembly import stiffness_matrix
-    from vemkit.families.square import square, structured_triangle
-    from vemkit.system import lame_parameters
+    from vemkit.vem.assembly import stiffness_matrix
+    from vemkit.mesh.families.square import square, structured_triangle
+    from vemkit.vem.elasticity import lame_parameters
 
     lam, mu = lame_parameters(2000.0, 0.4)
     mesh = (square if kind == "square" else structured_triangle)(n)
@@ -54,8 +54,8 @@ def skfem_case(n: int, repeat: int) -> dict:
     import skfem
     from skfem.models.elasticity import linear_elasticity
 
-    from vemkit.families.square import structured_triangle
-    from vemkit.system import lame_parameters
+    from vemkit.mesh.families.square import structured_triangle
+    from vemkit.vem.elasticity import lame_parameters
 
     lam, mu = lame_parameters(2000.0, 0.4)
     mesh = structured_triangle(n)
@@ -75,9 +75,9 @@ def skfem_case(n: int, repeat: int) -> dict:
 
 def linear_solve_case(n: int) -> dict:
     """Runs in its own process (see main): the paper scene without contact, AMG-CG."""
-    from vemkit.families.square import square
-    from vemkit.linear_solvers import linear_solver
-    from vemkit.system import discrete_problem
+    from vemkit.mesh.families.square import square
+    from vemkit.solvers.linear import linear_solver
+    from vemkit.contact.problem import discrete_problem
 
     discrete_problem(square(2), 2000.0, 0.4, neumann={"left": lambda x, y: (x, y)})  # JIT warm-up
     t0 = time.perf_counter()

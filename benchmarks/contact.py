@@ -26,8 +26,9 @@ PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper
 
 
 def run_case(method: str, level: int) -> dict:
-    from vemkit.run import scene_problem, solve_problem
-    from vemkit.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+    from vemkit.solvers.dispatch import solve as solve_problem
+    from vemkit.config.scene import load_scene
 
     scene = load_scene(PAPER_SCENE, [f"discretization.mesh.n={2 ** level}", f"solver.method={method}"])
     warm = load_scene(PAPER_SCENE, ["discretization.mesh.n=4", f"solver.method={method}"])

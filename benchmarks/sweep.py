@@ -44,9 +44,9 @@ def sweep_config(name: str) -> dict:
 def in_process(name: str) -> dict:
     import numpy as np
 
-    from vemkit.scene import load_scene
-    from vemkit.stability import prebuilt_linear_supported
-    from vemkit.sweeps import run_sweep
+    from vemkit.config.scene import load_scene
+    from vemkit.solvers.verification import prebuilt_linear_supported
+    from vemkit.studies.sweeps import run_sweep
 
     spec = sweep_config(name)
     scene = load_scene(ROOT / spec["scene"], spec["all_overrides"])

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from vemkit.contact.laws import ContactLaw
-from vemkit.families import build_mesh
-from vemkit.system import discrete_problem
+from vemkit.mesh.families import build_mesh
+from vemkit.contact.problem import discrete_problem
 
 PAPER = dict(E=2000.0, nu=0.4, gap=0.1, law=ContactLaw(10.0, 1.0, 450.0, 0.0))
 

@@ -49,10 +49,10 @@ def _remove(*paths):
 
 
 def cmd_solve(args) -> int:
-    from vemkit.mesh_io import write_vtu
-    from vemkit.results import write_netcdf
-    from vemkit.run import solve_scene
-    from vemkit.scene import load_scene
+    from vemkit.mesh.files import write_vtu
+    from vemkit.io.solution_file import write_netcdf
+    from vemkit.studies.scene_solve import solve_scene
+    from vemkit.config.scene import load_scene
 
     scene = load_scene(args.scene, args.set or ())
     show = not args.quiet and sys.stderr.isatty()
@@ -82,9 +82,9 @@ def _option_value(text: str):
 
 
 def cmd_mesh(args) -> int:
-    from vemkit.families import build_mesh
-    from vemkit.mesh_checks import validate_mesh
-    from vemkit.mesh_io import write_ugrid, write_vtu
+    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.checks import validate_mesh
+    from vemkit.mesh.files import write_ugrid, write_vtu
 
     options = dict(_option_value(o) for o in (args.option or ()))
     mesh = build_mesh(args.family, args.n, **options)

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vemkit.assembly import DofMap
-from vemkit.mesh import Mesh
+from vemkit.vem.assembly import DofMap
+from vemkit.mesh.mesh import Mesh
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-# The stability matrix (vemkit.stability): every case of vemkit.stability.CASES (or the list in
+# The stability matrix (vemkit.studies.robustness): every case of vemkit.studies.robustness.CASES (or the list in
 # config/sweeps.yaml: stability.cases) with every solver, cut into `parts` jobs, gathered into a
 # netCDF file, a Markdown report and a plot. Needs sweeps.smk (the configuration) included first.
 

@@ -1,4 +1,4 @@
-# Parameter sweeps (vemkit.sweeps) from config/sweeps.yaml, and the `extras` target gathering the
+# Parameter sweeps (vemkit.studies.sweeps) from config/sweeps.yaml, and the `extras` target gathering the
 # sweeps, the speed-accuracy study (tradeoff.smk) and the stability matrix (stability.smk). Include
 # this file first of the three: it reads and validates config/sweeps.yaml (another file:
 # VEMKIT_SWEEPS_CONFIG=path). Nothing here is part of the default target.
@@ -11,7 +11,7 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 SWEEPS_CONFIG_FILE = os.environ.get("VEMKIT_SWEEPS_CONFIG", "config/sweeps.yaml")
-SWEEP_DIMENSION_NAMES = {  # as vemkit.sweeps.DIMENSION_NAMES (checked by tests/test_sweeps.py)
+SWEEP_DIMENSION_NAMES = {  # as vemkit.studies.sweeps.DIMENSION_NAMES (checked by tests/test_sweeps.py)
     "contact.normal.k": "k_nu", "contact.normal.m": "m_nu", "contact.friction.k": "k_tau",
     "contact.friction.m": "m_tau", "contact.gap": "g_a", "material.E": "E", "material.nu": "kappa",
     "discretization.mesh.n": "n", "discretization.stabilization": "stabilization", "solver.method": "solver",
@@ -60,7 +60,7 @@ def sweep_settings(name):
 
 
 def sweep_dimension(key):
-    """As vemkit.sweeps.dimension_name (not imported: keeps the DAG build light)."""
+    """As vemkit.studies.sweeps.dimension_name (not imported: keeps the DAG build light)."""
     return SWEEP_DIMENSION_NAMES.get(key, re.sub(r"[^A-Za-z0-9_]+", "_", key).strip("_"))
 
 

@@ -1,4 +1,4 @@
-# The speed-accuracy study (vemkit.tradeoff): one job per mesh family runs every level, solver,
+# The speed-accuracy study (vemkit.studies.tradeoff): one job per mesh family runs every level, solver,
 # tolerance and stabilization of config/sweeps.yaml (tradeoff) and measures the errors against the
 # reference solution of the main workflow (common.smk: reference_file); one job gathers them into
 # results/tradeoff/tradeoff.nc, the Markdown answer pareto.md and the plot pareto.png.

@@ -4,7 +4,7 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit.convergence import convergence_dataset, read_records, study_scene, write_convergence
+    from vemkit.studies.convergence import convergence_dataset, read_records, study_scene, write_convergence
 
     p = smk.params
     scene = study_scene(p.scene, p.parameters["overrides"] + [f"solver.{k}={v}" for k, v in p.parameters["solver"].items()])

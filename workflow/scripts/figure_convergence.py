@@ -4,8 +4,8 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit import plots
-    from vemkit.convergence import read_convergence
+    from vemkit.report import figures as plots
+    from vemkit.studies.convergence import read_convergence
 
     fig = plots.convergence_figure(read_convergence(smk.input[0]), norm=smk.params.norm)
     plots.save(fig, smk.output.png, smk.output.pdf)

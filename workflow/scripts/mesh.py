@@ -4,9 +4,9 @@ from _helpers import level, logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit.families import build_mesh
-    from vemkit.mesh_checks import validate_mesh
-    from vemkit.mesh_io import write_ugrid
+    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.checks import validate_mesh
+    from vemkit.mesh.files import write_ugrid
 
     spec = smk.params.spec
     for n, path in zip(smk.params.levels, smk.output, strict=True):

@@ -10,10 +10,10 @@ with logged(smk):
 
     numba.set_num_threads(max(1, min(smk.threads, numba.config.NUMBA_NUM_THREADS)))
 
-    from vemkit.convergence import study_scene
-    from vemkit.mesh_io import read_ugrid
-    from vemkit.results import write_netcdf
-    from vemkit.run import solve_scene
+    from vemkit.studies.convergence import study_scene
+    from vemkit.mesh.files import read_ugrid
+    from vemkit.io.solution_file import write_netcdf
+    from vemkit.studies.scene_solve import solve_scene
 
     spec, stab, label = smk.params.spec, smk.wildcards.stab, smk.wildcards.label
     for n, mesh_path, path in zip(smk.params.levels, smk.input.meshes, smk.output, strict=True):

@@ -4,14 +4,14 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit import stability
-    from vemkit.sweeps import read_dataset, write_dataset
+    from vemkit.studies import robustness as stability
+    from vemkit.studies.sweeps import read_dataset, write_dataset
 
     s = smk.params.settings
     if smk.rule == "stability_part":
         import numpy as np
 
-        from vemkit.scene import load_scene
+        from vemkit.config.scene import load_scene
 
         cases = stability.select_cases(None if s["cases"] == "all" else s["cases"])
         part = int(smk.wildcards.part)
@@ -30,8 +30,8 @@ with logged(smk):
     else:
         import xarray as xr
 
-        from vemkit.plots import save
-        from vemkit.sweep_plots import stability_figure
+        from vemkit.report.figures import save
+        from vemkit.report.study_figures import stability_figure
 
         parts = [read_dataset(p) for p in smk.input]
         ds = xr.concat(parts, dim="case", data_vars="minimal", coords="minimal", compat="override",

@@ -4,10 +4,10 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit import sweeps
+    from vemkit.studies import sweeps
 
     if smk.rule == "sweep_part":
-        from vemkit.scene import load_scene
+        from vemkit.config.scene import load_scene
 
         s = smk.params.settings
         part = int(smk.wildcards.part)
@@ -30,8 +30,8 @@ with logged(smk):
         print(f"{smk.output[0]}: {ds.attrs['converged_points']}/{ds.attrs['points']} converged, "
               f"solve time of the parts {ds.attrs['total_time']:.2f} s")
     else:  # sweep_figure
-        from vemkit import sweep_plots
-        from vemkit.plots import save
+        from vemkit.report import study_figures as sweep_plots
+        from vemkit.report.figures import save
 
         ds = sweeps.read_dataset(smk.input[0])
         spec, kind, name = dict(smk.params.figure), smk.wildcards.kind, smk.wildcards.sweep

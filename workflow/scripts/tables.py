@@ -6,8 +6,8 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit import tables
-    from vemkit.convergence import read_convergence
+    from vemkit.report import tables
+    from vemkit.studies.convergence import read_convergence
 
     ds = read_convergence(smk.input[0])
     kind = smk.wildcards.table

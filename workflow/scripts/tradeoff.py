@@ -17,15 +17,15 @@ smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
     import json
 
-    from vemkit import tradeoff
-    from vemkit.scene import load_scene
+    from vemkit.studies import tradeoff
+    from vemkit.config.scene import load_scene
 
     if _NUMPY_EARLY:
         print("warning: numpy was loaded before the thread counts were set to 1", flush=True)
     s = smk.params.settings
     scene = load_scene(s["scene"], s["overrides"])
     if smk.rule == "tradeoff_family":
-        from vemkit.convergence import ReferenceSolution, write_records
+        from vemkit.studies.convergence import ReferenceSolution, write_records
 
         reference = ReferenceSolution(smk.input.reference)
         tradeoff.check_reference_scene(scene, reference.dataset.attrs.get("scene", ""))
@@ -42,10 +42,10 @@ with logged(smk):
             progress=progress)
         write_records(records, smk.output[0])
     else:
-        from vemkit.convergence import read_records
-        from vemkit.plots import save
-        from vemkit.sweep_plots import pareto_figure
-        from vemkit.sweeps import write_dataset
+        from vemkit.studies.convergence import read_records
+        from vemkit.report.figures import save
+        from vemkit.report.study_figures import pareto_figure
+        from vemkit.studies.sweeps import write_dataset
 
         ds = tradeoff.tradeoff_dataset(read_records(smk.input), targets=s["targets"], gains=s["refinement_gain"],
                                        scene_yaml=scene.to_yaml(), settings=s)

@@ -1,0 +1,136 @@
+"""Stability at the extremes (vemkit.studies.robustness): classification, the independent check, the matrix."""
+
+from pathlib import Path
+
+import netCDF4
+import numpy as np
+import pytest
+
+from vemkit.config.scene import load_scene
+from vemkit.contact.problem import scene_problem
+from vemkit.exceptions import ConvergenceError, LinearSolveError, SceneError, TimeBudgetExceeded
+from vemkit.solvers.verification import FAILURE_CLASSES, STATUS_MEANINGS, failure_class, guarded_solve, verify_solution
+from vemkit.studies.robustness import (
+    CASES,
+    case_overrides,
+    run_matrix,
+    select_cases,
+    stability_dataset,
+    stability_markdown,
+)
+from vemkit.report.study_figures import stability_figure
+from vemkit.studies.sweeps import write_dataset
+
+ROOT = Path(__file__).resolve().parents[2]
+SOLVERS = {"ssn": {"max_iterations": 100}, "uzawa": {"max_iterations": 3000, "stop": "both"}}
+# one case of each kind of extreme; the whole matrix is the workflow's results/stability
+REPRESENTATIVE = ["paper", "k_nu=1e+08", "k_tau=0", "k_tau=1e+06", "m_nu=3,k_nu=10000", "m_tau=1,k_tau=10000",
+                  "kappa=0.4999", "E=0.002", "E=2e+09", "g_a=10", "voronoi,tiny edges,anisotropy=10", "hanging,levels=3"]
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(ROOT / "config/scenes/paper.yaml")
+
+
+@pytest.fixture(scope="module")
+def matrix(scene):
+    return run_matrix(scene, select_cases(REPRESENTATIVE), SOLVERS, 8, time_budget=30)
+
+
+def test_the_matrix_has_at_least_fifty_valid_cases(scene):
+    names = [c["name"] for c in CASES]
+    assert len(names) >= 50 and len(set(names)) == len(names)
+    k_nu = {c["set"].get("contact.normal.k") for c in CASES}
+    assert {1e-3, 1e8} <= k_nu
+    assert {0.0, 1e6} <= {c["set"].get("contact.friction.k") for c in CASES}
+    assert {2.0, 3.0} <= {c["set"].get("contact.normal.m") for c in CASES}
+    assert 1.0 in {c["set"].get("contact.friction.m") for c in CASES}
+    assert 0.4999 in {c["set"].get("material.nu") for c in CASES}
+    assert {2e-3, 2e9} <= {c["set"].get("material.E") for c in CASES}
+    assert {0.0, 10.0} <= {c["set"].get("contact.gap") for c in CASES}
+    for case in CASES:  # every case is a valid scene
+        scene.with_overrides(case_overrides(case, 8))
+    with pytest.raises(ValueError, match="unknown"):
+        select_cases(["no such case"])
+
+
+def test_every_case_converges_checked_or_fails_classified(matrix):
+    for result in matrix:
+        name = result["case"]["name"]
+        for method, outcome in result["outcomes"].items():
+            assert outcome.status == "converged" or outcome.status in FAILURE_CLASSES, (name, method)
+            if outcome.converged:
+                checks = outcome.checks
+                assert checks["passed"] and checks["worst"] <= 1e-6, (name, method, checks)
+                assert all(np.isfinite(outcome.solution.u))
+            else:
+                assert outcome.message and outcome.solution is None, (name, method)
+    ssn = {r["case"]["name"]: r["outcomes"]["ssn"].status for r in matrix}
+    assert all(status == "converged" for status in ssn.values()), ssn
+
+
+def test_uzawa_fails_for_a_stiff_foundation_naming_the_culprit(matrix):
+    stiff = next(r for r in matrix if r["case"]["name"] == "k_nu=1e+08")["outcomes"]["uzawa"]
+    assert stiff.status in ("diverged", "stagnated", "max_iterations")
+    assert "contact.normal.k" in stiff.message and stiff.iterations > 0
+
+
+def test_the_independent_check_catches_wrong_solutions(scene):
+    problem = scene_problem(scene.with_overrides(["discretization.mesh.n=8"]))
+    outcome = guarded_solve(problem, {"method": "ssn", "tol": 1e-10})
+    u, lam = outcome.solution.u, outcome.solution.multiplier
+    assert verify_solution(problem, u, lam)["passed"]
+    assert verify_solution(problem, 1.001 * u, lam)["equilibrium"] > 1e-4
+    wrong = verify_solution(problem, u, -lam)
+    assert not wrong["passed"] and wrong["complementarity"] > 0.1
+    assert not verify_solution(problem, np.full_like(u, np.nan), lam)["passed"]
+
+
+def test_failure_classes():
+    def context(exc, cause):
+        try:
+            try:
+                raise cause
+            except type(cause):
+                raise exc from None
+        except type(exc) as raised:
+            return raised
+
+    assert failure_class(TimeBudgetExceeded("late")) == "time_budget"
+    assert failure_class(ConvergenceError("uzawa diverged after 5 iterations (non-finite values): ...")) == "diverged"
+    assert failure_class(ConvergenceError("uzawa did not converge after 201 iterations (|Δu| stagnated at 1)")) == "stagnated"
+    assert failure_class(ConvergenceError("ssn did not converge after 50 iterations (residual 1e-2 > tol 1e-10)")) == "max_iterations"
+    assert failure_class(ConvergenceError("uzawa stopped after 2 iterations by the |Δλ| test but the discrete problem "
+                                          "residual is 1e-4 (accepted 1e-05)")) == "inaccurate_stop"
+    assert failure_class(context(ConvergenceError("ssn: AMG-CG stopped"), LinearSolveError("cg"))) == "linear_solver_failed"
+    assert failure_class(LinearSolveError("singular")) == "linear_solver_failed"
+    assert failure_class(SceneError("contact.normal.k = -1: must be >= 0")) == "invalid_input"
+    assert failure_class(ValueError("anything"), phase="setup") == "invalid_input"
+    assert failure_class(ValueError("operands could not be broadcast"), phase="solve") == "unexpected_exception"
+    assert failure_class(KeyError("x")) == "unexpected_exception"
+    assert failure_class(ConvergenceError("something new")) == "other"
+
+
+def test_time_budget_is_a_classified_failure(scene):
+    problem = scene_problem(scene.with_overrides(["discretization.mesh.n=8"]))
+    outcome = guarded_solve(problem, {"method": "uzawa", "tol": 1e-10}, time_budget=1e-9)
+    assert outcome.status == "time_budget" and "time budget" in outcome.message
+
+
+def test_dataset_table_and_plot(matrix, tmp_path):
+    ds = stability_dataset(matrix, settings={"n": 8, "check_tol": 1e-6})
+    assert ds["status"].dims == ("case", "solver") and list(ds["solver"].values) == ["ssn", "uzawa"]
+    assert ds["status"].attrs["flag_meanings"].split() == list(STATUS_MEANINGS)
+    assert float(ds["k_nu"].sel(case="k_nu=1e+08")) == 1e8 and float(ds["kappa"].sel(case="kappa=0.4999")) == 0.4999
+    path = write_dataset(ds, tmp_path / "stability.nc")
+    with netCDF4.Dataset(path) as nc:
+        nc.set_auto_mask(False)
+        for name, var in nc.variables.items():
+            if var.dtype is not str and var.dtype.kind == "f":
+                assert np.all(np.isfinite(var[:])), name
+    text = stability_markdown(ds)
+    assert "| k_nu=1e+08 |" in text and "## Failures" in text and "**ssn**: converged" in text
+    fig = stability_figure(ds)
+    fig.savefig(tmp_path / "stability.png")
+    assert (tmp_path / "stability.png").stat().st_size > 10_000

@@ -1,0 +1,454 @@
+"""Scene files (SPEC §6): read the YAML, apply ``--set`` overrides, validate, fill the defaults.
+
+One source of truth: ``vemkit/config/schemas/scene.schema.json`` holds the keys, the bounds and the
+``default`` values; this module walks it. Every problem is a :class:`SceneError` (a ``ValueError``)
+with a one-line message naming the offending key, e.g.
+``material.nu = 0.7: must be < 0.5 (Poisson ratio of plane stress); fix the scene or --set material.nu=...``
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import json
+import re
+import sys
+from functools import lru_cache, partial
+from importlib.resources import files
+from pathlib import Path
+from typing import NamedTuple
+
+import jsonschema
+import numpy as np
+import yaml
+
+from vemkit.config.expressions import Expression, compile_expression
+from vemkit.exceptions import ExpressionError, SceneError
+from vemkit.mesh.mesh import UNIT_SQUARE_SIDES
+
+__all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
+           "scene_schema"]
+
+DOMAIN_SIDES = {"unit_square": tuple(UNIT_SQUARE_SIDES)}
+# points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
+_UNIT_SQUARE_SIDE_POINTS = {
+    "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
+    "bottom": lambda s: (s, 0.0 * s), "top": lambda s: (s, 0.0 * s + 1.0),
+}
+_PROBES = 16  # points per side (and per direction inside) where expressions are test-evaluated
+NO_DIRICHLET = "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]"
+_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
+               "object": "a mapping", "array": "a list", "null": "null", "boolean": "true/false"}
+
+
+class PowerLaw(NamedTuple):
+    """``p(t) = k (t)_+^m`` (5.1)."""
+
+    k: float
+    m: float
+
+
+# -- YAML ----------------------------------------------------------------------------------------
+class _SceneLoader(yaml.SafeLoader):
+    """SafeLoader that rejects duplicate keys and reads ``1e-10`` as a float (as YAML 1.2 does)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                duplicate = key in seen
+            except TypeError:  # unhashable: let SafeLoader report it
+                break
+            if duplicate:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r}", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+class _SceneDumper(yaml.SafeDumper):
+    """SafeDumper that quotes every string _SceneLoader would read as a float."""
+
+
+_SCIENTIFIC_FLOAT = re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$")
+for _cls in (_SceneLoader, _SceneDumper):
+    _cls.add_implicit_resolver("tag:yaml.org,2002:float", _SCIENTIFIC_FLOAT, list("-+0123456789"))
+
+
+def _parse_yaml(text: str, source: str):
+    try:
+        return yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        where = f"{source}:{mark.line + 1}" if mark is not None else source
+        context = f" ({error.context} at line {error.context_mark.line + 1})" \
+            if error.context and error.context_mark is not None and error.problem else ""
+        raise SceneError(f"{where}: YAML syntax error: {error.problem or error.context}{context}") \
+            from None
+    except yaml.YAMLError as error:
+        raise SceneError(f"{source}: YAML syntax error: {error}") from None
+
+
+# -- the schema ----------------------------------------------------------------------------------
+def scene_schema() -> dict:
+    """The scene JSON Schema (draft 2020-12), read from the package data (a fresh copy)."""
+    return json.loads((files("vemkit.config") / "schemas" / "scene.schema.json").read_text(encoding="utf-8"))
+
+
+@lru_cache(maxsize=1)
+def _validator() -> jsonschema.Draft202012Validator:
+    return jsonschema.Draft202012Validator(scene_schema())
+
+
+def _resolve(node: dict) -> dict:
+    """``node`` with a local ``$ref`` merged in (sibling keywords win)."""
+    while "$ref" in node:
+        target = _validator().schema["$defs"][node["$ref"].rsplit("/", 1)[-1]]
+        node = {**target, **{k: v for k, v in node.items() if k != "$ref"}}
+    return node
+
+
+def _key(path) -> str:
+    text = ""
+    for part in path:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text or "(scene)"
+
+
+def _show(value) -> str:
+    try:
+        text = repr(value) if isinstance(value, str) else json.dumps(value, default=str,
+                                                                      ensure_ascii=False)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+# -- overrides -----------------------------------------------------------------------------------
+def _apply_override(data: dict, override: str) -> None:
+    """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema."""
+    key_text, separator, value_text = str(override).partition("=")
+    segments = [s for s in re.split(r"\.|\[(\d+)\]", key_text.strip()) if s]
+    if not separator or not segments or not all(re.fullmatch(r"[\w-]+", s) for s in segments):
+        raise SceneError(f"--set {override}: expected key.path=value, e.g. --set solver.method=uzawa")
+    value = _parse_yaml(value_text, f"--set {override}")
+    node, container, path = _resolve(_validator().schema), data, []
+    for position, segment in enumerate(segments):
+        if "properties" in node:
+            if segment not in node["properties"]:
+                raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
+                                 f"{_suggest(segment, node['properties'])}")
+            node = _resolve(node["properties"][segment])
+        elif "items" in node and segment.isdigit():
+            node, segment = _resolve(node["items"]), int(segment)
+        else:
+            raise SceneError(f"--set {override}: {_key(path)!r} has no key {segment!r}")
+        if isinstance(container, dict) and isinstance(segment, str) and segments[position + 1:]:
+            container.setdefault(segment, copy.deepcopy(node.get("default", {})))
+        elif not (isinstance(container, dict) and isinstance(segment, str) or isinstance(
+                container, list) and isinstance(segment, int) and segment < len(container)):
+            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has no "
+                             f"entry {segment!r}")
+        path.append(segment)
+        if segments[position + 1:]:
+            container = container[segment]
+        else:
+            container[segment] = value
+
+
+# -- validation ----------------------------------------------------------------------------------
+def _suggest(word, choices) -> str:
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1)
+    allowed = ", ".join(str(c) for c in choices)
+    return f" (did you mean {close[0]!r}?); allowed here: {allowed}" if close else \
+        f"; allowed here: {allowed}"
+
+
+def _check_finite(value, path) -> None:
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and \
+            not abs(value) <= sys.float_info.max:  # nan, inf, ints beyond the float range
+        raise SceneError(f"{_key(path)} = {value}: must be a finite number; "
+                         f"fix the scene or --set {_key(path)}=...")
+    children = value.items() if isinstance(value, dict) else \
+        enumerate(value) if isinstance(value, list) else ()
+    for key, child in children:
+        _check_finite(child, [*path, key])
+
+
+def _document_order(data, error) -> tuple:
+    """Position of ``error`` in the scene, so that the first problem in file order is reported."""
+    position, node = [], data
+    for part in error.absolute_path:
+        keys = list(node) if isinstance(node, dict) else list(range(len(node)))
+        position.append(keys.index(part) if part in keys else len(keys))
+        node = node[part]
+    if error.validator == "required" and isinstance(node, dict):
+        position.append(len(node))
+    elif error.validator == "additionalProperties" and isinstance(node, dict):
+        allowed = _resolve(error.schema).get("properties", {})
+        position.append(min((i for i, k in enumerate(node) if k not in allowed), default=0))
+    return tuple(position)
+
+
+def _schema_error_message(error) -> str:
+    path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
+    key, value = _key(path), error.instance
+    side_names = ", ".join(_validator().schema["$defs"]["side"]["enum"])
+    if keyword == "additionalProperties":
+        allowed = list(schema.get("properties", {}))
+        extra = next(k for k in value if k not in allowed)
+        if key == "boundary.neumann":
+            return f"{key}.{extra}: unknown boundary name {extra!r}; the unit_square has sides " \
+                   f"{side_names}; fix the scene"
+        return f"{_key([*path, extra])}: unknown key{_suggest(extra, allowed)}; fix the scene"
+    if keyword == "required":
+        missing = next(k for k in error.validator_value if k not in value)
+        title = _resolve(schema["properties"][missing]).get("title", "")
+        if _key([*path, missing]) == "boundary.dirichlet":
+            return f"boundary.dirichlet is missing: {NO_DIRICHLET}"
+        return f"{_key([*path, missing])} is missing ({title}); add it to the scene or " \
+               f"--set {_key([*path, missing])}=..."
+    if keyword == "minItems" and key == "boundary.dirichlet":
+        return f"boundary.dirichlet = []: {NO_DIRICHLET}"
+    if keyword == "enum" and schema == _validator().schema["$defs"]["side"]:
+        return f"{key} = {_show(value)}: unknown boundary name; the unit_square has sides " \
+               f"{side_names}; fix the scene or --set {key}=..."
+    bound = error.validator_value
+    if keyword == "type":
+        types = [bound] if isinstance(bound, str) else bound
+        need = "must be " + " or ".join(_TYPE_NAMES.get(t, t) for t in types)
+    elif keyword in ("enum", "const"):
+        need = "must be one of " + ", ".join(map(str, bound if keyword == "enum" else [bound]))
+    else:
+        need = {"exclusiveMinimum": f"must be > {bound}", "minimum": f"must be >= {bound}",
+                "exclusiveMaximum": f"must be < {bound}", "maximum": f"must be <= {bound}",
+                "minItems": f"must have at least {bound} entries",
+                "maxItems": f"must have at most {bound} entries",
+                "uniqueItems": "lists an entry twice", "minLength": "must not be empty",
+                "maxLength": f"must be at most {bound} characters"}.get(keyword, error.message)
+    title = f" ({schema['title']})" if "title" in schema else ""
+    return f"{key} = {_show(value)}: {need}{title}; fix the scene or --set {key}=..."
+
+
+def _validate(data) -> None:
+    if not isinstance(data, dict):
+        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), "
+                         f"got {_show(data)}")
+    _check_finite(data, [])
+    errors = list(_validator().iter_errors(data))
+    if errors:
+        first = min(errors, key=lambda e: (_document_order(data, e), e.validator != "type"))
+        raise SceneError(_schema_error_message(first))
+
+
+def _normalized(value, node: dict):
+    """Defaults filled, keys in schema order, numbers as float and integers as int."""
+    node = _resolve(node)
+    types = node.get("type")
+    types = [types] if isinstance(types, str) else (types or [])
+    if isinstance(value, dict) and "properties" in node:
+        result = {}
+        for name, child in node["properties"].items():
+            if name in value:
+                result[name] = _normalized(value[name], child)
+            elif "default" in _resolve(child):
+                result[name] = _normalized(copy.deepcopy(_resolve(child)["default"]), child)
+        return result
+    if isinstance(value, list) and "items" in node:
+        return [_normalized(item, node["items"]) for item in value]
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return int(value) if "integer" in types else float(value)
+    return value
+
+
+def _semantic_checks(data: dict) -> dict:
+    """Checks beyond the schema; returns the compiled expressions by key."""
+    sides = DOMAIN_SIDES[data["domain"]]
+    boundary = data["boundary"]
+    owner = {}
+    for part in ("dirichlet", "neumann", "contact"):
+        for side in boundary[part]:
+            if side not in sides:
+                raise SceneError(f"boundary.{part}: unknown boundary name {side!r}; the "
+                                 f"{data['domain']} has sides {', '.join(sides)}")
+            if side in owner:
+                raise SceneError(f"boundary: side {side!r} is listed in both {owner[side]} and "
+                                 f"{part}; a side has one boundary condition")
+            owner[side] = part
+    if boundary["contact"] and "contact" not in data:
+        raise SceneError(f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
+                         "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}")
+    s = (np.arange(_PROBES) + 0.5) / _PROBES
+    inside = np.meshgrid(s, s)
+    probes = [("body_force", data["body_force"], inside)]
+    for side, entry in boundary["neumann"].items():
+        points = _UNIT_SQUARE_SIDE_POINTS[side](s)
+        probes.append((f"boundary.neumann.{side}.traction", entry["traction"], points))
+    compiled = {}
+    for key, pair, points in probes:
+        compiled[key] = tuple(_compile(f"{key}[{i}]", pair[i]) for i in (0, 1))
+        for expression in compiled[key]:
+            _evaluate(expression, points)
+    if "contact" in data:
+        gap = compiled["contact.gap"] = _compile("contact.gap", data["contact"]["gap"])
+        for side in boundary["contact"]:
+            x, y = _UNIT_SQUARE_SIDE_POINTS[side](np.linspace(0.0, 1.0, _PROBES + 1))
+            values = _evaluate(gap, (x, y))
+            if values.min() < 0:
+                i = int(np.argmin(values))
+                raise SceneError(f"contact.gap = {_show(data['contact']['gap'])}: is {values[i]:.6g} "
+                                 f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
+                                 "g_a must be >= 0); fix the scene or --set contact.gap=...")
+    return compiled
+
+
+def _compile(key: str, value) -> Expression:
+    try:
+        return compile_expression(value, name=key)
+    except ExpressionError as error:
+        raise SceneError(str(error)) from None
+
+
+def _evaluate(expression: Expression, points) -> np.ndarray:
+    try:
+        return expression(*points)
+    except ExpressionError as error:
+        raise SceneError(str(error)) from None
+
+
+# -- the scene -----------------------------------------------------------------------------------
+def _field(*path, doc: str = "", convert=None):
+    """A read-only property for ``scene.data[path[0]][path[1]]...``."""
+    def get(self):
+        value = self._data
+        for part in path:
+            value = value[part]
+        return convert(value) if convert else value
+    return property(get, doc=doc)
+
+
+class Scene:
+    """A validated scene with every default filled in; immutable (use :meth:`with_overrides`).
+
+    Build it with :func:`load_scene`, :func:`scene_from_yaml` or :func:`scene_from_dict`.
+    """
+
+    __slots__ = ("_data", "_expressions", "source")
+
+    def __init__(self, data: dict, expressions: dict, source: str | None = None):
+        object.__setattr__(self, "_data", data)
+        object.__setattr__(self, "_expressions", expressions)
+        object.__setattr__(self, "source", source)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("a Scene is immutable; use scene.with_overrides([...])")
+
+    def __reduce__(self):
+        return (partial(scene_from_yaml, source=self.source), (self.to_yaml(),))
+
+    def __eq__(self, other):
+        return isinstance(other, Scene) and self._data == other._data
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"Scene(name={self.name!r}, source={self.source!r})"
+
+    @property
+    def data(self) -> dict:
+        """The validated, defaults-filled scene as plain data (a copy)."""
+        return copy.deepcopy(self._data)
+
+    name = _field("name")
+    domain = _field("domain")
+    E = _field("material", "E", doc="Young's modulus")
+    nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
+    dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
+    neumann_sides = _field("boundary", "neumann", convert=tuple)
+    contact_sides = _field("boundary", "contact", convert=tuple)
+    has_contact = _field("boundary", "contact", convert=bool, doc="True if a side is in contact")
+    stabilization = _field("discretization", "stabilization")
+    contact_quadrature = _field("discretization", "contact_quadrature")
+    mesh_options = _field("discretization", "mesh", convert=dict,
+                          doc="discretization.mesh: family, n and the family options given (a copy)")
+    solver_options = _field("solver", convert=dict,
+                            doc="solver, defaults filled; rho/eps_u/eps_lambda may be None (a copy)")
+    body_force = property(lambda self: self._expressions["body_force"],
+                          doc="(Expression, Expression): the volume force f1")
+    gap_expression = property(lambda self: self._expressions.get("contact.gap"),
+                              doc="Expression of the initial gap g_a; None without contact section")
+
+    @property
+    def sides(self) -> tuple:
+        """All sides of the domain; sides not listed under boundary are traction-free."""
+        return DOMAIN_SIDES[self.domain]
+
+    def lame(self) -> tuple[float, float]:
+        """``(lambda_star, mu)`` of the paper's plane-stress C: Eν/(1−ν²), E/(2(1+ν)) (SPEC §1)."""
+        return self.E * self.nu / (1.0 - self.nu**2), self.E / (2.0 * (1.0 + self.nu))
+
+    def traction(self, side: str) -> tuple[Expression, Expression]:
+        """The prescribed traction f2 on a Neumann side; KeyError for other sides."""
+        key = f"boundary.neumann.{side}.traction"
+        if key not in self._expressions:
+            raise KeyError(f"{side!r} is not a Neumann side of this scene "
+                           f"(neumann sides: {', '.join(self.neumann_sides) or 'none'})")
+        return self._expressions[key]
+
+    normal_compliance = property(lambda self: self._contact_law("normal"),
+                                 doc="PowerLaw p_nu(t) = k (t)_+^m; None without contact section")
+    friction_bound = property(lambda self: self._contact_law("friction"),
+                              doc="PowerLaw p_tau(t) = k (t)_+^m (m = 0: the paper's reduced law); "
+                                  "None without contact section")
+
+    def _contact_law(self, kind: str) -> PowerLaw | None:
+        contact = self._data.get("contact")
+        return PowerLaw(**contact[kind]) if contact else None
+
+    def to_yaml(self) -> str:
+        """The full, defaults-filled scene as YAML; loads back to an equal scene."""
+        return yaml.dump(self._data, Dumper=_SceneDumper, sort_keys=False,
+                         default_flow_style=None, allow_unicode=True)
+
+    def with_overrides(self, overrides) -> Scene:
+        """A new scene with ``key.path=value`` overrides applied (as ``--set``)."""
+        return scene_from_dict(self._data, overrides, source=self.source)
+
+
+def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
+    """Validate a scene given as plain data; ``overrides`` are ``"a.b.c=value"`` strings."""
+    if isinstance(overrides, str):
+        overrides = [overrides]
+    if not isinstance(data, dict):
+        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), "
+                         f"got {_show(data)}")
+    data = copy.deepcopy(data)
+    for override in overrides:
+        _apply_override(data, override)
+    _validate(data)
+    normalized = _normalized(data, _validator().schema)
+    expressions = _semantic_checks(normalized)
+    return Scene(normalized, expressions, source)
+
+
+def scene_from_yaml(text: str, overrides=(), *, source: str = "<string>") -> Scene:
+    """Validate a scene given as YAML text (e.g. the attribute stored in a solution file)."""
+    data = _parse_yaml(text, source)
+    if data is None:
+        raise SceneError(f"{source}: the scene is empty")
+    return scene_from_dict(data, overrides, source=source)
+
+
+def load_scene(path, overrides=()) -> Scene:
+    """Read, override and validate a scene file; every problem is a one-line SceneError."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError(f"{path}: scene file not found") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{path}: not a UTF-8 text file") from None
+    except OSError as error:
+        raise SceneError(f"{path}: cannot read the scene file ({error.strerror or error})") from None
+    return scene_from_yaml(text, overrides, source=str(path))

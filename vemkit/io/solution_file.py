@@ -1,0 +1,124 @@
+"""A solved problem as a self-describing xarray Dataset, and its safe netCDF file (SPEC §6).
+
+The Dataset carries the UGRID-1.0 mesh topology ``mesh2d``, the nodal displacement ``u1``,
+``u2`` (``mesh2d_nNodes``), per-cell strain, stress and shear energy density
+(``mesh2d_nFaces``), the contact boundary quantities (``contact_node``), the solver history
+(``iteration``), and global attributes: the scene as YAML, solver, iterations, wall time, version.
+``write_netcdf`` refuses NaN and writes through a temporary file, so a failed run leaves nothing.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+import vemkit
+from vemkit.exceptions import ResultError
+from vemkit.vem.projection import projected_solution, shear_energy_density, stress
+from vemkit.mesh.files import mesh_to_ugrid_dataset, read_ugrid
+
+STATE_MEANINGS = "separated stick slip"
+
+
+def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> xr.Dataset:
+    """Everything a user needs from one solve, described by its own attributes."""
+    from vemkit.solvers.solution import contact_state
+
+    mesh = problem.mesh
+    u = problem.dofs.expand(solution.u)
+    proj = projected_solution(mesh, u)
+    sig = stress(proj.strain, problem.lam, problem.mu)
+    ds = mesh_to_ugrid_dataset(mesh)
+    node, face = "mesh2d_nNodes", "mesh2d_nFaces"
+    ds["u1"] = (node, u[:, 0], {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
+    ds["u2"] = (node, u[:, 1], {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
+    face_attrs = {"mesh": "mesh2d", "location": "face", "comment": "constant per cell: from the projection Pi_1 (3.8)"}
+    for name, values, long_name, units in (
+        ("strain_11", proj.strain[:, 0], "strain eps11 of Pi u", "1"),
+        ("strain_22", proj.strain[:, 1], "strain eps22 of Pi u", "1"),
+        ("strain_12", proj.strain[:, 2], "strain eps12 of Pi u", "1"),
+        ("stress_11", sig[:, 0], "stress sigma11 = C eps(Pi u)", "daN/mm2"),
+        ("stress_22", sig[:, 1], "stress sigma22", "daN/mm2"),
+        ("stress_12", sig[:, 2], "stress sigma12", "daN/mm2"),
+        ("shear_energy_density", shear_energy_density(sig, problem.lam, problem.mu), "|dev sigma|^2/(4 mu) (Fig. 6)", "daN/mm2"),
+    ):
+        ds[name] = (face, values, dict(face_attrs, long_name=long_name, units=units))
+
+    cb = problem.contact
+    if cb.size:
+        st = contact_state(problem, solution.u, solution.multiplier)
+        order = np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))
+        c = "contact_node"
+        ds = ds.assign_coords(
+            contact_x=(c, cb.coords[order, 0], {"long_name": "x of contact vertex", "units": "mm"}),
+            contact_y=(c, cb.coords[order, 1], {"long_name": "y of contact vertex", "units": "mm"}),
+        )
+        ds["contact_vertex"] = (c, cb.vertices[order], {"long_name": "mesh2d node index of the contact vertex"})
+        ds["contact_weight"] = (c, cb.weight[order], {"long_name": "nodal quadrature weight on Gamma_C", "units": "mm"})
+        for name, values, long_name, units in (
+            ("normal_pressure", st.normal_pressure, "p_nu(u_nu - g_a) (2.6)", "daN/mm2"),
+            ("tangential_stress", st.tangential_stress, "sigma_tau = -p_tau lambda (2.7)-(2.8)", "daN/mm2"),
+            ("friction_bound", st.friction_bound, "p_tau(u_nu - g_a)", "daN/mm2"),
+            ("friction_multiplier", solution.multiplier, "lambda in [-1, 1] (5.3)", "1"),
+            ("slip", st.slip, "tangential displacement u_tau", "mm"),
+            ("penetration", st.penetration, "u_nu - g_a (> 0: penetration)", "mm"),
+        ):
+            ds[name] = (c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
+        ds["contact_state"] = (
+            c, np.asarray(st.state, dtype=np.int8)[order],
+            {"long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
+        )
+    for key, values in solution.history.items():
+        ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
+    ds.attrs.update(
+        {
+            "Conventions": "CF-1.8 UGRID-1.0",
+            "title": "vemkit solution",
+            "scene": scene_yaml,
+            "solver": solution.method,
+            "iterations": int(solution.iterations),
+            "linear_iterations": int(solution.linear_iterations),
+            "wall_time": float(solution.wall_time),
+            "n_dofs": int(problem.n_dofs),
+            "stabilization": problem.stabilization,
+            "vemkit_version": vemkit.__version__,
+        }
+    )
+    ds.attrs.update(extra_attrs or {})
+    return ds
+
+
+def check_finite(ds: xr.Dataset, what: str = "result") -> None:
+    for name, var in ds.variables.items():
+        if np.issubdtype(var.dtype, np.floating) and not np.all(np.isfinite(var.values)):
+            raise ResultError(f"{what}: variable {name} holds NaN or inf; nothing was written")
+
+
+def write_netcdf(ds: xr.Dataset, path) -> Path:
+    """Write ``ds`` to ``path`` (netCDF4) atomically: all or nothing, never NaN."""
+    path = Path(path)
+    check_finite(ds, str(path))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_solution(path):
+    """(Mesh, Dataset) of a solution file written by ``vemkit solve`` or the workflow."""
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    return read_ugrid(path), ds

@@ -1,0 +1,251 @@
+"""Lowest-order (k = 1) virtual element for plane elasticity: one polygon at a time.
+
+Degrees of freedom are the displacements at the vertices, interleaved
+``(u1(x_1), u2(x_1), u1(x_2), ...)``. For k = 1 the strain of the projection Pi v (3.8) is the
+element average of eps(v), computable from the boundary values:
+
+    |K| eps(Pi v) = int_dK sym(v (x) n) ds = sum_i sym(v_i (x) q_i) |K|,
+    q_i = (y_{i+1} - y_{i-1}, x_{i-1} - x_{i+1}) / (2 |K|).
+
+The rigid part of Pi v is fixed by the paper's two vertex constraints (after (3.8)): the vertex
+mean of Pi v equals that of v, and the vertex mean of x x Pi v equals that of x x v.
+
+The local form (3.9) is a_h^K = |K| B^T D B + alpha_K (I - Pi)^T (I - Pi), with the dofi-dofi
+stabilization S_K of the paper and the scaling alpha_K named by ``stabilization``.
+
+Two implementations: the Numba kernel ``element_stiffness`` used by the assembly, and
+``element_stiffness_reference``, a plain numpy twin that solves (3.8) literally with boundary
+integrals and a 6 x 6 system, used by the tests to pin the kernel.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from vemkit.vem.elasticity import elasticity_matrix
+
+STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
+
+
+def stabilization_code(name: str) -> int:
+    try:
+        return STABILIZATIONS.index(name)
+    except ValueError:
+        raise ValueError(
+            f"stabilization {name!r} is unknown; use one of {', '.join(STABILIZATIONS)}"
+        ) from None
+
+
+# --------------------------------------------------------------------------------------------
+# Numba kernel
+# --------------------------------------------------------------------------------------------
+@numba.njit(cache=True)
+def cell_coordinates(vertices, offsets, cell_vertices, c):
+    """(px, py): the vertex coordinates of cell c, in its (counter-clockwise) order."""
+    s = offsets[c]
+    n = offsets[c + 1] - s
+    px = np.empty(n)
+    py = np.empty(n)
+    for i in range(n):
+        px[i] = vertices[cell_vertices[s + i], 0]
+        py[i] = vertices[cell_vertices[s + i], 1]
+    return px, py
+
+
+@numba.njit(cache=True)
+def polygon_area(px, py):
+    n = px.shape[0]
+    a = 0.0
+    for i in range(n):
+        j = (i + 1) % n
+        a += px[i] * py[j] - px[j] * py[i]
+    return 0.5 * a
+
+
+@numba.njit(cache=True)
+def strain_operator(px, py, area, B):
+    """B (3 x 2n): element-average strain (eps11, eps22, 2 eps12) from vertex values."""
+    n = px.shape[0]
+    inv = 1.0 / (2.0 * area)
+    for i in range(n):
+        ip = (i + 1) % n
+        im = (i - 1 + n) % n
+        qx = (py[ip] - py[im]) * inv
+        qy = (px[im] - px[ip]) * inv
+        B[0, 2 * i] = qx
+        B[0, 2 * i + 1] = 0.0
+        B[1, 2 * i] = 0.0
+        B[1, 2 * i + 1] = qy
+        B[2, 2 * i] = qy
+        B[2, 2 * i + 1] = qx
+
+
+@numba.njit(cache=True)
+def projection_coefficients(px, py, B, P):
+    """P (6 x 2n): coefficients of Pi v = c + (E + omega J)(x - xbar) from the vertex values.
+
+    Rows: c1, c2, omega, eps11, eps22, eps12 (tensor component). xbar is the vertex mean.
+    """
+    n = px.shape[0]
+    xb = 0.0
+    yb = 0.0
+    for i in range(n):
+        xb += px[i]
+        yb += py[i]
+    xb /= n
+    yb /= n
+    s = 0.0
+    for i in range(n):
+        s += (px[i] - xb) ** 2 + (py[i] - yb) ** 2
+    s /= n
+    for j in range(2 * n):
+        P[0, j] = 0.0
+        P[1, j] = 0.0
+        P[3, j] = B[0, j]
+        P[4, j] = B[1, j]
+        P[5, j] = 0.5 * B[2, j]
+    for i in range(n):
+        P[0, 2 * i] = 1.0 / n
+        P[1, 2 * i + 1] = 1.0 / n
+    # omega * mean|d|^2 = mean(d x v) - mean(d x E d),  d x E d = E12 (d1^2 - d2^2) + d1 d2 (E22 - E11)
+    a = 0.0
+    b = 0.0
+    for i in range(n):
+        d1 = px[i] - xb
+        d2 = py[i] - yb
+        a += d1 * d1 - d2 * d2
+        b += d1 * d2
+    a /= n
+    b /= n
+    for j in range(2 * n):
+        P[2, j] = -(a * P[5, j] + b * (P[4, j] - P[3, j])) / s
+    for i in range(n):
+        P[2, 2 * i] += -(py[i] - yb) / (n * s)
+        P[2, 2 * i + 1] += (px[i] - xb) / (n * s)
+    return xb, yb
+
+
+@numba.njit(cache=True)
+def element_stiffness(px, py, lam, mu, stab, K, B, P, R):
+    """Local VEM stiffness (3.9) into K (2n x 2n). B (3 x 2n), P (6 x 2n), R (2n x 2n) are work.
+
+    stab: 0 = dofi (alpha = 1), 1 = dofi-2mu (alpha = 2 mu), 2 = trace (alpha = tr(Kc) / 2n).
+    """
+    n = px.shape[0]
+    m = 2 * n
+    area = polygon_area(px, py)
+    strain_operator(px, py, area, B)
+    xb, yb = projection_coefficients(px, py, B, P)
+    d11 = lam + 2.0 * mu
+    # consistency |K| B^T D B
+    tr = 0.0
+    for i in range(m):
+        b0 = B[0, i]
+        b1 = B[1, i]
+        b2 = B[2, i]
+        t0 = area * (d11 * b0 + lam * b1)
+        t1 = area * (lam * b0 + d11 * b1)
+        t2 = area * mu * b2
+        for j in range(m):
+            K[i, j] = t0 * B[0, j] + t1 * B[1, j] + t2 * B[2, j]
+        tr += K[i, i]
+    if stab == 0:
+        alpha = 1.0
+    elif stab == 1:
+        alpha = 2.0 * mu
+    else:
+        alpha = tr / m
+    # R holds (I - Pi_D)^T: row j is the vertex values of phi_j - Pi phi_j (contiguous for the product)
+    for j in range(m):
+        c1 = P[0, j]
+        c2 = P[1, j]
+        om = P[2, j]
+        e11 = P[3, j]
+        e22 = P[4, j]
+        e12 = P[5, j]
+        for i in range(n):
+            d1 = px[i] - xb
+            d2 = py[i] - yb
+            R[j, 2 * i] = -(c1 + e11 * d1 + (e12 - om) * d2)
+            R[j, 2 * i + 1] = -(c2 + (e12 + om) * d1 + e22 * d2)
+        R[j, j] += 1.0
+    # stabilization alpha (I - Pi)^T (I - Pi)
+    for i in range(m):
+        for j in range(i, m):
+            acc = 0.0
+            for k in range(m):
+                acc += R[i, k] * R[j, k]
+            acc *= alpha
+            K[i, j] += acc
+            if j != i:
+                K[j, i] += acc
+    return area
+
+
+# --------------------------------------------------------------------------------------------
+# numpy twin: the projection (3.8) solved literally
+# --------------------------------------------------------------------------------------------
+def _p1_basis(xb, yb):
+    """[P1]^2 basis: two translations, a rotation, three strain modes; each as (A, c): q(x) = A x + c."""
+    mats = [
+        np.zeros((2, 2)),
+        np.zeros((2, 2)),
+        np.array([[0.0, -1.0], [1.0, 0.0]]),
+        np.array([[1.0, 0.0], [0.0, 0.0]]),
+        np.array([[0.0, 0.0], [0.0, 1.0]]),
+        np.array([[0.0, 1.0], [1.0, 0.0]]),
+    ]
+    consts = [np.array([1.0, 0.0]), np.array([0.0, 1.0])] + [-(A @ [xb, yb]) for A in mats[2:]]
+    return mats, consts
+
+
+def element_stiffness_reference(coords, lam, mu, stabilization="dofi-2mu"):
+    """Local stiffness by solving (3.8) with the paper's constraints; returns (K, Pi_D)."""
+    coords = np.asarray(coords, float)
+    n = coords.shape[0]
+    x, y = coords[:, 0], coords[:, 1]
+    area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+    xb, yb = coords.mean(axis=0)
+    mats, consts = _p1_basis(xb, yb)
+    C = lambda e: lam * np.trace(e) * np.eye(2) + 2 * mu * e  # noqa: E731  (SPEC §1)
+    sym = lambda A: 0.5 * (A + A.T)  # noqa: E731
+    stress = [C(sym(A)) for A in mats]
+    # a_K(phi_j, q) = int_dK (C eps(q) n) . phi_j ds, phi_j linear on each edge (trapezoid exact)
+    rhs_strain = np.zeros((3, 2 * n))
+    for e in range(n):
+        a, b = e, (e + 1) % n
+        t = coords[b] - coords[a]
+        normal_len = np.array([t[1], -t[0]])  # |e| * outward normal (CCW polygon)
+        for beta in range(3):
+            traction = stress[3 + beta] @ normal_len
+            for v in (a, b):
+                rhs_strain[beta, 2 * v : 2 * v + 2] += 0.5 * traction
+    G = np.array([[area * np.tensordot(sym(mats[a]), stress[b]) for b in range(6)] for a in range(6)])
+    # constraint rows: vertex means of the two components, vertex mean of x x q
+    def vertex_values(alpha):
+        return coords @ mats[alpha].T + consts[alpha]
+
+    system = np.zeros((6, 6))
+    rhs = np.zeros((6, 2 * n))
+    for alpha in range(6):
+        vals = vertex_values(alpha)
+        system[0, alpha] = vals[:, 0].mean()
+        system[1, alpha] = vals[:, 1].mean()
+        system[2, alpha] = np.mean(x * vals[:, 1] - y * vals[:, 0])
+        system[3:, alpha] = G[3:, alpha]
+    for i in range(n):
+        rhs[0, 2 * i] = 1.0 / n
+        rhs[1, 2 * i + 1] = 1.0 / n
+        rhs[2, 2 * i] = -y[i] / n
+        rhs[2, 2 * i + 1] = x[i] / n
+    rhs[3:] = rhs_strain
+    coef = np.linalg.solve(system, rhs)  # (6, 2n): Pi phi_j in the basis
+    D = np.zeros((2 * n, 6))
+    for alpha in range(6):
+        D[:, alpha] = vertex_values(alpha).ravel()
+    Pi = D @ coef
+    K_consistency = coef.T @ G @ coef
+    alpha_K = {"dofi": 1.0, "dofi-2mu": 2 * mu, "trace": np.trace(K_consistency) / (2 * n)}[stabilization]
+    R = np.eye(2 * n) - Pi
+    return K_consistency + alpha_K * R.T @ R, Pi
