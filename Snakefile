@@ -3,13 +3,15 @@
 #   snakemake -j2 results/table1.nc      only what Table 1 needs
 #   snakemake --report report.html       the HTML report
 # Layout: workflow/rules/*.smk (rules), workflow/scripts/ (thin scripts calling vemkit),
-# config/config.yaml validated against workflow/schemas/config.schema.yaml.
+# config/config.yaml and config/sweeps.yaml (Snakemake's config; add yours with --configfile),
+# validated against workflow/schemas/{config,sweeps}.schema.yaml in common.smk.
 from snakemake.utils import min_version
 
 min_version("8.0")
 
 
 configfile: "config/config.yaml"
+configfile: "config/sweeps.yaml"
 
 
 report: "workflow/report/workflow.rst"
@@ -31,3 +33,13 @@ rule all:
     input:
         DEFAULT_TARGETS,
     default_target: True
+
+
+rule extras:
+    """Sweeps, speed-accuracy study and robustness matrix (not in the default target)."""
+    input:
+        EXTRAS_TARGETS,
+
+
+localrules:
+    extras,

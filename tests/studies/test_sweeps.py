@@ -1,7 +1,5 @@
 """Parameter sweeps (vemkit.studies.sweeps): dimensions, physical consistency, reuse, the file's fill scheme."""
 
-import ast
-import re
 from pathlib import Path
 
 import netCDF4
@@ -124,13 +122,13 @@ def test_failures_are_classified_and_the_file_holds_no_nan(scene, tmp_path):
     np.testing.assert_allclose(back["normal_force"].values, ds["normal_force"].values, equal_nan=True)
 
 
-def test_a_lenient_stop_fails_the_independent_check(scene):
-    """The paper's rule (stop on |du| OR |dlambda|) leaves uzawa at an equilibrium residual ~3e-6 at h = 1/8."""
+def test_the_paper_stop_rule_is_held_to_tol(scene):
+    """The paper's rule (stop on |du| OR |dlambda|) fires one lagged step early at h = 1/8 (residual ~3e-6);
+    uzawa refuses that stop and iterates on until the residual is what solver.tol asks for."""
     ds = run_sweep(scene, {"solver.method": ["uzawa"], "solver.stop": ["either", "both"]}, check_tol=1e-6).squeeze("solver")
-    assert STATUS_MEANINGS[int(ds["status"].sel(solver_stop="either"))] == "not_converged_check_failed"
-    assert "independent check fails: equilibrium" in str(ds["message"].sel(solver_stop="either").values)
-    assert int(ds["status"].sel(solver_stop="both")) == 0
-    assert float(ds["residual"].sel(solver_stop="both")) <= 1e-6
+    for stop in ("either", "both"):
+        assert int(ds["status"].sel(solver_stop=stop)) == 0, stop
+        assert float(ds["residual"].sel(solver_stop=stop)) <= 1e-8, stop
 
 
 def test_split_parts_combine_to_the_whole(scene):
@@ -152,10 +150,3 @@ def test_grid_checks():
         normalize_grid({"contact.gap": []})
     assert dimension_name("material.nu") == "kappa"
     assert dimension_name("discretization.mesh.levels") == "discretization_mesh_levels"
-
-
-def test_workflow_uses_the_same_dimension_names():
-    text = (ROOT / "workflow/rules/sweeps.smk").read_text(encoding="utf-8")
-    literal = re.search(r"SWEEP_DIMENSION_NAMES = (\{.*?\n\})", text, re.S).group(1)
-    literal = re.sub(r"#.*", "", literal)
-    assert ast.literal_eval(literal) == DIMENSION_NAMES

@@ -2,6 +2,6 @@
 
 Owns Table 1 and the convergence tables (``tables``), the paper's figures and the contact figure
 (``figures``), and the figures of the sweeps, the robustness matrix and the speed-accuracy study
-(``study_figures``). matplotlib is imported here only (the ``report`` extra). Imports from
-vemkit: every layer below.
+(``study_figures``). matplotlib is imported here only (the ``report`` extra).
+Imports from vemkit: every layer below.
 """

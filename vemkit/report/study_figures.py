@@ -1,4 +1,4 @@
-"""Figures of the sweeps, the speed-accuracy study and the stability matrix (matplotlib, Agg).
+"""Figures of the sweeps, the speed-accuracy study and the stability matrix (matplotlib's object API).
 
 - :func:`sweep_map_figure`: one panel per quantity, a colour map over two grid dimensions (the
   other dimensions held at a chosen value); points that did not converge are crossed out;
@@ -14,14 +14,10 @@ read Datasets of ``vemkit.studies.sweeps.read_dataset`` (NaN where a point is no
 
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import numpy as np  # noqa: E402
-from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
+import numpy as np
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f", "#17becf", "#bcbd22")
 MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import re
 import time
 from dataclasses import replace
 
@@ -39,13 +38,8 @@ from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outc
 
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import package_versions
-#: short dimension names of common scene keys (others: the key with "." -> "_")
-DIMENSION_NAMES = {
-    "contact.normal.k": "k_nu", "contact.normal.m": "m_nu", "contact.friction.k": "k_tau",
-    "contact.friction.m": "m_tau", "contact.gap": "g_a", "material.E": "E", "material.nu": "kappa",
-    "discretization.mesh.n": "n", "discretization.stabilization": "stabilization", "solver.method": "solver",
-    "solver.tol": "tol",
-}
+from vemkit.studies.sweep_dimensions import DIMENSION_NAMES, dimension_name
+
 SHARED_PREFIXES = ("contact.", "solver.")  # keys that leave K, the load and the mesh unchanged
 QUANTITIES = {  # name: (long name, units)
     "max_penetration": ("max over Gamma_C of (u_nu - g_a)_+", "mm"),
@@ -63,11 +57,6 @@ PROFILES = {  # name: (ContactState attribute or "multiplier", long name, units)
     "penetration": ("penetration", "u_nu - g_a along Gamma_C", "mm"),
     "multiplier": ("multiplier", "friction multiplier lambda along Gamma_C", "1"),
 }
-
-
-def dimension_name(key: str) -> str:
-    """The netCDF dimension of a scene key: DIMENSION_NAMES, else the key with [.[]] -> "_"."""
-    return DIMENSION_NAMES.get(key, re.sub(r"[^A-Za-z0-9_]+", "_", key).strip("_"))
 
 
 def normalize_grid(grid) -> dict:

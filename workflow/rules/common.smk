@@ -1,24 +1,56 @@
-# Configuration checks, file names and the targets; no rules here.
-import json
+# Configuration checks, file names and the targets; no rules here. Every other rule file uses only
+# what this file defines (the Snakefile includes it first).
+#
+# The configuration is Snakemake's own `config`: config/config.yaml (the paper) and
+# config/sweeps.yaml (the studies), merged with any `--configfile` / `--config` of the command line.
+# Each part is validated against its schema; a key that neither schema knows is an error.
+from pathlib import Path
 
+import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
+from vemkit.studies.sweep_dimensions import dimension_name
+
+#: part of the configuration: (schema, the file that sets its defaults)
+CONFIG_PARTS = {
+    "paper": ("../schemas/config.schema.yaml", "config/config.yaml"),
+    "studies": ("../schemas/sweeps.schema.yaml", "config/sweeps.yaml"),
+}
 
 
-def _validate_config():
-    """Snakemake's validate (fills the defaults), its error cut to one line naming the key."""
+def config_error(source, key, problem):
+    """The one-line error of a configuration value, naming the key and the file to fix."""
+    return WorkflowError(f"invalid workflow configuration: {key or 'top level'}: {problem}; fix {source} "
+                         "(or the --configfile / --config that set it)")
+
+
+def _validated(data, schema, source):
+    """Snakemake's validate (fills the defaults in place), its error cut to one line naming the key."""
     import jsonschema
 
     try:
-        validate(config, "../schemas/config.schema.yaml")
+        validate(data, schema)
     except WorkflowError as error:
         cause = error.__cause__ or error.__context__
         if not isinstance(cause, jsonschema.ValidationError):
             raise
         key = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in cause.absolute_path).lstrip(".")
-        raise WorkflowError(f"invalid workflow configuration: {key or 'top level'}: {cause.message}; fix "
-                            "config/config.yaml (schema: workflow/schemas/config.schema.yaml)") from None
+        raise config_error(f"{source} (schema: workflow/schemas/{Path(schema).name})", key, cause.message) from None
+
+
+def _validate_config():
+    schema_dir = Path(workflow.current_basedir)
+    known = set()
+    for schema, source in CONFIG_PARTS.values():
+        keys = set(yaml.safe_load((schema_dir / schema).read_text(encoding="utf-8"))["properties"])
+        part = {k: v for k, v in config.items() if k in keys}
+        _validated(part, schema, source)
+        config.update(part)
+        known |= keys
+    unknown = sorted(set(config) - known)
+    if unknown:
+        raise config_error("config/config.yaml or config/sweeps.yaml", unknown[0], "unknown key")
 
 
 _validate_config()
@@ -120,6 +152,92 @@ DEFAULT_TARGETS = (
     + expand("results/figures/{fig}.{ext}", fig=FIELD_FIGURES + ["fig6", "contact", "convergence"],
              ext=FIGURE_FORMATS)
 )
+
+
+# -- the studies of config/sweeps.yaml (not in the default target) ---------------------------------
+SWEEPS = config["sweeps"]
+SWEEP_DEFAULTS = config["sweep_defaults"]
+STABILITY = config["stability"]
+TRADEOFF = config["tradeoff"]
+STUDIES_SOURCE = "config/sweeps.yaml"
+
+
+def studies_scene():
+    """The scene and overrides of the sweeps and the robustness matrix."""
+    return {"scene": config["studies_scene"], "overrides": config["studies_overrides"]}
+
+
+def sweep_parts(name):
+    """Jobs of a sweep: its `parts`, at most the length of the first dimension with >= 2 values."""
+    spec = SWEEPS[name]
+    lengths = [len(v) for v in spec["grid"].values() if len(v) >= 2]
+    wanted = spec.get("parts", SWEEP_DEFAULTS["parts"])
+    return max(1, min(wanted, lengths[0])) if lengths else 1
+
+
+def sweep_settings(name):
+    """A sweep's settings with the sweep_defaults filled in."""
+    spec = SWEEPS[name]
+    base = studies_scene()
+    solver = {**SWEEP_DEFAULTS["solver"], **spec.get("solver", {})}
+    return {
+        "scene": base["scene"],
+        "overrides": base["overrides"] + spec["overrides"] + [f"solver.{k}={v}" for k, v in solver.items()],
+        "grid": spec["grid"],
+        "time_budget": spec.get("time_budget", SWEEP_DEFAULTS["time_budget"]),
+        "check_tol": spec.get("check_tol", SWEEP_DEFAULTS["check_tol"]),
+        "parts": sweep_parts(name),
+    }
+
+
+def stability_settings():
+    return {**studies_scene(), **STABILITY}
+
+
+def tradeoff_settings():
+    return {
+        "scene": config["scene"],
+        "overrides": config["overrides"] + [f"solver.{k}={v}" for k, v in config["solver"].items()],
+        "reference": {"mesh": REF["mesh"], "n": REF["n"], "stabilization": TRADEOFF["reference_stabilization"]},
+        **{k: v for k, v in TRADEOFF.items() if k != "families"},
+    }
+
+
+def _check_sweeps():
+    for name, spec in SWEEPS.items():
+        dims = [dimension_name(k) for k in spec["grid"]]
+        meshed = any(k.startswith("discretization.mesh") for k in spec["grid"])
+        for kind, figure in spec["figures"].items():
+            used = [figure[a] for a in ("x", "y", "hue", "across") if a in figure] + list(figure.get("select", {}))
+            for dim in used:
+                if dim not in dims:
+                    raise config_error(STUDIES_SOURCE, f"sweeps.{name}.figures.{kind}",
+                                       f"{dim!r} is not a dimension of the grid ({', '.join(dims)})")
+            if kind == "profiles" and meshed:
+                raise config_error(STUDIES_SOURCE, f"sweeps.{name}.figures.profiles", "the grid changes the mesh, "
+                                   "so the contact nodes differ between points; drop the profiles figure")
+
+
+def _check_tradeoff():
+    for i, gain in enumerate(TRADEOFF["refinement_gain"]):
+        for key in ("uniform", "refined"):
+            if gain[key] not in TRADEOFF["families"]:
+                raise config_error(STUDIES_SOURCE, f"tradeoff.refinement_gain[{i}].{key}", f"{gain[key]!r} is not "
+                                   f"a family of tradeoff.families ({', '.join(TRADEOFF['families'])})")
+    too_fine = [n for n in TRADEOFF["levels"] if n > REF["n"]]
+    if too_fine:
+        raise config_error(STUDIES_SOURCE, "tradeoff.levels", f"{too_fine[0]} > reference n = {REF['n']} "
+                           "(config/config.yaml): errors are measured against the finer reference")
+
+
+_check_sweeps()
+_check_tradeoff()
+
+SWEEP_TARGETS = [f"results/sweeps/{name}.nc" for name in SWEEPS] + [
+    f"results/sweeps/{name}/{kind}.png" for name, spec in SWEEPS.items() for kind in spec["figures"]]
+STABILITY_TARGETS = [f"results/stability/stability.{ext}" for ext in ("nc", "md", "png")]
+TRADEOFF_TARGETS = ["results/tradeoff/tradeoff.nc", "results/tradeoff/pareto.md", "results/tradeoff/pareto.png"]
+EXTRAS_TARGETS = SWEEP_TARGETS + TRADEOFF_TARGETS + STABILITY_TARGETS
 
 
 wildcard_constraints:

@@ -33,4 +33,4 @@ if BATCH:
         benchmark:
             "results/benchmarks/mesh/{label}/levels.tsv"
         script:
-            "../scripts/mesh.py"
+            "../scripts/mesh_levels.py"

@@ -38,4 +38,4 @@ if BATCH:
         benchmark:
             "results/benchmarks/solve/{label}/{stab}/levels.tsv"
         script:
-            "../scripts/solve.py"
+            "../scripts/solve_levels.py"

@@ -1,17 +1,6 @@
-# The stability matrix (vemkit.studies.robustness): every case of vemkit.studies.robustness.CASES (or the list in
+# The solver-robustness matrix (vemkit.studies.robustness): every case of its CASES (or the list in
 # config/sweeps.yaml: stability.cases) with every solver, cut into `parts` jobs, gathered into a
-# netCDF file, a Markdown report and a plot. Needs sweeps.smk (the configuration) included first.
-
-if "SWEEPS_CONFIG" not in globals():
-    raise WorkflowError("workflow/rules/stability.smk needs workflow/rules/sweeps.smk included before it")
-
-STABILITY = SWEEPS_CONFIG["stability"]
-STABILITY_TARGETS = [f"results/stability/stability.{ext}" for ext in ("nc", "md", "png")]
-EXTRAS_TARGETS += STABILITY_TARGETS
-
-
-def stability_settings():
-    return {"scene": SWEEPS_CONFIG["scene"], "overrides": SWEEPS_CONFIG["overrides"], **STABILITY}
+# netCDF file, a Markdown report and a plot. Settings come from common.smk.
 
 
 rule stability_part:
@@ -26,7 +15,7 @@ rule stability_part:
     benchmark:
         "results/benchmarks/stability/part{part}.tsv"
     script:
-        "../scripts/stability.py"
+        "../scripts/stability_part.py"
 
 
 rule stability:
@@ -43,7 +32,7 @@ rule stability:
     benchmark:
         "results/benchmarks/stability/gather.tsv"
     script:
-        "../scripts/stability.py"
+        "../scripts/stability_gather.py"
 
 
 localrules:

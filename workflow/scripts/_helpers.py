@@ -1,4 +1,5 @@
-"""Shared by the workflow scripts: the job's log file, and the level n of a wildcard."""
+"""Shared by the workflow scripts: the job's log file, the level n of a wildcard, and the bodies of
+the rules that come in a one-level and a batched (all levels in one job) form."""
 
 from __future__ import annotations
 
@@ -33,3 +34,40 @@ def level(text):
     """The n of a file name as a number: 16 -> 16, 22.627417 -> 22.627417."""
     value = float(text)
     return int(value) if value.is_integer() else value
+
+
+def write_meshes(smk):
+    """Rules mesh and mesh_levels: the meshes of one family (one per level) as UGRID netCDF."""
+    from vemkit.mesh.checks import validate_mesh
+    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.files import write_ugrid
+
+    spec = smk.params.spec
+    for n, path in zip(smk.params.levels, smk.output, strict=True):
+        mesh = build_mesh(spec["family"], level(n), **dict(spec.get("options") or {}))
+        validate_mesh(mesh)
+        write_ugrid(mesh, path)
+        print(f"{path}: {mesh.n_cells} cells, {mesh.n_vertices} vertices, h = {mesh.h:.4g}, meta {mesh.meta}")
+
+
+def write_solutions(smk):
+    """Rules solve and solve_levels: the configured scene, one stabilization, on each mesh file."""
+    import json
+
+    import numba
+
+    from vemkit.io.solution_file import write_netcdf
+    from vemkit.mesh.files import read_ugrid
+    from vemkit.studies.convergence import study_scene
+    from vemkit.studies.scene_solve import solve_scene
+
+    numba.set_num_threads(max(1, min(smk.threads, numba.config.NUMBA_NUM_THREADS)))
+    spec, stab, label = smk.params.spec, smk.wildcards.stab, smk.wildcards.label
+    for n, mesh_path, path in zip(smk.params.levels, smk.input.meshes, smk.output, strict=True):
+        n = level(n)
+        scene = study_scene(smk.params.scene, smk.params.overrides, spec["family"], spec.get("options") or {}, n, stab)
+        problem, solution, ds = solve_scene(scene, mesh=read_ugrid(mesh_path))
+        ds.attrs["workflow_run"] = json.dumps({"family": label, "n": n, "stabilization": stab, "mesh_file": mesh_path})
+        write_netcdf(ds, path)
+        print(f"{path}: {problem.n_dofs} dofs, {solution.method} {solution.iterations} iterations, "
+              f"solver {solution.wall_time:.3f} s, assembly {problem.info.get('assembly_time', 0.0):.3f} s", flush=True)

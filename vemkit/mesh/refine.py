@@ -1,0 +1,167 @@
+"""Local refinement of polygonal meshes; neighbours gain hanging nodes as plain vertices (SPEC §9).
+
+A marked cell with geometric corners c_0 … c_{m−1} (the vertices where its boundary turns; a
+hanging node on a straight edge is a vertex but not a corner) is split into m polygons
+
+    child_i = [c_i, …, s_i, z, s_{i−1}, …]        (the dots: vertices already on those edge halves)
+
+where s_i is the midpoint of the geometric edge c_i c_{i+1} and z the centroid of the cell. A
+square becomes its four quadrants (quadrisection), a triangle three quadrilaterals, a Voronoi cell
+m quadrilaterals. The split needs z in the kernel of the cell (z to the left of every edge), which
+holds for convex cells; for a non-convex cell the vertex mean is tried next, and a cell with neither
+in its kernel is left whole (reported in ``RefinedMesh.skipped``).
+
+A new edge midpoint is inserted as a vertex into the one or two cells sharing that edge, so the mesh
+stays vertex-conforming: the neighbour is not refined, it simply gains a vertex (SPEC §3).
+``max_hanging = k`` also refines every cell that would otherwise carry more than k vertices inside
+one of its geometric edges (repeated until none does). On a circular side (``mesh.meta["circles"]``:
+{side: [cx, cy, r]}) a new boundary vertex is placed on the circle, not on the chord. Boundary
+edges keep their side names. The prolongation maps vertex values of the old mesh to the new one
+(linear along split edges, the vertex mean at cell centres): a warm start for the next solve.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+
+from vemkit.exceptions import InputError
+from vemkit.mesh.mesh import Mesh
+from vemkit.mesh.refine_kernels import (augmented_rings, children, corner_flags, max_inner_vertices,
+                                        midpoint_requests, split_centres)
+
+
+class RefinedMesh(NamedTuple):
+    mesh: Mesh
+    parent: np.ndarray  # (new cells,) the old cell each new cell comes from
+    prolongation: sp.csr_matrix  # (new vertices, old vertices)
+    refined: np.ndarray  # old cells that were split (marked, or added by max_hanging)
+    skipped: np.ndarray  # cells to split that could not be (no centre in their kernel)
+
+
+def corner_positions(points: np.ndarray) -> np.ndarray:
+    """Positions (in the polygon's vertex list) of the geometric corners of one polygon."""
+    n = points.shape[0]
+    flags = corner_flags(np.ascontiguousarray(points, dtype=float), np.array([0, n]), np.arange(n))
+    return np.flatnonzero(flags)
+
+
+class _Splits(NamedTuple):
+    """The new edge points of one refinement pass, grouped by old edge."""
+
+    keys: np.ndarray  # sorted min * N + max of the split old edges
+    ptr: np.ndarray  # CSR over keys
+    vertices: np.ndarray  # new vertex ids, per edge in the direction min -> max
+    points: np.ndarray  # (new, 2) their coordinates
+    ends: np.ndarray  # (new, 2) the old edge (min, max) of each new vertex
+    t: np.ndarray  # (new,) the parameter along min -> max
+
+
+def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: dict) -> _Splits:
+    """Midpoints of the geometric edges of ``cells``, merged per old edge (SPEC §9)."""
+    a, b, t = midpoint_requests(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, corner, cells)
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    t = np.where(a < b, t, 1.0 - t)
+    n = np.int64(mesh.n_vertices)
+    rows = np.unique(np.stack([lo * n + hi, np.round(t * 1e9).astype(np.int64)], axis=1), axis=0)
+    keys, ticks = rows[:, 0], rows[:, 1] / 1e9
+    ends = np.stack([keys // n, keys % n], axis=1)
+    points = mesh.vertices[ends[:, 0]] + ticks[:, None] * (mesh.vertices[ends[:, 1]] - mesh.vertices[ends[:, 0]])
+    points = _on_circles(mesh, ends, points, circles)
+    unique_keys, first = np.unique(keys, return_index=True)
+    ptr = np.r_[first, keys.size].astype(np.int64)
+    return _Splits(unique_keys, ptr, n + np.arange(keys.size), points, ends, ticks)
+
+
+def _on_circles(mesh: Mesh, ends: np.ndarray, points: np.ndarray, circles: dict) -> np.ndarray:
+    """Points on boundary edges of a circular side moved radially onto the circle."""
+    for side, (cx, cy, r) in circles.items():
+        edges = np.sort(mesh.boundary.get(side, np.zeros((0, 2), np.int64)), axis=1)
+        on = (edges[:, 0][None, :] == ends[:, :1]) & (edges[:, 1][None, :] == ends[:, 1:])
+        hit = on.any(axis=1) if edges.size else np.zeros(len(points), bool)
+        d = points[hit] - (cx, cy)
+        points[hit] = np.array([cx, cy]) + r * d / np.linalg.norm(d, axis=1)[:, None]
+    return points
+
+
+def _rings(mesh: Mesh, splits: _Splits):
+    points = np.concatenate([mesh.vertices, splits.points])
+    offsets, ring = augmented_rings(mesh.cell_offsets, mesh.cell_vertices, splits.keys, splits.ptr,
+                                    splits.vertices, np.int64(mesh.n_vertices))
+    return points, offsets, ring
+
+
+def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles: dict | None = None) -> RefinedMesh:
+    """Split the marked cells (indices or a boolean mask) as the module docstring describes."""
+    marked = np.asarray(marked)
+    marked = np.flatnonzero(marked) if marked.dtype == bool else np.unique(marked.astype(np.int64))
+    if marked.size and (marked.min() < 0 or marked.max() >= mesh.n_cells):
+        raise InputError(f"refine_cells: cell indices must lie in [0, {mesh.n_cells})", key="marked")
+    if max_hanging is not None and max_hanging < 1:
+        raise InputError(f"adaptivity.max_hanging = {max_hanging}: must be >= 1 (or absent)", key="max_hanging")
+    circles = dict(mesh.meta.get("circles", {}) if circles is None else circles)
+    corner = corner_flags(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices)
+    refine = marked
+    while True:
+        splits = _plan(mesh, refine, corner, circles)
+        points, offsets, ring = _rings(mesh, splits)
+        ring_corner = np.zeros(ring.size, dtype=bool)
+        ring_corner[ring < mesh.n_vertices] = corner  # old slots keep their order; new points are no corners
+        if max_hanging is None:
+            break
+        inner = max_inner_vertices(offsets, ring, ring_corner)
+        extra = np.setdiff1d(np.flatnonzero(inner > max_hanging), refine)
+        if extra.size == 0:
+            break
+        refine = np.union1d(refine, extra)
+    return _assemble(mesh, refine, splits, points, offsets, ring, ring_corner)
+
+
+def _assemble(mesh: Mesh, refine, splits: _Splits, points, offsets, ring, ring_corner) -> RefinedMesh:
+    centres = split_centres(points, offsets, ring, refine)
+    ok = ~np.isnan(centres[:, 0])
+    split, skipped = refine[ok], refine[~ok]
+    n_new = points.shape[0]
+    centre_ids = n_new + np.arange(split.size)
+    child_offsets, child_ring, child_parent = children(points, offsets, ring, ring_corner, split, centre_ids)
+    keep = np.setdiff1d(np.arange(mesh.n_cells), split)
+    sizes = np.r_[np.diff(offsets)[keep], np.diff(child_offsets)]
+    kept_ring = ring[np.concatenate([np.arange(offsets[k], offsets[k + 1]) for k in keep])] if keep.size else ring[:0]
+    cell_offsets = np.r_[0, np.cumsum(sizes)].astype(np.int64)
+    vertices = np.concatenate([points, centres[ok]])
+    boundary = {name: _split_boundary(edges, splits, mesh.n_vertices) for name, edges in mesh.boundary.items()}
+    meta = {**mesh.meta, "refinements": int(mesh.meta.get("refinements", 0)) + 1}
+    new = Mesh(vertices, cell_offsets, np.concatenate([kept_ring, child_ring]), boundary, meta)
+    parent = np.r_[keep, split[child_parent]].astype(np.int64)
+    return RefinedMesh(new, parent, _prolongation(mesh, splits, split), split, skipped)
+
+
+def _split_boundary(edges: np.ndarray, splits: _Splits, n_old: int) -> np.ndarray:
+    """Boundary edges (a, b) cut at their new points, in order, with the same side.
+
+    Each edge is read as a two-vertex polygon [a, b]: its augmented ring is a, (k new points), b,
+    (the same k reversed), so the first k + 2 entries are the path from a to b.
+    """
+    if edges.size == 0:
+        return edges.reshape(0, 2)
+    offsets, ring = augmented_rings(np.arange(0, 2 * edges.shape[0] + 1, 2), edges.ravel(), splits.keys,
+                                    splits.ptr, splits.vertices, np.int64(n_old))
+    out = []
+    for start, stop in zip(offsets[:-1], offsets[1:]):
+        path = ring[start:start + (stop - start) // 2 + 1]
+        out.append(np.stack([path[:-1], path[1:]], axis=1))
+    return np.concatenate(out).astype(np.int64)
+
+
+def _prolongation(mesh: Mesh, splits: _Splits, split: np.ndarray) -> sp.csr_matrix:
+    """Old vertex values to new ones: identity, linear along split edges, cell mean at centres."""
+    n_old, n_edge = mesh.n_vertices, splits.t.size
+    sizes = mesh.cell_sizes[split]
+    rows = np.r_[np.arange(n_old), np.repeat(n_old + np.arange(n_edge), 2),
+                 np.repeat(n_old + n_edge + np.arange(split.size), sizes)]
+    cols = np.r_[np.arange(n_old), splits.ends.ravel(),
+                 np.concatenate([mesh.cell(k) for k in split]) if split.size else np.zeros(0, np.int64)]
+    vals = np.r_[np.ones(n_old), np.stack([1.0 - splits.t, splits.t], axis=1).ravel(), np.repeat(1.0 / sizes, sizes)]
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_old + n_edge + split.size, n_old))
