@@ -10,7 +10,7 @@ JOBS   ?= 2
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test,slurm]"
+	$(BIN)/python -m pip install --quiet -e ".[report,workflow,slurm,test]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -28,3 +28,11 @@ bench: $(STAMP)
 
 clean-results:
 	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs
+
+# The SLURM profile on a real one-node SLURM cluster set up on this host (Debian, as root: installs
+# slurm-wlm, slurmdbd, munge, mariadb-server; starts and then stops its own daemons). Not part of
+# `make test`. MODE=no-accounting: the same without slurmdbd (job status through squeue).
+MODE ?= accounting
+.PHONY: cluster-test
+cluster-test: $(STAMP)
+	$(BIN)/python workflow/cluster/cluster_test.py --mode $(MODE)

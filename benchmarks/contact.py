@@ -19,7 +19,6 @@ import sys
 import time
 from pathlib import Path
 
-import vemkit  # noqa: F401  (single-threaded BLAS before numpy loads)
 
 OUT = Path(__file__).resolve().parent / "out"
 PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"

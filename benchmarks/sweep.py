@@ -23,7 +23,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import vemkit  # noqa: F401  (sets single-threaded BLAS before numpy loads)
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = Path(__file__).resolve().parent / "out"

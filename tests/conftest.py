@@ -4,6 +4,7 @@ import pytest
 from vemkit.contact.laws import ContactLaw
 from vemkit.mesh.families import build_mesh
 from vemkit.contact.problem import discrete_problem
+from vemkit.mesh.mesh import from_polygons, tag_box_boundary
 
 PAPER = dict(E=2000.0, nu=0.4, gap=0.1, law=ContactLaw(10.0, 1.0, 450.0, 0.0))
 
@@ -36,6 +37,31 @@ def paper_problem(mesh, stabilization="dofi-2mu", law=None, gap=None, E=None, nu
         law=PAPER["law"] if law is None else law,
         stabilization=stabilization,
     )
+
+
+#: single cells of every kind the kernels must handle (counter-clockwise)
+POLYGONS = {
+    "square": [[0, 0], [1, 0], [1, 1], [0, 1]],
+    "triangle": [[0, 0], [1, 0.2], [0.3, 0.9]],
+    "pentagon": [[0, 0], [2, 0.1], [2.5, 1.3], [1, 2], [-0.3, 1]],
+    "nonconvex-arrow": [[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2]],
+    "hanging-square": [[0, 0], [0.5, 0], [1, 0], [1, 0.5], [1, 1], [0, 1]],
+    "L-shape": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],
+}
+
+
+def nonconvex_mesh():
+    """Unit square as two non-convex cells (a dent at (0.3, 0.55) and (0.75, 0.45)) and two triangles."""
+    v = [[0, 0], [0.5, 0.3], [1, 0], [1, 0.5], [1, 1], [0.5, 0.8], [0, 1], [0, 0.5], [0.3, 0.55], [0.75, 0.45]]
+    polys = [
+        [0, 1, 8, 5, 6, 7],  # reflex angle at vertex 8
+        [1, 9, 2, 3, 4, 5, 8],  # reflex angle at vertex 9
+        [0, 2, 9, 1],  # a triangle with vertex 1 in the middle of its edge
+        [5, 4, 6],
+    ]
+    mesh = tag_box_boundary(from_polygons(np.array(v, float), polys))
+    assert np.all(mesh.cell_areas > 0) and abs(mesh.cell_areas.sum() - 1) < 1e-14
+    return mesh
 
 
 @pytest.fixture

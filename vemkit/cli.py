@@ -1,23 +1,29 @@
 """The ``vemkit`` command line (SPEC §6).
 
-    vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--quiet]
-    vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu]
+    vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
+    vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu] [--max-dofs N] [-q]
 
-Exit status 0 on success; on any failure one line ``vemkit: error: ...`` naming the input and
-the fix, exit status 2, and no output file left behind.
+Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy).
+Any failure is one line ``vemkit: error: ...`` naming the input and the fix, exit status 2: a bad
+scene, ``--set``, option, argument, output path, a request beyond the limits, a solve that did
+not converge. A bug is one line ``vemkit: error: internal error (...); please report``, exit
+status 70. SIGINT/SIGTERM end the run at once (exit 130/143). Outputs are written next to their
+targets and renamed over them only on success: whatever the paths held before is never lost.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
-import yaml
-
 import vemkit
+from vemkit.exceptions import InputError, OutputError, SolveError, VemkitError
 
 EXIT_FAILURE = 2
+EXIT_INTERNAL = 70
 
 
 class _Progress:
@@ -42,101 +48,176 @@ class _Progress:
             self.bar.close()
 
 
-def _remove(*paths):
-    for p in paths:
-        if p is not None:
-            Path(p).unlink(missing_ok=True)
+def _outputs(args, inputs):
+    """(output, vtu) targets checked before any work (vemkit.io.output_files.output_target)."""
+    from vemkit.io.output_files import output_target, same_file
+
+    output = output_target(args.output, "-o", inputs)
+    vtu = None if args.vtu is None else output_target(args.vtu, "--vtu", inputs)
+    if vtu is not None and same_file(output, vtu):
+        raise OutputError(f"-o {args.output} and --vtu {args.vtu} name the same file; give two "
+                          "different paths", key="--vtu")
+    return output, vtu
+
+
+@contextmanager
+def _writing(args):
+    """A failing writer (a full disk, a vanished directory) is an OutputError naming the outputs."""
+    try:
+        yield
+    except (OSError, RuntimeError) as error:
+        names = " and ".join(p for p in (args.output, args.vtu) if p)
+        raise OutputError(f"cannot write {names} ({' '.join(str(error).split())}); nothing was "
+                          "written: check the disk space and permissions", key="-o") from None
 
 
 def cmd_solve(args) -> int:
-    from vemkit.mesh.files import write_vtu
-    from vemkit.io.solution_file import write_netcdf
-    from vemkit.studies.scene_solve import solve_scene
     from vemkit.config.scene import load_scene
 
+    _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
-    show = not args.quiet and sys.stderr.isatty()
-    progress = _Progress(show, scene.solver_options["method"])
+    mesh_file = scene.mesh_options.get("file")  # SPEC §8: relative to the scene file
+    output, vtu = _outputs(args, [args.scene] + ([Path(args.scene).parent / mesh_file] if mesh_file else []))
+
+    from vemkit.config.limits import check_scene_resources
+
+    check_scene_resources(scene, args.max_dofs)  # before anything is built
+
+    from vemkit.io.output_files import atomic_outputs
+    from vemkit.io.solution_file import check_finite
+    from vemkit.mesh.files import write_vtu
+    from vemkit.studies.scene_solve import solve_scene
+
+    progress = _Progress(not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
     try:
-        problem, solution, ds = solve_scene(scene, progress=progress)
+        problem, solution, ds = solve_scene(scene, progress=progress, verify=True)
     finally:
         progress.close()
-    write_netcdf(ds, args.output)
-    if args.vtu:
-        u = problem.dofs.expand(solution.u)
-        cells = {k: ds[k].values for k in ("stress_11", "stress_22", "stress_12", "shear_energy_density")}
-        write_vtu(problem.mesh, args.vtu, point_data={"displacement": u}, cell_data=cells)
+    check_finite(ds, args.output)
+    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+        ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
+        if vtu_part is not None:
+            u = problem.dofs.expand(solution.u)
+            cells = {k: ds[k].values for k in ("stress_11", "stress_22", "stress_12", "shear_energy_density")}
+            write_vtu(problem.mesh, vtu_part, point_data={"displacement": u}, cell_data=cells)
     if not args.quiet:
-        print(
-            f"{args.output}: {solution.method} converged in {solution.iterations} iterations, "
-            f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s"
-        )
+        print(f"{args.output}: {solution.method} converged in {solution.iterations} iterations, "
+              f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})")
     return 0
-
-
-def _option_value(text: str):
-    key, sep, value = text.partition("=")
-    if not sep or not key:
-        raise ValueError(f"--option {text!r}: write it as key=value, e.g. --option seed=3")
-    return key, yaml.safe_load(value)
 
 
 def cmd_mesh(args) -> int:
-    from vemkit.mesh.families import build_mesh
+    from vemkit.config.limits import check_resources, estimate_mesh, estimate_resources
+    from vemkit.config.mesh_options import mesh_request
+
+    output, vtu = _outputs(args, [])
+    options = mesh_request(args.family, args.n, args.option or ())
+    estimate = estimate_resources(*estimate_mesh(options))  # before anything is built
+    family, n = options.pop("family"), options.pop("n")
+    check_resources(estimate, args.max_dofs, what=f"the {family} mesh with N = {n}", fix="a smaller N")
+
+    from vemkit.io.output_files import atomic_outputs
     from vemkit.mesh.checks import validate_mesh
+    from vemkit.mesh.families import build_mesh
     from vemkit.mesh.files import write_ugrid, write_vtu
 
-    options = dict(_option_value(o) for o in (args.option or ()))
-    mesh = build_mesh(args.family, args.n, **options)
+    mesh = build_mesh(family, n, **options)
     validate_mesh(mesh)
-    write_ugrid(mesh, args.output)
-    if args.vtu:
-        write_vtu(mesh, args.vtu)
+    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+        write_ugrid(mesh, output_part)
+        if vtu_part is not None:
+            write_vtu(mesh, vtu_part)
     if not args.quiet:
-        print(f"{args.output}: {args.family} mesh, {mesh.n_cells} cells, {mesh.n_vertices} vertices")
+        print(f"{args.output}: {family} mesh, {mesh.n_cells} cells, {mesh.n_vertices} vertices")
     return 0
 
 
+class _ArgumentParser(argparse.ArgumentParser):
+    """argparse whose usage errors are an InputError (one line, exit status 2), not a usage dump."""
+
+    def error(self, message):
+        raise InputError(f"{message}; see {self.prog} --help", key="arguments")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid integer {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text}: give an integer >= 1")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
+    from vemkit.config.limits import DEFAULT_MAX_DOFS
+
+    parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
+    limit = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
+                 help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})")
     solve = sub.add_parser("solve", help="solve a scene and write the solution as netCDF")
     solve.add_argument("scene", help="scene YAML file (see config/scenes/paper.yaml)")
     solve.add_argument("-o", "--output", required=True, help="solution file (netCDF4, UGRID)")
     solve.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. solver.method=uzawa")
     solve.add_argument("--vtu", help="also write a VTU file for ParaView")
+    solve.add_argument("--max-dofs", **limit)
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress display and no summary line")
-    solve.set_defaults(func=cmd_solve, outputs=("output", "vtu"))
+    solve.set_defaults(func=cmd_solve)
     mesh = sub.add_parser("mesh", help="build a mesh of a family and write it as UGRID netCDF")
     mesh.add_argument("family", help="square, triangle, voronoi or hanging")
     mesh.add_argument("n", type=int, help="cells per side (h = 1/n)")
     mesh.add_argument("-o", "--output", required=True, help="mesh file (netCDF4, UGRID)")
     mesh.add_argument("--option", action="append", metavar="KEY=VALUE", help="family option, e.g. seed=3, kind=delaunay")
     mesh.add_argument("--vtu", help="also write a VTU file")
+    mesh.add_argument("--max-dofs", **limit)
     mesh.add_argument("-q", "--quiet", action="store_true")
-    mesh.set_defaults(func=cmd_mesh, outputs=("output", "vtu"))
+    mesh.set_defaults(func=cmd_mesh)
     return parser
 
 
-def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    outputs = [getattr(args, name, None) for name in args.outputs]
+def _fail(message, status: int = EXIT_FAILURE) -> int:
+    print(f"vemkit: error: {' '.join(str(message).split())}", file=sys.stderr)
+    return status
+
+
+def _run(argv) -> int:
+    """Parse and run; every failure becomes one line on stderr and an exit status."""
     try:
-        return args.func(args)
-    except KeyboardInterrupt:
-        _remove(*outputs)
-        print("vemkit: interrupted; no output written", file=sys.stderr)
-        return 130
-    except (ValueError, RuntimeError, OSError, KeyError) as error:
-        _remove(*outputs)
-        message = " ".join(str(error).split()) or type(error).__name__
-        print(f"vemkit: error: {message}", file=sys.stderr)
-        return EXIT_FAILURE
-    except BaseException:  # a bug: keep the traceback, but leave no output behind
-        _remove(*outputs)
-        raise
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            args = build_parser().parse_args(argv)
+            status = args.func(args)
+        if not args.quiet:  # what a user should see, one line each; not libraries' deprecations
+            shown = [w for w in caught if issubclass(w.category, (RuntimeWarning, UserWarning))]
+            for text in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in shown):
+                print(f"vemkit: warning: {' '.join(text.split())}", file=sys.stderr)
+        return status
+    except (InputError, SolveError, VemkitError) as error:
+        return _fail(error)
+    except MemoryError:
+        return _fail("out of memory although the estimate fitted (please report); use a coarser "
+                     "discretization.mesh")
+    except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
+        where = f"{error.filename}: " if error.filename else ""
+        return _fail(f"{where}{error.strerror or error}; nothing was written")
+    except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
+        return _fail(f"internal error ({type(error).__name__}: {error}); please report",
+                     EXIT_INTERNAL)
+
+
+def main(argv=None) -> int:
+    """The command; ``argv=None`` (the real command line) keeps the signal handlers installed up
+    to the process exit, so that a signal after the work still ends the process cleanly."""
+    from vemkit.io.output_files import exit_on_signals
+
+    with exit_on_signals(restore=argv is not None):
+        try:
+            return _run(argv)
+        except KeyboardInterrupt:  # only when signals could not be handled (not the main thread)
+            print("vemkit: interrupted; no output written", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":

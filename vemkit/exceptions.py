@@ -9,11 +9,14 @@ Imports nothing from vemkit.
     │   ├── SceneError                    a scene file, a ``--set`` override, a CLI option
     │   ├── ExpressionError               an expression in a scene
     │   ├── MeshError                     a mesh (built or read) the solver must not use
-    │   └── ResultError                   a result that must not be written (NaN, wrong shape)
+    │   ├── ResultError                   a result that must not be written (NaN, wrong shape)
+    │   ├── OutputError                   an output path that must not or cannot be written
+    │   └── ResourceLimitError            a request beyond a documented limit or the machine
     └── SolveError (RuntimeError)         a solve that did not produce a trustworthy answer
         ├── ConvergenceError              a contact solver did not converge (``reason``)
         ├── LinearSolveError              a linear solve failed
-        └── TimeBudgetExceeded            a solve ran past its wall-time budget
+        ├── TimeBudgetExceeded            a solve ran past its wall-time budget
+        └── VerificationError             the independent check of a returned solution failed
 """
 
 from __future__ import annotations
@@ -59,9 +62,21 @@ class ResultError(InputError):
     """A result that must not be stored (non-finite values, inconsistent shapes)."""
 
 
+class OutputError(InputError):
+    """An output path that is refused (an input, a directory, a device) or could not be written."""
+
+
+class ResourceLimitError(InputError):
+    """A request beyond a documented limit or the machine; ``estimate`` holds the prediction."""
+
+    def __init__(self, message: str = "", *, key: str | None = None, estimate: dict | None = None):
+        super().__init__(message, key=key)
+        self.estimate = dict(estimate or {})
+
+
 #: why a solve failed (``SolveError.reason``); the robustness study classifies by these
 SOLVE_FAILURE_REASONS = ("diverged", "stagnated", "max_iterations", "inaccurate_stop", "other",
-                         "time_budget", "linear_solver_failed")
+                         "time_budget", "linear_solver_failed", "check_failed")
 
 
 class SolveError(VemkitError, RuntimeError):
@@ -96,3 +111,9 @@ class TimeBudgetExceeded(SolveError):
     """A solve ran past its wall-time budget (checked after every iteration)."""
 
     default_reason = "time_budget"
+
+
+class VerificationError(SolveError):
+    """The solver returned, but the independent residual check did not meet the requested accuracy."""
+
+    default_reason = "check_failed"

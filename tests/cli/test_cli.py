@@ -72,7 +72,7 @@ BAD_SETS = {
 
 
 @pytest.mark.parametrize("case", BAD_SETS)
-def test_bad_scene_exits_nonzero_with_one_line_and_no_file(tmp_path, case):
+def test_bad_scene_exits_nonzero_with_one_line_and_keeps_the_old_file(tmp_path, case):
     override, named = BAD_SETS[case]
     out = tmp_path / "out.nc"
     out.write_text("stale result from an earlier run")
@@ -81,7 +81,7 @@ def test_bad_scene_exits_nonzero_with_one_line_and_no_file(tmp_path, case):
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("vemkit: error:"), run.stderr
     assert named in lines[0]
-    assert not out.exists()
+    assert out.read_text() == "stale result from an earlier run"  # what the user had is kept (issue 9)
     assert not list(tmp_path.glob(".out.nc*"))
 
 
@@ -107,7 +107,25 @@ def test_mesh_command(tmp_path):
     assert run.returncode != 0 and "seed" in run.stderr
 
 
-def test_unimplemented_contact_quadrature_is_refused_not_ignored(tmp_path):
+def test_gauss_contact_quadrature_is_used_and_bad_point_counts_refused(tmp_path):
+    from vemkit.config.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+    from vemkit.solvers.ssn import solve_ssn
+
+    out = tmp_path / "gauss.nc"
+    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.mesh.n=4",
+                 "--set", "discretization.contact_quadrature=gauss")
+    assert run.returncode == 0, run.stderr
+    with xr.open_dataset(out) as ds:
+        assert "contact_gauss_points: 3" in ds.attrs["scene"]
+        u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
+    for quadrature, differs in (("nodal", True), ("gauss", False)):
+        scene = load_scene(PAPER).with_overrides(["discretization.mesh.n=4",
+                                                  f"discretization.contact_quadrature={quadrature}"])
+        pb = scene_problem(scene)
+        expected = pb.dofs.expand(solve_ssn(pb, tol=1e-10).u)
+        assert (np.max(np.abs(u - expected)) > 1e-8 * np.max(np.abs(expected))) == differs, quadrature
     out = tmp_path / "g.nc"
-    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.contact_quadrature=gauss")
-    assert run.returncode != 0 and "contact_quadrature" in run.stderr and not out.exists()
+    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.contact_quadrature=gauss",
+                 "--set", "discretization.contact_gauss_points=0")
+    assert run.returncode != 0 and "contact_gauss_points" in run.stderr and not out.exists()

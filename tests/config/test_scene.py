@@ -70,7 +70,7 @@ def test_paper_scene_has_the_paper_numbers(paper):
     assert paper.stabilization == "dofi-2mu" and paper.contact_quadrature == "nodal"
     assert paper.solver_options == {"method": "ssn", "tol": 1e-10, "max_iterations": None,
                                     "linear": "auto", "rho": None, "eps_u": None,
-                                    "eps_lambda": None, "stop": "either"}
+                                    "eps_lambda": None, "stop": "either", "time_budget": None}
 
 
 def test_paper_loads_and_tractions_evaluate_vectorised(paper):
@@ -193,21 +193,21 @@ def with_change(path, value):
     ("contact.normal.m=-1", "contact.normal.m = -1", ">= 0"),
     ("contact.friction.k=-450", "contact.friction.k = -450", ">= 0"),
     ("contact.friction.m=-0.5", "contact.friction.m = -0.5", ">= 0"),
-    ("material.E=0", "material.E = 0", "> 0"),
-    ("material.E=-2000", "material.E = -2000", "> 0"),
+    ("material.E=0", "material.E = 0", ">= 1e-12"),
+    ("material.E=-2000", "material.E = -2000", ">= 1e-12"),
     ("material.E=abc", "material.E = 'abc'", "must be a number"),
     ("material.E=true", "material.E = true", "must be a number"),
     ("material.E=.nan", "material.E = nan", "finite"),
     ("material.nu=0.5", "material.nu = 0.5", "< 0.5"),
     ("material.nu=0.7", "material.nu = 0.7", "< 0.5"),
-    ("material.nu=-1", "material.nu = -1", "> -1"),
+    ("material.nu=-1", "material.nu = -1", ">= -0.999"),
     ("discretization.mesh.n=0", "discretization.mesh.n = 0", ">= 1"),
     ("discretization.mesh.n=2.5", "discretization.mesh.n = 2.5", "integer"),
     ("discretization.mesh.n=sixteen", "discretization.mesh.n = 'sixteen'", "integer"),
     ("discretization.mesh.family=hexagon", "discretization.mesh.family", "square"),
     ("discretization.stabilization=none", "discretization.stabilization", "dofi-2mu"),
     ("solver.method=newton", "solver.method", "ssn, uzawa"),
-    ("solver.tol=0", "solver.tol = 0", "> 0"),
+    ("solver.tol=0", "solver.tol = 0", ">= 1e-15"),
     ("solver.max_iterations=0", "solver.max_iterations = 0", ">= 1"),
     ("solver.rho=-1", "solver.rho = -1", "> 0"),
     ("body_force=[0]", "body_force", "2"),

@@ -73,3 +73,19 @@ def test_bad_settings_are_refused(theta, target):
 
     with pytest.raises(InputError):
         AdaptivitySettings(theta=theta, target=target)
+
+
+def test_the_adaptive_solution_file_holds_the_indicator_and_the_history(tmp_path):
+    import xarray as xr
+
+    from vemkit.io.solution_file import write_netcdf
+    from vemkit.studies.adaptivity import adaptive_dataset
+
+    scene = load_scene(PAPER, ["discretization.mesh.n=4"])
+    run = adapt(scene, AdaptivitySettings(max_steps=3))
+    write_netcdf(adaptive_dataset(scene, run), tmp_path / "adapted.nc")
+    with xr.open_dataset(tmp_path / "adapted.nc") as ds:
+        assert ds.sizes["adapt_step"] == 3 and ds.sizes["mesh2d_nFaces"] == run.problem.mesh.n_cells
+        assert np.allclose(ds["error_indicator"], run.indicators["indicator"])
+        assert list(ds["adapt_n_dofs"].values) == [r["n_dofs"] for r in run.history]
+        assert "adapt_true_error" not in ds and ds.attrs["adapt_stop_reason"] == "max_steps"

@@ -9,7 +9,8 @@ import pytest
 from vemkit.config.scene import load_scene
 from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import ConvergenceError, LinearSolveError, SceneError, TimeBudgetExceeded
-from vemkit.solvers.verification import FAILURE_CLASSES, STATUS_MEANINGS, failure_class, guarded_solve, verify_solution
+from vemkit.solvers.verification import (FAILURE_CLASSES, STATUS_MEANINGS, failed, failure_class, guarded_solve,
+                                         verify_solution)
 from vemkit.studies.robustness import (
     CASES,
     case_overrides,
@@ -87,29 +88,61 @@ def test_the_independent_check_catches_wrong_solutions(scene):
     assert not verify_solution(problem, np.full_like(u, np.nan), lam)["passed"]
 
 
-def test_failure_classes():
-    def context(exc, cause):
+def test_failure_classes_come_from_types_and_attributes_not_messages():
+    def raised_from(exc, cause):
         try:
             try:
                 raise cause
-            except type(cause):
-                raise exc from None
+            except type(cause) as inner:
+                raise exc from inner
         except type(exc) as raised:
             return raised
 
-    assert failure_class(TimeBudgetExceeded("late")) == "time_budget"
-    assert failure_class(ConvergenceError("uzawa diverged after 5 iterations (non-finite values): ...")) == "diverged"
-    assert failure_class(ConvergenceError("uzawa did not converge after 201 iterations (|Δu| stagnated at 1)")) == "stagnated"
-    assert failure_class(ConvergenceError("ssn did not converge after 50 iterations (residual 1e-2 > tol 1e-10)")) == "max_iterations"
-    assert failure_class(ConvergenceError("uzawa stopped after 2 iterations by the |Δλ| test but the discrete problem "
-                                          "residual is 1e-4 (accepted 1e-05)")) == "inaccurate_stop"
-    assert failure_class(context(ConvergenceError("ssn: AMG-CG stopped"), LinearSolveError("cg"))) == "linear_solver_failed"
-    assert failure_class(LinearSolveError("singular")) == "linear_solver_failed"
+    # the messages say one thing, the attributes another: the attributes win
+    misleading = "uzawa diverged after 5 iterations (non-finite values, |Δu| stagnated, max_iterations = 9 reached)"
+    for reason in ("diverged", "stagnated", "max_iterations", "inaccurate_stop", "other"):
+        error = ConvergenceError(misleading, solver="uzawa", reason=reason, iterations=7)
+        assert failure_class(error) == reason
+        outcome = failed("uzawa", error, "solve")
+        assert (outcome.status, outcome.iterations) == (reason, 7)
+    assert failure_class(ConvergenceError("ssn diverged after 3 iterations")) == "other"  # no reason given
+    assert failed("ssn", ConvergenceError("ssn did not converge after 50 iterations"), "solve").iterations == -1
+    assert failure_class(TimeBudgetExceeded("diverged")) == "time_budget"
+    wrapped = ConvergenceError("ssn: diverged", solver="ssn", reason="linear_solver_failed", iterations=2)
+    assert failure_class(wrapped) == "linear_solver_failed"
+    assert failure_class(raised_from(ConvergenceError("ssn: diverged"), LinearSolveError("cg"))) == "linear_solver_failed"
+    assert failure_class(LinearSolveError("diverged")) == "linear_solver_failed"
     assert failure_class(SceneError("contact.normal.k = -1: must be >= 0")) == "invalid_input"
     assert failure_class(ValueError("anything"), phase="setup") == "invalid_input"
-    assert failure_class(ValueError("operands could not be broadcast"), phase="solve") == "unexpected_exception"
+    assert failure_class(ValueError("solver.rho = -1"), phase="solve") == "unexpected_exception"
     assert failure_class(KeyError("x")) == "unexpected_exception"
-    assert failure_class(ConvergenceError("something new")) == "other"
+    with pytest.raises(ValueError, match="unknown solve failure reason"):
+        ConvergenceError("x", reason="no such reason")
+
+
+def test_real_solver_failures_carry_their_class():
+    """Each solver failure raised by the solvers names its reason, solver and iteration."""
+    from vemkit.contact.laws import ContactLaw
+    from vemkit.solvers.ssn import solve_ssn
+    from vemkit.solvers.uzawa import solve_uzawa
+    from conftest import paper_problem
+    from vemkit.mesh.families.square import square
+
+    stick_slip = paper_problem(square(8), law=ContactLaw(10.0, 1.0, 700.0, 0.0))
+    stiff = paper_problem(square(8), law=ContactLaw(1e6, 1.0, 450.0, 0.0))
+    cases = [
+        (lambda: solve_ssn(stick_slip, linear="direct", max_iterations=1), "ssn", ("max_iterations",)),
+        (lambda: solve_uzawa(stick_slip, linear="direct", max_iterations=5), "uzawa", ("max_iterations",)),
+        (lambda: solve_uzawa(stiff, linear="direct"), "uzawa", ("diverged", "stagnated")),
+        (lambda: solve_uzawa(paper_problem(square(8)), linear="direct", rho=1.0, max_iterations=3), "uzawa",
+         ("inaccurate_stop",)),
+    ]
+    for run, solver, reasons in cases:
+        with pytest.raises(ConvergenceError) as failure:
+            run()
+        error = failure.value
+        assert error.solver == solver and error.reason in reasons and error.iterations > 0, (solver, str(error))
+        assert failure_class(error) == error.reason
 
 
 def test_time_budget_is_a_classified_failure(scene):

@@ -9,7 +9,6 @@ import pytest
 from vemkit.config.scene import load_scene
 from vemkit.solvers.verification import STATUS_MEANINGS
 from vemkit.studies.sweeps import (
-    DIMENSION_NAMES,
     FLOAT_FILL,
     combine_parts,
     dimension_name,
@@ -97,6 +96,19 @@ def test_reused_problem_equals_fresh_solves(scene):
         np.testing.assert_allclose(reused[name].values, fresh[name].values, rtol=1e-12, atol=1e-14, equal_nan=True)
     np.testing.assert_array_equal(reused["iterations"].values, fresh["iterations"].values)
     assert reused["setup_time"].values.sum() < fresh["setup_time"].values.sum()
+
+
+def test_reused_problem_equals_fresh_solves_with_gauss_quadrature(scene):
+    """A changed gap reaches the Gauss points too (ContactBoundary.with_gap), and the resultant
+    normal force is the Gauss integral, which differs from the nodal sum when p_nu is not linear."""
+    gauss = scene.with_overrides(["discretization.contact_quadrature=gauss", "contact.normal.m=2.0"])
+    grid = {"contact.gap": [0.0, 0.05], "contact.normal.k": [100.0]}
+    reused = run_sweep(gauss, grid, reuse=True)
+    fresh = run_sweep(gauss, grid, reuse=False)
+    for name in ("normal_force", "max_penetration", "profile_pressure"):
+        np.testing.assert_allclose(reused[name].values, fresh[name].values, rtol=1e-12, atol=1e-14)
+    nodal = run_sweep(gauss.with_overrides(["discretization.contact_quadrature=nodal"]), grid)
+    assert not np.allclose(nodal["normal_force"].values, reused["normal_force"].values, rtol=1e-6)
 
 
 def test_failures_are_classified_and_the_file_holds_no_nan(scene, tmp_path):

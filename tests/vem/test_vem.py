@@ -4,27 +4,16 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from conftest import FAMILY_CASES, family_mesh
-from vemkit.vem.assembly import DofMap, stiffness_matrix
+from conftest import FAMILY_CASES, POLYGONS, family_mesh, nonconvex_mesh
+from vemkit.vem.assembly import stiffness_matrix
 from vemkit.vem.norms import exact_errors
 from vemkit.vem.projection import projected_solution, shear_energy_density, stress
 from vemkit.solvers.linear import linear_solver
-from vemkit.mesh.mesh import from_polygons, tag_box_boundary
 from vemkit.contact.problem import discrete_problem
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.element import STABILIZATIONS, element_stiffness, element_stiffness_reference
 
 LAM, MU = lame_parameters(2000.0, 0.4)
-
-POLYGONS = {
-    "square": [[0, 0], [1, 0], [1, 1], [0, 1]],
-    "triangle": [[0, 0], [1, 0.2], [0.3, 0.9]],
-    "pentagon": [[0, 0], [2, 0.1], [2.5, 1.3], [1, 2], [-0.3, 1]],
-    "nonconvex-arrow": [[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2]],
-    "hanging-square": [[0, 0], [0.5, 0], [1, 0], [1, 0.5], [1, 1], [0, 1]],
-    "L-shape": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],
-}
-
 
 def kernel(coords, stab):
     n = len(coords)
@@ -124,20 +113,6 @@ def test_stiffness_times_any_linear_field_is_its_boundary_traction(case):
         t = sig @ np.array(nrm, float)
         f += traction_load(mesh, mesh.boundary[side], lambda x, y, t=t: (t[0] + 0 * x, t[1] + 0 * x))
     assert np.abs(K @ u - f.ravel()).max() < 1e-10 * np.abs(f).max()
-
-
-def nonconvex_mesh():
-    """Unit square as two non-convex cells (a dent at (0.3, 0.55) and (0.75, 0.45)) and two triangles."""
-    v = [[0, 0], [0.5, 0.3], [1, 0], [1, 0.5], [1, 1], [0.5, 0.8], [0, 1], [0, 0.5], [0.3, 0.55], [0.75, 0.45]]
-    polys = [
-        [0, 1, 8, 5, 6, 7],  # reflex angle at vertex 8
-        [1, 9, 2, 3, 4, 5, 8],  # reflex angle at vertex 9
-        [0, 2, 9, 1],  # a triangle with vertex 1 in the middle of its edge
-        [5, 4, 6],
-    ]
-    mesh = tag_box_boundary(from_polygons(np.array(v, float), polys))
-    assert np.all(mesh.cell_areas > 0) and abs(mesh.cell_areas.sum() - 1) < 1e-14
-    return mesh
 
 
 @pytest.mark.parametrize("stab", STABILIZATIONS)

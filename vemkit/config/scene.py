@@ -23,18 +23,22 @@ import numpy as np
 import yaml
 
 from vemkit.config.expressions import Expression, compile_expression
+from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
 from vemkit.exceptions import ExpressionError, SceneError
-from vemkit.mesh.mesh import UNIT_SQUARE_SIDES
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
            "scene_schema"]
 
-DOMAIN_SIDES = {"unit_square": tuple(UNIT_SQUARE_SIDES)}
+# the unit square's sides, as vemkit.mesh.domain.UNIT_SQUARE_SIDES (config is the layer below mesh)
+DOMAIN_SIDES = {"unit_square": ("left", "right", "bottom", "top")}
 # points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
 _UNIT_SQUARE_SIDE_POINTS = {
     "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
     "bottom": lambda s: (s, 0.0 * s), "top": lambda s: (s, 0.0 * s + 1.0),
 }
+#: contact.normal.k / material.E above this is refused (README "Input rules and limits"): measured,
+#: ssn's independent check is 5e-9 at k/E = 5e8 and fails at 5e11 (paper scene, n = 8)
+MAX_NORMAL_K_OVER_E = 1e9
 _PROBES = 16  # points per side (and per direction inside) where expressions are test-evaluated
 NO_DIRICHLET = "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]"
 _TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
@@ -46,48 +50,6 @@ class PowerLaw(NamedTuple):
 
     k: float
     m: float
-
-
-# -- YAML ----------------------------------------------------------------------------------------
-class _SceneLoader(yaml.SafeLoader):
-    """SafeLoader that rejects duplicate keys and reads ``1e-10`` as a float (as YAML 1.2 does)."""
-
-    def construct_mapping(self, node, deep=False):
-        seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            try:
-                duplicate = key in seen
-            except TypeError:  # unhashable: let SafeLoader report it
-                break
-            if duplicate:
-                raise yaml.constructor.ConstructorError(
-                    None, None, f"duplicate key {key!r}", key_node.start_mark)
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
-class _SceneDumper(yaml.SafeDumper):
-    """SafeDumper that quotes every string _SceneLoader would read as a float."""
-
-
-_SCIENTIFIC_FLOAT = re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$")
-for _cls in (_SceneLoader, _SceneDumper):
-    _cls.add_implicit_resolver("tag:yaml.org,2002:float", _SCIENTIFIC_FLOAT, list("-+0123456789"))
-
-
-def _parse_yaml(text: str, source: str):
-    try:
-        return yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
-    except yaml.MarkedYAMLError as error:
-        mark = error.problem_mark or error.context_mark
-        where = f"{source}:{mark.line + 1}" if mark is not None else source
-        context = f" ({error.context} at line {error.context_mark.line + 1})" \
-            if error.context and error.context_mark is not None and error.problem else ""
-        raise SceneError(f"{where}: YAML syntax error: {error.problem or error.context}{context}") \
-            from None
-    except yaml.YAMLError as error:
-        raise SceneError(f"{source}: YAML syntax error: {error}") from None
 
 
 # -- the schema ----------------------------------------------------------------------------------
@@ -165,15 +127,20 @@ def _suggest(word, choices) -> str:
         f"; allowed here: {allowed}"
 
 
-def _check_finite(value, path) -> None:
+def _scene_fix(key: str | None) -> str:
+    """The fix a message suggests for ``key`` (None: an unknown key)."""
+    return "fix the scene" if key is None else f"fix the scene or --set {key}=..."
+
+
+def _check_finite(value, path, fix=_scene_fix) -> None:
     if isinstance(value, (int, float)) and not isinstance(value, bool) and \
             not abs(value) <= sys.float_info.max:  # nan, inf, ints beyond the float range
-        raise SceneError(f"{_key(path)} = {value}: must be a finite number; "
-                         f"fix the scene or --set {_key(path)}=...")
+        raise SceneError(f"{_key(path)} = {value}: must be a finite number; {fix(_key(path))}",
+                         key=_key(path))
     children = value.items() if isinstance(value, dict) else \
         enumerate(value) if isinstance(value, list) else ()
     for key, child in children:
-        _check_finite(child, [*path, key])
+        _check_finite(child, [*path, key], fix)
 
 
 def _document_order(data, error) -> tuple:
@@ -191,7 +158,7 @@ def _document_order(data, error) -> tuple:
     return tuple(position)
 
 
-def _schema_error_message(error) -> str:
+def _schema_error_message(error, fix=_scene_fix) -> str:
     path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
     key, value = _key(path), error.instance
     side_names = ", ".join(_validator().schema["$defs"]["side"]["enum"])
@@ -201,7 +168,7 @@ def _schema_error_message(error) -> str:
         if key == "boundary.neumann":
             return f"{key}.{extra}: unknown boundary name {extra!r}; the unit_square has sides " \
                    f"{side_names}; fix the scene"
-        return f"{_key([*path, extra])}: unknown key{_suggest(extra, allowed)}; fix the scene"
+        return f"{_key([*path, extra])}: unknown key{_suggest(extra, allowed)}; {fix(None)}"
     if keyword == "required":
         missing = next(k for k in error.validator_value if k not in value)
         title = _resolve(schema["properties"][missing]).get("title", "")
@@ -228,7 +195,7 @@ def _schema_error_message(error) -> str:
                 "uniqueItems": "lists an entry twice", "minLength": "must not be empty",
                 "maxLength": f"must be at most {bound} characters"}.get(keyword, error.message)
     title = f" ({schema['title']})" if "title" in schema else ""
-    return f"{key} = {_show(value)}: {need}{title}; fix the scene or --set {key}=..."
+    return f"{key} = {_show(value)}: {need}{title}; {fix(key)}"
 
 
 def _validate(data) -> None:
@@ -279,6 +246,11 @@ def _semantic_checks(data: dict) -> dict:
     if boundary["contact"] and "contact" not in data:
         raise SceneError(f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
                          "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}")
+    if "contact" in data and data["contact"]["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
+        raise SceneError(f"contact.normal.k = {data['contact']['normal']['k']:g}: must be at most "
+                         f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "
+                         "(stiffer is rigid contact, beyond double precision); fix the scene or "
+                         "--set contact.normal.k=...", key="contact.normal.k")
     s = (np.arange(_PROBES) + 0.5) / _PROBES
     inside = np.meshgrid(s, s)
     probes = [("body_force", data["body_force"], inside)]
@@ -370,6 +342,8 @@ class Scene:
     has_contact = _field("boundary", "contact", convert=bool, doc="True if a side is in contact")
     stabilization = _field("discretization", "stabilization")
     contact_quadrature = _field("discretization", "contact_quadrature")
+    contact_gauss_points = _field("discretization", "contact_gauss_points",
+                                  doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
     mesh_options = _field("discretization", "mesh", convert=dict,
                           doc="discretization.mesh: family, n and the family options given (a copy)")
     solver_options = _field("solver", convert=dict,
@@ -408,7 +382,7 @@ class Scene:
 
     def to_yaml(self) -> str:
         """The full, defaults-filled scene as YAML; loads back to an equal scene."""
-        return yaml.dump(self._data, Dumper=_SceneDumper, sort_keys=False,
+        return yaml.dump(self._data, Dumper=SceneDumper, sort_keys=False,
                          default_flow_style=None, allow_unicode=True)
 
     def with_overrides(self, overrides) -> Scene:
@@ -443,12 +417,5 @@ def scene_from_yaml(text: str, overrides=(), *, source: str = "<string>") -> Sce
 def load_scene(path, overrides=()) -> Scene:
     """Read, override and validate a scene file; every problem is a one-line SceneError."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SceneError(f"{path}: scene file not found") from None
-    except UnicodeDecodeError:
-        raise SceneError(f"{path}: not a UTF-8 text file") from None
-    except OSError as error:
-        raise SceneError(f"{path}: cannot read the scene file ({error.strerror or error})") from None
+    text = read_user_file(path, "scene file")  # a regular file of at most 256 KiB (safe_yaml)
     return scene_from_yaml(text, overrides, source=str(path))

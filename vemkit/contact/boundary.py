@@ -5,27 +5,88 @@ edge as weight; the outward normal of a vertex is the length-weighted mean of th
 normals of its contact edges (exact on straight parts), the tangent is tau = (-nu_2, nu_1)
 (on the bottom edge nu = (0, -1), tau = (1, 0)). Clamped vertices are dropped: their
 displacement is zero and they carry no unknown.
+
+``gauss`` quadrature (``contact_gauss_points`` N per edge): the normal-compliance term of (3.16),
+
+    int_{Gamma_C} p_nu(u_nu - g) v_nu ds  =  sum_e sum_q |e| w_q p_nu(t_eq) sum_a phi_a(s_q) v_a . nu_e,
+
+with t = u_h . nu_e - g interpolated linearly along each edge e between its two end values
+(phi_a the hat functions of the ends, nu_e the edge normal: the normal of a straight edge, which is
+also the vertex normal of the nodal rule on straight parts), and Gauss-Legendre points s_q,
+weights w_q on [0, 1]. A clamped end keeps u = 0 and its own gap. Its consistent linearization is
+sum_q |e| w_q p_nu'(t_eq) phi_a phi_b nu_e nu_e^T, coupling the two ends of an edge (no longer
+one block per vertex). On a constant penetration along an edge both rules give the same force.
+
+The friction term keeps its nodal multiplier in both cases: sum_c w_c p_tau(u_nu,c - g_c)
+lambda_c tau_c. The multiplier lambda lives at the vertices, |lambda_c| <= 1 is a projection vertex
+by vertex, the Uzawa update (5.5) lambda_c <- P(lambda_c + rho k_tau u_tau,c) is vertex-wise, and
+the semismooth Newton complementarity function is vertex-wise too; a Gauss-point multiplier
+would need its own space and an inf-sup compatible pairing with u_tau, which the paper's
+discretization does not have.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+import scipy.sparse as sp
 
+from vemkit.exceptions import InputError, SceneError
 from vemkit.vem.assembly import DofMap
 from vemkit.mesh.mesh import Mesh
+
+QUADRATURES = ("nodal", "gauss")
+MAX_GAUSS_POINTS = 10
+
+
+def gauss_rule(points: int):
+    """Gauss-Legendre points and weights on [0, 1] (weights sum to 1), exact for degree 2 points - 1."""
+    if not (isinstance(points, (int, np.integer)) and 1 <= points <= MAX_GAUSS_POINTS):
+        raise SceneError(f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to "
+                         f"{MAX_GAUSS_POINTS}", key="discretization.contact_gauss_points")
+    x, w = np.polynomial.legendre.leggauss(int(points))
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+def rank_one_blocks(cb, values, left, n, right=None):
+    """Sparse sum_c values_c left_c right_c^T on the contact dofs (right = left if not given)."""
+    right = left if right is None else right
+    rows = np.stack([cb.dofs[:, 0], cb.dofs[:, 0], cb.dofs[:, 1], cb.dofs[:, 1]], axis=1).ravel()
+    cols = np.stack([cb.dofs[:, 0], cb.dofs[:, 1], cb.dofs[:, 0], cb.dofs[:, 1]], axis=1).ravel()
+    a0, a1, b0, b1 = left[:, 0], left[:, 1], right[:, 0], right[:, 1]
+    vals = (values[:, None] * np.stack([a0 * b0, a0 * b1, a1 * b0, a1 * b1], axis=1)).ravel()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
 @dataclass(frozen=True)
 class ContactBoundary:
     vertices: np.ndarray  # (n_c,) mesh vertex indices
     dofs: np.ndarray  # (n_c, 2) free-dof indices of (u1, u2)
-    weight: np.ndarray  # (n_c,) quadrature weights
+    weight: np.ndarray  # (n_c,) nodal quadrature weights
     normal: np.ndarray  # (n_c, 2) unit outward normals nu
     tangent: np.ndarray  # (n_c, 2) unit tangents tau
     gap: np.ndarray  # (n_c,) initial gap g_a >= 0
     coords: np.ndarray  # (n_c, 2) vertex coordinates
+    quadrature: str = "nodal"  # of the normal-compliance term: nodal or gauss
+    # (n_e, 2) contact-vertex index of the two ends of every Gamma_C edge, -1 at a clamped end
+    edge_vertex: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    edge_normal: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_e, 2) unit outward edge normals
+    edge_length: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_e,)
+    edge_gap: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_e, 2) gap at both ends
+    edge_coords: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))  # (n_e, end, xy)
+    gauss_points: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) on [0, 1]
+    gauss_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) summing to 1
+
+    def __post_init__(self):
+        if self.quadrature not in QUADRATURES:
+            raise SceneError(f"discretization.contact_quadrature = {self.quadrature!r}: use nodal or gauss",
+                             key="discretization.contact_quadrature")
+        if self.quadrature == "gauss":
+            free = self.edge_vertex >= 0
+            if not np.array_equal(self.edge_gap[free], self.gap[self.edge_vertex[free]]):
+                raise InputError("the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
+                                 "quadrature: use ContactBoundary.with_gap", key="contact.gap")
 
     @property
     def size(self) -> int:
@@ -46,9 +107,103 @@ class ContactBoundary:
         np.add.at(out, self.dofs[:, 1], normal_part * self.normal[:, 1] + tangential_part * self.tangent[:, 1])
         return out
 
+    def with_gap(self, gap) -> "ContactBoundary":
+        """This boundary with another gap, gap(x, y) -> array (at the vertices and the clamped edge ends)."""
+        g = _gap_values(gap, self.coords)
+        return replace(self, gap=g, edge_gap=_edge_gaps(gap, self.edge_coords, self.edge_vertex, g))
 
-def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap) -> ContactBoundary:
-    """Collect the contact vertices of the named boundary ``parts``; gap(x, y) -> array."""
+    # -- the normal-compliance term and its linearization (nodal or gauss) ----------------------------
+    def contact_force(self, u, law, multiplier):
+        """Free-dof vector of the contact forces: the normal-compliance term plus the nodal friction term."""
+        penetration = self.normal_displacement(u) - self.gap
+        tangential = self.weight * law.friction_bound(penetration) * np.asarray(multiplier, dtype=float)
+        if self.quadrature == "nodal":
+            return self.scatter(self.weight * law.normal_pressure(penetration), tangential, u.size)
+        return self.normal_force(u, law) + self.scatter(np.zeros(self.size), tangential, u.size)
+
+    def normal_force(self, u, law):
+        """Free-dof vector of int p_nu(u_nu - g) phi_i nu ds (the normal-compliance term of (3.16))."""
+        if self.quadrature == "nodal":
+            t = self.normal_displacement(u) - self.gap
+            return self.scatter(self.weight * law.normal_pressure(t), np.zeros(self.size), u.size)
+        t = self._gauss_penetration(u)
+        end_force = (self._gauss_weight() * law.normal_pressure(t)) @ self._shape()  # (n_e, 2)
+        values = end_force[:, :, None] * self.edge_normal[:, None, :]  # (n_e, end, component)
+        return self._assemble_vector(values, u.size)
+
+    def normal_energy(self, u, law) -> float:
+        """int P_nu(u_nu - g) ds, P_nu' = p_nu (the normal-compliance part of the energy)."""
+        if self.quadrature == "nodal":
+            return self.weight @ law.normal_energy(self.normal_displacement(u) - self.gap)
+        return float(np.sum(self._gauss_weight() * law.normal_energy(self._gauss_penetration(u))))
+
+    def normal_jacobian(self, u, law, cap=np.inf):
+        """d(normal_force)/du; p_nu' capped at ``cap`` (per contact vertex, or a number) for m_nu < 1."""
+        if self.quadrature == "nodal":
+            t = self.normal_displacement(u) - self.gap
+            return rank_one_blocks(self, self.weight * np.minimum(law.normal_stiffness(t), cap), self.normal, u.size)
+        slope = np.minimum(law.normal_stiffness(self._gauss_penetration(u)), self._edge_cap(cap)[:, None])
+        phi = self._shape()
+        ends = np.einsum("eq,qa,qb->eab", self._gauss_weight() * slope, phi, phi)  # (n_e, 2, 2)
+        nn = self.edge_normal[:, :, None] * self.edge_normal[:, None, :]  # (n_e, 2, 2)
+        values = ends[:, :, None, :, None] * nn[:, None, :, None, :]  # (n_e, a, i, b, j)
+        dofs = self._edge_dofs(u.size)  # (n_e, 2, 2), clamped ends -> u.size
+        rows = np.broadcast_to(dofs[:, :, :, None, None], values.shape).ravel()
+        cols = np.broadcast_to(dofs[:, None, None, :, :], values.shape).ravel()
+        keep = (rows < u.size) & (cols < u.size)
+        return sp.csr_matrix((values.ravel()[keep], (rows[keep], cols[keep])), shape=(u.size, u.size))
+
+    def _shape(self):
+        """(n_q, 2) the hat functions of the two edge ends at the Gauss points."""
+        return np.stack([1.0 - self.gauss_points, self.gauss_points], axis=1)
+
+    def _gauss_weight(self):
+        """(n_e, n_q) |e| w_q."""
+        return self.edge_length[:, None] * self.gauss_weights[None, :]
+
+    def _edge_dofs(self, n_dofs):
+        """(n_e, 2, 2) free dofs of the edge ends; clamped ends point at n_dofs (a dummy slot)."""
+        padded = np.vstack([self.dofs, [[n_dofs, n_dofs]]])
+        return padded[self.edge_vertex]  # -1 (clamped) indexes the dummy row
+
+    def _gauss_penetration(self, u):
+        """(n_e, n_q) u_nu - g at the Gauss points, both linear along each edge."""
+        u_padded = np.append(u, 0.0)
+        end_u = u_padded[self._edge_dofs(u.size)]  # (n_e, 2, 2); u = 0 at clamped ends
+        ends = np.einsum("eai,ei->ea", end_u, self.edge_normal) - self.edge_gap
+        return ends @ self._shape().T
+
+    def _edge_cap(self, cap):
+        """(n_e,) the smaller cap of the free ends of each edge."""
+        cap = np.broadcast_to(np.asarray(cap, dtype=float), (self.size,))
+        return np.min(np.append(cap, np.inf)[self.edge_vertex], axis=1)
+
+    def _assemble_vector(self, values, n_dofs):
+        dofs = self._edge_dofs(n_dofs)
+        return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
+
+
+
+def _gap_values(gap, coords, check=True):
+    g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (coords.shape[0],)).copy()
+    if not np.all(np.isfinite(g)) or (check and np.any(g < 0)):
+        raise SceneError("contact.gap must be finite and >= 0 at every contact vertex (2.11)", key="contact.gap")
+    return g
+
+
+def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap):
+    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at clamped ends."""
+    ends = np.zeros(edge_vertex.shape)
+    free = edge_vertex >= 0
+    ends[free] = vertex_gap[edge_vertex[free]]
+    if np.any(~free):
+        ends[~free] = _gap_values(gap, edge_coords[~free], check=False)
+    return ends
+
+
+def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap, quadrature: str = "nodal",
+                     gauss_points: int = 3) -> ContactBoundary:
+    """Collect the contact vertices and edges of the named boundary ``parts``; gap(x, y) -> array."""
     edges = np.concatenate([mesh.boundary[name] for name in parts]) if parts else np.zeros((0, 2), np.int64)
     nv = mesh.n_vertices
     t = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
@@ -65,7 +220,13 @@ def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap) -> ContactBoundary:
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
     free = dofs.free_index[verts]
     coords = mesh.vertices[verts]
-    g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (verts.size,)).copy()
-    if np.any(g < 0) or not np.all(np.isfinite(g)):
-        raise ValueError("contact.gap must be finite and >= 0 at every contact vertex (2.11)")
-    return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight[verts], normal, tangent, g, coords)
+    g = _gap_values(gap, coords)
+    contact_index = np.full(nv, -1, dtype=np.int64)
+    contact_index[verts] = np.arange(verts.size)
+    edge_vertex = contact_index[edges]
+    edge_coords = mesh.vertices[edges]
+    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, g)
+    s, w = gauss_rule(gauss_points) if quadrature == "gauss" else (np.zeros(0), np.zeros(0))
+    return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight[verts], normal, tangent, g, coords,
+                           quadrature, edge_vertex, weighted_normal / length[:, None], length, edge_gap, edge_coords,
+                           s, w)

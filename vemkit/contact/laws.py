@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vemkit.exceptions import InputError
+
 
 def power_law(t, k: float, m: float):
     t = np.asarray(t, dtype=float)
@@ -39,7 +41,7 @@ class ContactLaw:
         for name in ("k_normal", "m_normal", "k_friction", "m_friction"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0.0):
-                raise ValueError(f"contact law {name} = {value}: must be a finite number >= 0")
+                raise InputError(f"contact law {name} = {value}: must be a finite number >= 0", key=name)
 
     def normal_pressure(self, penetration):
         """p_nu(u_nu - g_a)."""
@@ -48,6 +50,12 @@ class ContactLaw:
     def normal_stiffness(self, penetration):
         """d p_nu / d u_nu."""
         return power_law_derivative(penetration, self.k_normal, self.m_normal)
+
+    def normal_energy(self, penetration):
+        """P_nu(t) with P_nu' = p_nu: k t_+^(m+1) / (m+1), or k t for m = 0 (constant pressure)."""
+        if self.m_normal == 0.0:
+            return self.k_normal * penetration
+        return self.k_normal * np.maximum(penetration, 0.0) ** (self.m_normal + 1.0) / (self.m_normal + 1.0)
 
     def friction_bound(self, penetration):
         """p_tau(u_nu - g_a)."""

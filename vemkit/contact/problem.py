@@ -13,6 +13,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.exceptions import SceneError
 from vemkit.vem.assembly import DofMap, stiffness_matrix
 from vemkit.contact.boundary import ContactBoundary, contact_boundary
 from vemkit.contact.laws import ContactLaw
@@ -60,14 +61,18 @@ def discrete_problem(
     law: ContactLaw | None = None,
     body_force=None,
     stabilization: str = "dofi-2mu",
+    contact_quadrature: str = "nodal",
+    contact_gauss_points: int = 3,
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data.
 
     neumann: {part: traction(x, y) -> (f2_1, f2_2)}; body_force(x, y) -> (f1_1, f1_2).
+    contact_quadrature: nodal or gauss (with contact_gauss_points per edge), see vemkit.contact.boundary.
     """
     for name in list(dirichlet) + list(neumann or {}) + list(contact):
         if name not in mesh.boundary:
-            raise ValueError(f"boundary part {name!r} is not in the mesh; parts: {', '.join(sorted(mesh.boundary))}")
+            raise SceneError(f"boundary part {name!r} is not in the mesh; parts: {', '.join(sorted(mesh.boundary))}",
+                             key="boundary")
     lam, mu = lame_parameters(E, nu)
     clamped = np.unique(np.concatenate([mesh.boundary[n].ravel() for n in dirichlet])) if dirichlet else []
     dofs = DofMap.from_clamped(mesh.n_vertices, clamped)
@@ -80,7 +85,7 @@ def discrete_problem(
 
         triangles, parent = triangulate_cells(mesh)
         f += body_force_load(mesh, cell_averages(mesh, body_force, triangles, parent))
-    cb = contact_boundary(mesh, contact, dofs, gap)
+    cb = contact_boundary(mesh, contact, dofs, gap, contact_quadrature, contact_gauss_points)
     return DiscreteProblem(
         mesh, dofs, K, dofs.restrict(f), cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization
     )
@@ -116,6 +121,8 @@ def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
         law=law,
         body_force=body,
         stabilization=scene.stabilization,
+        contact_quadrature=scene.contact_quadrature,
+        contact_gauss_points=scene.contact_gauss_points,
     )
     problem.info["assembly_time"] = time.perf_counter() - t0
     return problem

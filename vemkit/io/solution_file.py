@@ -4,13 +4,12 @@ The Dataset carries the UGRID-1.0 mesh topology ``mesh2d``, the nodal displaceme
 ``u2`` (``mesh2d_nNodes``), per-cell strain, stress and shear energy density
 (``mesh2d_nFaces``), the contact boundary quantities (``contact_node``), the solver history
 (``iteration``), and global attributes: the scene as YAML, solver, iterations, wall time, version.
-``write_netcdf`` refuses NaN and writes through a temporary file, so a failed run leaves nothing.
+``write_netcdf`` refuses NaN and writes through a temporary file renamed over the target on success,
+so a failed or interrupted run leaves the target as it was.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ import xarray as xr
 
 import vemkit
 from vemkit.exceptions import ResultError
+from vemkit.io.output_files import atomic_outputs
 from vemkit.vem.projection import projected_solution, shear_energy_density, stress
 from vemkit.mesh.files import mesh_to_ugrid_dataset, read_ugrid
 
@@ -99,21 +99,16 @@ def check_finite(ds: xr.Dataset, what: str = "result") -> None:
 
 
 def write_netcdf(ds: xr.Dataset, path) -> Path:
-    """Write ``ds`` to ``path`` (netCDF4) atomically: all or nothing, never NaN."""
+    """Write ``ds`` to ``path`` (netCDF4) atomically: all or nothing, never NaN.
+
+    The file is written next to ``path`` and renamed over it only when complete
+    (:func:`vemkit.io.output_files.atomic_outputs`); a failure or a signal leaves ``path`` as it was.
+    """
     path = Path(path)
     check_finite(ds, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4")
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_outputs(path) as (temporary,):
+        ds.to_netcdf(temporary, format="NETCDF4", engine="netcdf4")
     return path
 
 

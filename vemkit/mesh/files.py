@@ -1,4 +1,14 @@
-"""Mesh files: UGRID-1.0 netCDF (round trip) and VTU (for ParaView).
+"""Mesh files: UGRID-1.0 netCDF (round trip), gmsh ``.msh`` (read) and VTU (for ParaView).
+
+``read_mesh(path)`` reads ``.nc`` (UGRID) or ``.msh`` (gmsh, versions 2 and 4 through meshio) and
+validates the mesh like a family's: a broken mesh is refused with a one-line ``MeshError`` naming
+the file and the cell or vertex (SPEC §8).
+
+gmsh: the 2D elements (linear triangles and quadrilaterals, mixed freely) are the cells, turned
+counter-clockwise if needed; nodes used by no cell (geometry points) are dropped; z must be 0.
+Line elements carry the sides: each physical line group becomes the boundary part named by its
+physical name, or by its number when it has none. Boundary edges in no group form the part
+``untagged``; a tagged line that is not a boundary edge is refused.
 
 UGRID layout (what ``mesh_to_ugrid_dataset`` builds with xugrid, and ``read_ugrid`` reads):
 
@@ -24,6 +34,10 @@ import numpy as np
 import xarray as xr
 import xugrid
 
+from vemkit.exceptions import MeshError
+from vemkit.mesh.checks import validate_mesh
+from vemkit.mesh.domain import SIDE_NAME
+from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
 
 TOPOLOGY = "mesh2d"
@@ -49,8 +63,8 @@ def mesh_to_ugrid_dataset(mesh: Mesh) -> xr.Dataset:
     ds = grid.to_dataset()
     names = list(mesh.boundary)
     for name in names:
-        if not name.isidentifier():
-            raise ValueError(f"boundary part name {name!r}: use letters, digits and underscores only")
+        if not SIDE_NAME.fullmatch(name):
+            raise ValueError(f"boundary part name {name!r}: use letters, digits, _ and - only")
         ds[f"boundary_{name}"] = xr.DataArray(
             mesh.boundary[name], dims=(f"boundary_{name}_nEdges", "two"),
             attrs={"long_name": f"boundary part {name}: edges as vertex pairs, counter-clockwise",
@@ -129,3 +143,95 @@ def _json_scalar(value):
     if isinstance(value, np.ndarray):
         return value.tolist()
     raise TypeError(f"mesh meta value {value!r} cannot be stored as JSON")
+
+
+# -- any mesh file ------------------------------------------------------------------------------
+MESH_SUFFIXES = {".msh": "gmsh", ".nc": "UGRID netCDF"}
+_GMSH_CELLS = ("triangle", "quad")
+
+
+def read_mesh(path) -> Mesh:
+    """The validated mesh in ``path`` (``.msh``: gmsh 2 or 4; ``.nc``: UGRID); MeshError otherwise."""
+    path = Path(path)
+    if path.suffix not in MESH_SUFFIXES:
+        raise MeshError(f"{path}: unknown mesh file type {path.suffix!r}; give a gmsh .msh or a UGRID .nc file",
+                        key=str(path))
+    if not path.is_file():
+        raise MeshError(f"{path}: no such mesh file", key=str(path))
+    try:
+        mesh = read_gmsh(path) if path.suffix == ".msh" else read_ugrid(path)
+    except MeshError:
+        raise
+    except Exception as error:  # a file the reader cannot parse: say which and why, in one line
+        raise MeshError(f"{path.name}: cannot be read as {MESH_SUFFIXES[path.suffix]}: {error}", key=str(path)) from None
+    try:
+        validate_mesh(mesh)
+    except MeshError as error:
+        raise MeshError(f"{path.name}: {error}", key=str(path)) from None
+    return mesh
+
+
+def read_gmsh(path) -> Mesh:
+    """The mesh of a gmsh file (not validated; see ``read_mesh``), sides from physical line groups."""
+    path = Path(path)
+    data = meshio.read(path, file_format="gmsh")
+    if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
+        v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
+        raise MeshError(f"{path.name}: node {v} (counting from 0) has z = {data.points[v, 2]:g}; give a plane mesh "
+                        "(z = 0)", key=str(path))
+    polygons, lines, line_tags = [], [], []
+    physical = data.cell_data.get("gmsh:physical", [None] * len(data.cells))
+    for block, tags in zip(data.cells, physical):
+        if block.dim == 2:
+            if block.type not in _GMSH_CELLS:
+                raise MeshError(f"{path.name}: element type {block.type!r} is not supported; give linear triangles or "
+                                "quadrilaterals", key=str(path))
+            polygons.append(np.asarray(block.data, dtype=np.int64))
+        elif block.type == "line":
+            lines.append(np.asarray(block.data, dtype=np.int64))
+            line_tags.append(np.zeros(len(block.data), np.int64) if tags is None else np.asarray(tags, np.int64))
+        elif block.dim == 1:
+            raise MeshError(f"{path.name}: element type {block.type!r} is not supported; give linear lines", key=str(path))
+    if not polygons:
+        raise MeshError(f"{path.name}: no triangles or quadrilaterals in the file", key=str(path))
+    sizes = np.concatenate([np.full(len(p), p.shape[1]) for p in polygons])
+    refs = np.concatenate([p.ravel() for p in polygons])
+    used = np.zeros(data.points.shape[0], dtype=bool)
+    used[refs] = True
+    renumber = np.cumsum(used) - 1
+    vertices = np.asarray(data.points[used, :2], dtype=np.float64)
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    mesh = Mesh(vertices, offsets, counter_clockwise(vertices, offsets, renumber[refs]), {},
+                {"file": path.name, "format": "gmsh"})
+    names = {int(tag): name for name, (tag, dim) in data.field_data.items() if int(dim) == 1}
+    if lines:
+        lines = np.concatenate(lines)
+        if not used[lines].all():
+            raise MeshError(f"{path.name}: a line element uses node {int(lines[~used[lines]][0])} (counting from 0), "
+                            "which no cell uses; tag boundary lines of the mesh only", key=str(path))
+        return mesh.with_boundary(**_gmsh_sides(mesh, renumber[lines], np.concatenate(line_tags), names, path))
+    return mesh.with_boundary(untagged=mesh.boundary_edges)
+
+
+def _gmsh_sides(mesh: Mesh, lines: np.ndarray, tags: np.ndarray, names: dict, path: Path) -> dict:
+    """Boundary parts from line elements: (a, b) oriented as the boundary edge runs in its cell."""
+    n = np.int64(mesh.n_vertices)
+    be = mesh.boundary_edges
+    forward = dict(zip((be[:, 0] * n + be[:, 1]).tolist(), range(be.shape[0])))
+    backward = dict(zip((be[:, 1] * n + be[:, 0]).tolist(), range(be.shape[0])))
+    edge = np.array([forward.get(int(a) * n + int(b), backward.get(int(a) * n + int(b), -1)) for a, b in lines])
+    if (edge < 0).any():
+        a, b = lines[edge < 0][0]
+        raise MeshError(f"{path.name}: line element ({a}, {b}) of physical group {tags[edge < 0][0]} is not a boundary "
+                        "edge of the mesh; tag boundary lines only", key=str(path))
+    parts = {}
+    for tag in dict.fromkeys(tags.tolist()):
+        name = names.get(tag, str(tag)) if tag else "untagged"
+        if not SIDE_NAME.fullmatch(name):
+            raise MeshError(f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ and -",
+                            key=str(path))
+        parts[name] = be[np.unique(edge[tags == tag])]
+    rest = np.setdiff1d(np.arange(be.shape[0]), edge)
+    if rest.size:
+        parts["untagged"] = np.concatenate([parts.get("untagged", np.zeros((0, 2), np.int64)), be[rest]])
+    return parts

@@ -19,7 +19,8 @@ from functools import cached_property
 
 import numpy as np
 
-UNIT_SQUARE_SIDES = ("left", "right", "bottom", "top")
+from vemkit.mesh.domain import UNIT_SQUARE_SIDE_LINES
+from vemkit.mesh.geometry import polygon_areas
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,10 +124,7 @@ class Mesh:
     @cached_property
     def cell_areas(self) -> np.ndarray:
         """Signed (shoelace) area of every cell: positive for counter-clockwise polygons."""
-        he = self.half_edges
-        x, y = self.vertices[:, 0], self.vertices[:, 1]
-        cross = x[he[:, 0]] * y[he[:, 1]] - x[he[:, 1]] * y[he[:, 0]]
-        return 0.5 * np.add.reduceat(cross, self.cell_offsets[:-1]) if self.n_cells else np.zeros(0)
+        return polygon_areas(self.vertices[self.cell_vertices], self.cell_offsets)
 
     @cached_property
     def cell_diameters(self) -> np.ndarray:
@@ -170,14 +168,9 @@ def tag_box_boundary(mesh: Mesh, lower=(0.0, 0.0), upper=(1.0, 1.0), tol=1e-12) 
     be = mesh.boundary_edges
     p, q = mesh.vertices[be[:, 0]], mesh.vertices[be[:, 1]]
     scale = tol * max(1.0, float(np.max(np.abs(np.subtract(upper, lower)))))
-    sides = {
-        "left": (0, lower[0]),
-        "right": (0, upper[0]),
-        "bottom": (1, lower[1]),
-        "top": (1, upper[1]),
-    }
     parts = {}
-    for name, (axis, value) in sides.items():
+    for name, (axis, fraction) in UNIT_SQUARE_SIDE_LINES.items():  # left, right, bottom, top
+        value = lower[axis] + fraction * (upper[axis] - lower[axis])
         on = (np.abs(p[:, axis] - value) <= scale) & (np.abs(q[:, axis] - value) <= scale)
         parts[name] = be[on]
     return mesh.with_boundary(**parts)

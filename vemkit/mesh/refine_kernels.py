@@ -13,6 +13,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from vemkit.mesh.geometry import turn
+
 COLLINEAR = 1e-10  # |sin| of the turning angle below which a vertex is not a corner
 SAME_POINT = 1e-9  # relative length along an edge below which two points coincide
 
@@ -24,14 +26,8 @@ def corner_flags(points, offsets, ring):
     for c in range(offsets.shape[0] - 1):
         s, n = offsets[c], offsets[c + 1] - offsets[c]
         for i in range(n):
-            p = ring[s + (i - 1 + n) % n]
-            v = ring[s + i]
-            q = ring[s + (i + 1) % n]
-            bx, by = points[v, 0] - points[p, 0], points[v, 1] - points[p, 1]
-            ax, ay = points[q, 0] - points[v, 0], points[q, 1] - points[v, 1]
-            cross = bx * ay - by * ax
-            scale = np.sqrt((bx * bx + by * by) * (ax * ax + ay * ay))
-            out[s + i] = not (abs(cross) <= COLLINEAR * scale and bx * ax + by * ay > 0.0)
+            cross, scale, dot = turn(points, ring[s + (i - 1 + n) % n], ring[s + i], ring[s + (i + 1) % n])
+            out[s + i] = not (abs(cross) <= COLLINEAR * scale and dot > 0.0)
     return out
 
 
@@ -41,6 +37,31 @@ def _first_corner(corner, s, n):
         if corner[s + i]:
             return i
     return 0
+
+
+@numba.njit(cache=True)
+def _run(corner, s, n, start):
+    """Slots in the geometric edge that starts at corner slot ``start``: start, start + 1, … up to
+    (not including) the next corner."""
+    run = 1
+    while run < n and not corner[s + (start + run) % n]:
+        run += 1
+    return run
+
+
+@numba.njit(cache=True)
+def _segment(points, ring, s, n, k):
+    """Length of the polygon edge from slot k to slot k + 1 (cyclic)."""
+    u, v = ring[s + k % n], ring[s + (k + 1) % n]
+    return np.hypot(points[v, 0] - points[u, 0], points[v, 1] - points[u, 1])
+
+
+@numba.njit(cache=True)
+def _run_length(points, ring, s, n, start, run):
+    total = 0.0
+    for j in range(run):
+        total += _segment(points, ring, s, n, start + j)
+    return total
 
 
 @numba.njit(cache=True)
@@ -57,21 +78,16 @@ def midpoint_requests(points, offsets, ring, corner, cells):
         i = 0
         while i < n:
             start = (first + i) % n
-            run = 1  # slots of this geometric edge: start, start + 1, ... until the next corner
-            while run < n and not corner[s + (start + run) % n]:
-                run += 1
-            total = 0.0
-            for j in range(run):
-                u, v = ring[s + (start + j) % n], ring[s + (start + j + 1) % n]
-                total += np.hypot(points[v, 0] - points[u, 0], points[v, 1] - points[u, 1])
+            run = _run(corner, s, n, start)
+            total = _run_length(points, ring, s, n, start, run)
             half, walked = 0.5 * total, 0.0
             for j in range(run):
-                u, v = ring[s + (start + j) % n], ring[s + (start + j + 1) % n]
-                length = np.hypot(points[v, 0] - points[u, 0], points[v, 1] - points[u, 1])
+                length = _segment(points, ring, s, n, start + j)
                 if abs(walked - half) <= SAME_POINT * total:
                     break  # an old vertex at the midpoint
                 if walked + length > half + SAME_POINT * total:
-                    a_out[count], b_out[count], t_out[count] = u, v, (half - walked) / length
+                    a_out[count], b_out[count] = ring[s + (start + j) % n], ring[s + (start + j + 1) % n]
+                    t_out[count] = (half - walked) / length
                     count += 1
                     break
                 walked += length
@@ -174,17 +190,11 @@ def children(points, offsets, ring, corner, cells, centres):
         i = 0
         while i < n:
             start = (first + i) % n
-            run = 1
-            while run < n and not corner[s + (start + run) % n]:
-                run += 1
-            total = 0.0
-            for j in range(run):
-                u, v = ring[s + (start + j) % n], ring[s + (start + j + 1) % n]
-                total += np.hypot(points[v, 0] - points[u, 0], points[v, 1] - points[u, 1])
+            run = _run(corner, s, n, start)
+            total = _run_length(points, ring, s, n, start, run)
             best, walked, best_gap = 1, 0.0, np.inf
             for j in range(1, run):  # the inner vertex nearest half the edge length
-                u, v = ring[s + (start + j - 1) % n], ring[s + (start + j) % n]
-                walked += np.hypot(points[v, 0] - points[u, 0], points[v, 1] - points[u, 1])
+                walked += _segment(points, ring, s, n, start + j - 1)
                 if abs(walked - 0.5 * total) < best_gap:
                     best, best_gap = j, abs(walked - 0.5 * total)
             corners.append(start)

@@ -4,12 +4,21 @@ BLAS threads: vemkit's work is sparse (CSR products, AMG cycles, Numba kernels w
 threads), and multi-threaded dense BLAS only spins and competes with them (CG was 4x slower on 2
 cores). So :func:`solve` runs the solver with BLAS limited to one thread (threadpoolctl), unless
 the user has set ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``; nothing is changed at import.
+
+Floating-point failures (overflow, 0/0, division by zero) inside the solve raise instead of
+producing inf/NaN with a RuntimeWarning; :func:`solve` reports them as a ConvergenceError.
 """
 
 from __future__ import annotations
 
 import os
-from contextlib import nullcontext
+import time
+import warnings
+from contextlib import contextmanager, nullcontext
+
+import numpy as np
+
+from vemkit.exceptions import ConvergenceError, SceneError, TimeBudgetExceeded
 
 from vemkit.solvers.ssn import solve_ssn
 from vemkit.solvers.uzawa import solve_uzawa
@@ -26,18 +35,58 @@ def single_threaded_blas():
     return threadpool_limits(limits=1, user_api="blas")
 
 
+def _budgeted(progress, budget, method: str):
+    """``progress`` that raises TimeBudgetExceeded once ``budget`` seconds have passed."""
+    if budget is None:
+        return progress
+    start = time.perf_counter()
+
+    def watched(iteration, record=None):
+        if progress is not None:
+            progress(iteration, record)
+        elapsed = time.perf_counter() - start
+        if elapsed > budget:
+            raise TimeBudgetExceeded(
+                f"{method} ran past solver.time_budget = {budget:g} s ({elapsed:.1f} s after "
+                f"{iteration} iterations); raise solver.time_budget or use a coarser mesh",
+                solver=method, iterations=iteration)
+    return watched
+
+
+@contextmanager
+def floating_point_errors_raise():
+    """Overflow, invalid operations and division by zero raise (numpy), and so do RuntimeWarnings:
+    a solve never ends with warnings on stderr next to a result."""
+    with np.errstate(over="raise", invalid="raise", divide="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        yield
+
+
 def solve(problem, solver_options: dict, progress=None):
-    """Run the configured contact solver; raises ConvergenceError on failure."""
+    """Run the configured contact solver; raises ConvergenceError on failure.
+
+    ``solver_options["time_budget"]`` (seconds, optional): TimeBudgetExceeded once the solve has
+    run longer (checked after every iteration). A floating-point overflow, invalid operation or
+    division by zero inside the solve is a ConvergenceError (reason ``diverged``), never a result.
+    """
     opts = dict(solver_options)
     method = opts.pop("method")
+    progress = _budgeted(progress, opts.pop("time_budget", None), method)
     common = dict(linear=opts.pop("linear", "auto"), tol=opts.pop("tol"), progress=progress)
     if method == "uzawa":
         uzawa_keys = ("rho", "eps_u", "eps_lambda", "stop", "max_iterations")
         kwargs = {k: opts[k] for k in uzawa_keys if opts.get(k) is not None}
-        with single_threaded_blas():
-            return solve_uzawa(problem, **common, **kwargs)
-    if method == "ssn":
+        run = solve_uzawa
+    elif method == "ssn":
         kwargs = {"max_iterations": opts["max_iterations"]} if opts.get("max_iterations") else {}
-        with single_threaded_blas():
-            return solve_ssn(problem, **common, **kwargs)
-    raise ValueError(f"solver.method = {method!r} is unknown; use ssn or uzawa")
+        run = solve_ssn
+    else:
+        raise SceneError(f"solver.method = {method!r} is unknown; use ssn or uzawa", key="solver.method")
+    try:
+        with single_threaded_blas(), floating_point_errors_raise():
+            return run(problem, **common, **kwargs)
+    except (FloatingPointError, RuntimeWarning, ZeroDivisionError, OverflowError) as error:
+        raise ConvergenceError(
+            f"{method}: floating-point failure during the solve ({error}); the scene's numbers are "
+            "too large or too small for double precision: rescale the units (E, k, tractions)",
+            solver=method, reason="diverged") from error

@@ -13,7 +13,7 @@ import numpy as np
 import pyamg
 import scipy.sparse.linalg as spla
 
-from vemkit.exceptions import LinearSolveError
+from vemkit.exceptions import InputError, LinearSolveError, SceneError
 
 DIRECT_LIMIT = 20_000  # "auto" picks the direct solver below this many unknowns (measured crossover)
 
@@ -67,7 +67,8 @@ class AMGSolver:
         if info != 0 or not np.all(np.isfinite(x)):
             raise LinearSolveError(
                 f"AMG-CG stopped after {count[0]} iterations at relative residual {self.residual:.2e} "
-                f"(asked {tol:.1e}); try solver.linear=direct"
+                f"(asked {tol:.1e}); try solver.linear=direct",
+                solver="amg", iterations=count[0],
             )
         return x
 
@@ -90,7 +91,10 @@ class DirectSolver:
                 A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
             )
         except RuntimeError as exc:  # exactly singular
-            raise LinearSolveError(f"the stiffness matrix is singular ({exc}); is the body held (Dirichlet part)?") from None
+            raise LinearSolveError(
+                f"the stiffness matrix is singular ({exc}); is the body held (Dirichlet part)?",
+                solver="direct", iterations=0,
+            ) from None
 
     def solve(self, b, x0=None, tol=None, A=None):
         lu = self._lu if A is None or A is self.A else self._factor(A)
@@ -100,7 +104,10 @@ class DirectSolver:
         self.residual = float(np.linalg.norm(b - Aused @ x) / bnorm) if bnorm else 0.0
         self.iterations = 1
         if not np.all(np.isfinite(x)):
-            raise LinearSolveError("the direct solve produced non-finite values; the matrix is singular or badly scaled")
+            raise LinearSolveError(
+                "the direct solve produced non-finite values; the matrix is singular or badly scaled",
+                solver="direct", iterations=1,
+            )
         return x
 
 
@@ -112,7 +119,7 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
     """
     if isinstance(method, (AMGSolver, DirectSolver)):
         if method.A.shape != A.shape or method.A.nnz != A.nnz:
-            raise ValueError("the prebuilt linear solver was made for another stiffness matrix")
+            raise InputError("the prebuilt linear solver was made for another stiffness matrix", key="linear")
         return method
     if method == "auto":
         method = "direct" if A.shape[0] <= DIRECT_LIMIT else "amg"
@@ -120,4 +127,4 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
         return AMGSolver(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter)
     if method == "direct":
         return DirectSolver(A)
-    raise ValueError(f"solver.linear = {method!r} is unknown; use amg, direct or auto")
+    raise SceneError(f"solver.linear = {method!r} is unknown; use amg, direct or auto", key="solver.linear")

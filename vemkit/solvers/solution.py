@@ -50,14 +50,15 @@ def young_modulus(problem) -> float:
 
 
 def contact_force_vector(problem, u, multiplier):
-    """Free-dof vector sum_c w_c [p_nu(u_nu,c - g_c) nu_c + p_tau(u_nu,c - g_c) lambda_c tau_c]."""
-    cb, law = problem.contact, problem.law
+    """Free-dof vector sum_c w_c [p_nu(u_nu,c - g_c) nu_c + p_tau(u_nu,c - g_c) lambda_c tau_c].
+
+    With ``contact_quadrature: gauss`` the normal-compliance part is integrated with Gauss points on
+    each Gamma_C edge (vemkit.contact.boundary); the friction part stays nodal.
+    """
+    cb = problem.contact
     if cb.size == 0:
         return np.zeros_like(u)
-    penetration = cb.normal_displacement(u) - cb.gap
-    normal = cb.weight * law.normal_pressure(penetration)
-    tangential = cb.weight * law.friction_bound(penetration) * np.asarray(multiplier, dtype=float)
-    return cb.scatter(normal, tangential, u.size)
+    return cb.contact_force(u, problem.law, multiplier)
 
 
 def residual_scale(load_norm: float, contact_force_norm: float) -> float:

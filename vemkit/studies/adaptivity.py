@@ -13,19 +13,20 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import xarray as xr
 
 from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import InputError
+from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import contact_state
+from vemkit.studies.convergence import RECORD_KEYS
 from vemkit.vem.estimator import dorfler_marking, error_indicators
 from vemkit.vem.load import cell_averages
 
-HISTORY_KEYS = ("n_dofs", "n_cells", "estimate", "true_error", "effectivity", "marked", "wall_time",
-                "solve_time", "iterations")
 
 
 @dataclass(frozen=True)
@@ -52,7 +53,7 @@ class AdaptiveRun:
     problem: object  # the last DiscreteProblem
     solution: object  # its ContactSolution
     indicators: dict  # error_indicators of the last solution
-    history: list = field(default_factory=list)  # one dict per step (HISTORY_KEYS)
+    history: list = field(default_factory=list)  # one dict per step (the keys of HISTORY_ATTRS)
     reason: str = ""  # why the loop stopped: target, max_dofs, max_steps
 
 
@@ -126,3 +127,34 @@ def _stop_reason(estimate: float, n_dofs: int, step: int, settings: AdaptivitySe
     if step + 1 >= settings.max_steps:
         return "max_steps"
     return None
+
+
+HISTORY_ATTRS = {  # name: (long name, units); n_dofs, n_cells, iterations as in the convergence records
+    **{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
+    "estimate": ("relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
+    "true_error": ("relative H1-seminorm error against the exact or reference solution", "1"),
+    "effectivity": ("estimate / true_error", "1"),
+    "marked": ("cells marked for refinement (0: the last step)", "1"),
+    "wall_time": ("wall time of the step: assembly, solve, estimate, refinement", "s"),
+    "solve_time": ("assembly and contact solve", "s"),
+}
+
+
+def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
+    """The final solution file (SPEC §6) plus ``error_indicator`` per face and the per-step history
+    on the ``adapt_step`` dimension (SPEC §9). Entries a step does not have are not stored."""
+    ds = solution_dataset(run.problem, run.solution, scene_yaml=scene.to_yaml(), extra_attrs=extra_attrs)
+    ds["error_indicator"] = ("mesh2d_nFaces", run.indicators["indicator"],
+                             {"long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
+                              "mesh": "mesh2d", "location": "face", "units": "sqrt(daN mm)"})
+    steps = len(run.history)
+    for name, (long_name, units) in HISTORY_ATTRS.items():
+        values = [record.get(name, 0 if name == "marked" else None) for record in run.history]
+        if any(v is None for v in values):
+            continue
+        dtype = np.int64 if name in ("n_dofs", "n_cells", "marked", "iterations") else float
+        ds[f"adapt_{name}"] = ("adapt_step", np.asarray(values, dtype=dtype), {"long_name": long_name, "units": units})
+    ds = ds.assign_coords(adapt_step=("adapt_step", np.arange(steps), {"long_name": "adaptive step"}))
+    ds.attrs.update({"adapt_stop_reason": run.reason, "adapt_steps": steps,
+                     "adapt_estimate": float(run.history[-1]["estimate"])})
+    return ds

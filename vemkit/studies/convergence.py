@@ -41,11 +41,14 @@ RECORD_KEYS = {
     "error_h1": ("||Pi_1(u_h - u_ref)||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm, broken, SPEC 5)", "1"),
     "error_h1_semi": ("|Pi_1(u_h - u_ref)|_H1 / |Pi_1 u_ref|_H1 (H1 seminorm, broken, SPEC 5)", "1"),
     "error_l2": ("||Pi_1(u_h - u_ref)||_L2 / ||Pi_1 u_ref||_L2", "1"),
+    "error_paper": ("|Pi_1^ref(I_ref u_h - u_ref)|_H1 / |Pi_1^ref u_ref|_H1: the paper's measure, I_ref the "
+                    "interpolant at the reference vertices (bilinear on squares, Wachspress / mean value "
+                    "coordinates elsewhere), H1 seminorm broken over the reference cells (SPEC 5)", "1"),
     "iterations": ("nonlinear contact solver iterations", "1"),
     "wall_time": ("contact solver wall time (with the linear solver set-up)", "s"),
     "assembly_time": ("assembly wall time of the discrete problem", "s"),
 }
-_VARIABLES = ("error_h1", "error_h1_semi", "error_l2", "n_dofs", "n_cells", "iterations", "wall_time",
+_VARIABLES = ("error_h1", "error_h1_semi", "error_l2", "error_paper", "n_dofs", "n_cells", "iterations", "wall_time",
               "assembly_time", "h_max")
 
 
@@ -134,20 +137,29 @@ class ReferenceSolution:
         self.path = str(path)
         self.mesh, self.dataset = solution if solution is not None else read_solution(path)
         self.projected = _cached_projection(_projected(self.mesh, self.dataset))
+        self.displacement = _displacement(self.dataset)
+        self.areas = self.mesh.cell_areas
         self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh)
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
 
     def errors(self, mesh, dataset) -> dict:
-        from vemkit.vem.norms import projection_error
+        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), SPEC 5."""
+        from vemkit.vem.norms import paper_error, projection_error
 
-        return projection_error(mesh, _projected(mesh, dataset), self.mesh, self.projected, self.quadrature)
+        out = projection_error(mesh, _projected(mesh, dataset), self.mesh, self.projected, self.quadrature)
+        out["paper"] = paper_error(mesh, _displacement(dataset), self.mesh, self.displacement,
+                                   self.projected, self.areas)
+        return out
+
+
+def _displacement(ds) -> np.ndarray:
+    return np.stack([ds["u1"].values, ds["u2"].values], axis=1)
 
 
 def _projected(mesh, ds):
     from vemkit.vem.projection import projected_solution
 
-    u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
-    return projected_solution(mesh, u)
+    return projected_solution(mesh, _displacement(ds))
 
 
 def _same_mesh(a, b) -> bool:
@@ -170,6 +182,7 @@ def run_record(family: str, stabilization: str, n, mesh, ds, reference: Referenc
         "error_h1": err["h1"],
         "error_h1_semi": err["h1_semi"],
         "error_l2": err["l2"],
+        "error_paper": err["paper"],
         "iterations": int(ds.attrs["iterations"]),
         "wall_time": float(ds.attrs.get("wall_time", 0.0)),
         "assembly_time": float(ds.attrs.get("assembly_time", 0.0)),
@@ -209,6 +222,45 @@ def error_records(family: str, stabilization: str, runs, reference_path) -> list
     return family_error_records(family, [(stabilization, n, p) for n, p in runs], {stabilization: reference_path})
 
 
+def solved_error_records(family: str, spec: dict, stabilization: str, meshes, reference_mesh, scene_path,
+                         overrides=()) -> list[dict]:
+    """Error records of a variant of the workflow's scene, solved here rather than by the workflow's
+    solve rules: the scene with ``overrides`` and ``stabilization`` on every ``meshes`` = [(n, Mesh)]
+    of ``family`` (``spec``: its ``build_mesh`` arguments) and on ``reference_mesh`` = (n, Mesh), the
+    2^-8 square reference. Table 1 uses it for Gauss quadrature on Gamma_C."""
+    from vemkit.studies.scene_solve import solve_scene
+
+    def solve(mesh_spec, n, mesh):
+        scene = study_scene(scene_path, overrides, mesh_spec["family"], mesh_spec.get("options") or {}, n,
+                            stabilization)
+        problem, _, ds = solve_scene(scene, mesh=mesh)
+        return problem.mesh, ds
+
+    ref_n, ref_mesh = reference_mesh
+    reference = ReferenceSolution("<solved here>", solution=solve({"family": "square"}, ref_n, ref_mesh))
+    return [run_record(family, stabilization, n, *solve(spec, n, mesh), reference) for n, mesh in meshes]
+
+
+def with_paper_variant(ds: xr.Dataset, records, suffix: str, comment: str) -> xr.Dataset:
+    """``ds`` with ``error_paper_<suffix>`` and ``order_paper_<suffix>``: the paper's measure of
+    ``records`` (a variant of the discretization, e.g. ``gauss``) on the grid of ``ds``; NaN where
+    the variant has no run (fill values in the file)."""
+    shape = ds["error_h1"].shape
+    errors = np.full(shape, np.nan)
+    fams, stabs = [str(f) for f in ds["family"].values], [str(s) for s in ds["stabilization"].values]
+    ns = [int(n) for n in ds["n"].values]
+    for r in records:
+        if r["family"] in fams and r["stabilization"] in stabs and int(r["n"]) in ns:
+            errors[fams.index(r["family"]), stabs.index(r["stabilization"]), ns.index(int(r["n"]))] = r["error_paper"]
+    orders = np.apply_along_axis(lambda e: convergence_orders(ds["h"].values, e), -1, errors)
+    dims = ("family", "stabilization", "h")
+    return ds.assign({
+        f"error_paper_{suffix}": (dims, errors, {"long_name": f"error_paper with {comment}", "units": "1",
+                                                 "comment": "undefined where the variant was not run"}),
+        f"order_paper_{suffix}": (dims, orders, {"long_name": f"observed order of error_paper_{suffix}", "units": "1"}),
+    })
+
+
 def write_records(records, path) -> Path:
     """Records as JSON (a small intermediate file of the workflow), written atomically."""
     path = Path(path)
@@ -227,15 +279,7 @@ def read_records(paths) -> list[dict]:
 
 
 # -- the dataset ----------------------------------------------------------------------------------
-def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, families=None,
-                        stabilizations=None, title: str = "vemkit convergence study",
-                        commit: str | None = None) -> xr.Dataset:
-    """The convergence Dataset (dims ``family``, ``stabilization``, ``h``) of error records.
-
-    ``families`` / ``stabilizations`` fix the order of the labels (default: first appearance).
-    ``h`` runs from coarse to fine, as in the paper's Table 1. See the module docstring for how
-    undefined entries are marked.
-    """
+def _checked(records) -> list:
     records = list(records)
     if not records:
         raise ValueError("no error records: nothing to gather")
@@ -243,14 +287,15 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
         missing = [k for k in ("family", "stabilization", "n", "error_h1", "error_h1_semi") if k not in r]
         if missing:
             raise ValueError(f"error record {r!r} lacks {', '.join(missing)}")
-        for key in ("error_h1", "error_h1_semi"):
-            if not (np.isfinite(r[key]) and r[key] >= 0):
+        for key in ("error_h1", "error_h1_semi", "error_paper"):
+            if key in r and not (np.isfinite(r[key]) and r[key] >= 0):
                 raise ValueError(f"error record {r['family']}/{r['stabilization']}/n{r['n']}: {key} = {r[key]}"
                                  " is not a finite non-negative number")
-    fams = list(families) if families is not None else list(dict.fromkeys(r["family"] for r in records))
-    stabs = list(stabilizations) if stabilizations is not None else \
-        list(dict.fromkeys(r["stabilization"] for r in records))
-    ns = sorted({int(r["n"]) for r in records})
+    return records
+
+
+def _gridded(records, fams, stabs, ns):
+    """({variable: (family, stabilization, h) array, NaN where missing}, the mask of existing runs)."""
     shape = (len(fams), len(stabs), len(ns))
     data = {k: np.full(shape, np.nan) for k in _VARIABLES}
     seen = np.zeros(shape, dtype=bool)
@@ -266,32 +311,36 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
         for k in _VARIABLES:
             if k in r:
                 data[k][idx] = float(r[k])
-    h = 1.0 / np.asarray(ns, dtype=float)  # n increasing: h runs from coarse to fine
-    order = np.full(shape, np.nan)
-    order_semi = np.full(shape, np.nan)
-    for i in range(len(fams)):
-        for j in range(len(stabs)):
-            order[i, j] = convergence_orders(h, data["error_h1"][i, j])
-            order_semi[i, j] = convergence_orders(h, data["error_h1_semi"][i, j])
+    return data, seen
+
+
+def _orders(h, errors) -> np.ndarray:
+    """convergence_orders of every (family, stabilization) row of a (family, stabilization, h) array."""
+    out = np.full(errors.shape, np.nan)
+    for i in range(errors.shape[0]):
+        for j in range(errors.shape[1]):
+            out[i, j] = convergence_orders(h, errors[i, j])
+    return out
+
+
+_UNDEFINED_FIRST = "undefined at the coarsest h (an order needs two levels): _FillValue in the file, NaN in memory"
+_ORDERS = {  # order variable: (error variable, long name)
+    "order": ("error_h1", "observed convergence order of error_h1: log(e_prev/e) / log(h_prev/h)"),
+    "order_h1_semi": ("error_h1_semi", "observed convergence order of error_h1_semi"),
+    "order_paper": ("error_paper", "observed convergence order of error_paper (the paper's Table 1 order)"),
+}
+
+
+def _add_variables(ds, data, seen, h, has_paper) -> None:
     dims = ("family", "stabilization", "h")
-    ds = xr.Dataset(
-        coords={
-            "family": ("family", np.array(fams, dtype=str), {"long_name": "mesh family label"}),
-            "stabilization": ("stabilization", np.array(stabs, dtype=str),
-                              {"long_name": "stabilization alpha_K of the dofi-dofi form (SPEC 3)"}),
-            "h": ("h", h, {"long_name": "nominal mesh size h = 1/n", "units": "mm"}),
-            "n": ("h", np.asarray(ns, dtype=np.int64), {"long_name": "cells per side n = 1/h"}),
-        }
-    )
-    for key in ("error_h1", "error_h1_semi", "error_l2", "wall_time", "assembly_time", "h_max"):
-        long_name, units = RECORD_KEYS[key]
-        ds[key] = (dims, data[key], {"long_name": long_name, "units": units})
-    undefined_first = "undefined at the coarsest h (an order needs two levels): _FillValue in the file, NaN in memory"
-    ds["order"] = (dims, order, {
-        "long_name": "observed convergence order of error_h1: log(e_prev/e) / log(h_prev/h)",
-        "units": "1", "comment": undefined_first})
-    ds["order_h1_semi"] = (dims, order_semi, {
-        "long_name": "observed convergence order of error_h1_semi", "units": "1", "comment": undefined_first})
+    for key in ("error_h1", "error_h1_semi", "error_l2", "error_paper", "wall_time", "assembly_time", "h_max"):
+        if key != "error_paper" or has_paper:
+            long_name, units = RECORD_KEYS[key]
+            ds[key] = (dims, data[key], {"long_name": long_name, "units": units})
+    for name, (error, long_name) in _ORDERS.items():
+        if error != "error_paper" or has_paper:
+            ds[name] = (dims, _orders(h, data[error]), {"long_name": long_name, "units": "1",
+                                                        "comment": _UNDEFINED_FIRST})
     for key in ("n_dofs", "n_cells", "iterations"):
         long_name, units = RECORD_KEYS[key]
         values = np.where(np.isnan(data[key]), INT_FILL, data[key]).astype(np.int64)
@@ -299,15 +348,21 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
     ds["defined"] = (dims, seen.astype(np.int8),
                      {"long_name": "1 where the run exists, 0 where the family has no mesh at this h",
                       "flag_values": np.array([0, 1], np.int8), "flag_meanings": "missing present"})
-    ds["order_defined"] = (dims, np.isfinite(order).astype(np.int8),
+    ds["order_defined"] = (dims, np.isfinite(ds["order"].values).astype(np.int8),
                            {"long_name": "1 where order is defined", "flag_values": np.array([0, 1], np.int8),
                             "flag_meanings": "undefined defined"})
+
+
+def _provenance(title, scene_yaml, parameters, commit) -> dict:
     versions = package_versions()
-    ds.attrs.update({
+    return {
         "title": title,
         "Conventions": "CF-1.8",
         "error_measure": "relative errors of Pi_1 u_h against Pi_1 u_ref in the broken norms over the "
-                         "reference mesh (SPEC 5); error_h1: full H1 norm, error_h1_semi: H1 seminorm",
+                         "reference mesh (SPEC 5); error_h1: full H1 norm, error_h1_semi: H1 seminorm; "
+                         "error_paper: the paper's own measure |Pi_1^ref(I_ref u_h - u_ref)|_H1 / "
+                         "|Pi_1^ref u_ref|_H1 (interpolation at the reference vertices, projection on the "
+                         "reference mesh, H1 seminorm), the one its Table 1 prints",
         "missing_values": "order is undefined at the coarsest h; in the file, a float variable with "
                           f"undefined entries has _FillValue = {FLOAT_FILL} there, an integer one {INT_FILL}; "
                           "no NaN is stored; see the variables defined and order_defined",
@@ -315,9 +370,35 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
         "parameters": json.dumps(parameters or {}, sort_keys=True, default=str),
         "package_versions": json.dumps(versions, sort_keys=True),
         "git_commit": commit if commit is not None else git_commit(),
+        **{f"version_{name}": version for name, version in versions.items()},
+    }
+
+
+def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, families=None,
+                        stabilizations=None, title: str = "vemkit convergence study",
+                        commit: str | None = None) -> xr.Dataset:
+    """The convergence Dataset (dims ``family``, ``stabilization``, ``h``) of error records.
+
+    ``families`` / ``stabilizations`` fix the order of the labels (default: first appearance).
+    ``h`` runs from coarse to fine, as in the paper's Table 1. See the module docstring for how
+    undefined entries are marked.
+    """
+    records = _checked(records)
+    fams = list(families) if families is not None else list(dict.fromkeys(r["family"] for r in records))
+    stabs = list(stabilizations) if stabilizations is not None else \
+        list(dict.fromkeys(r["stabilization"] for r in records))
+    ns = sorted({int(r["n"]) for r in records})
+    data, seen = _gridded(records, fams, stabs, ns)
+    h = 1.0 / np.asarray(ns, dtype=float)  # n increasing: h runs from coarse to fine
+    ds = xr.Dataset(coords={
+        "family": ("family", np.array(fams, dtype=str), {"long_name": "mesh family label"}),
+        "stabilization": ("stabilization", np.array(stabs, dtype=str),
+                          {"long_name": "stabilization alpha_K of the dofi-dofi form (SPEC 3)"}),
+        "h": ("h", h, {"long_name": "nominal mesh size h = 1/n", "units": "mm"}),
+        "n": ("h", np.asarray(ns, dtype=np.int64), {"long_name": "cells per side n = 1/h"}),
     })
-    for name, version in versions.items():
-        ds.attrs[f"version_{name}"] = version
+    _add_variables(ds, data, seen, h, has_paper=any("error_paper" in r for r in records))
+    ds.attrs.update(_provenance(title, scene_yaml, parameters, commit))
     return ds
 
 

@@ -7,8 +7,17 @@ PAPER_TABLE1 = {
     "h": (2.0**-2, 2.0**-3, 2.0**-4, 2.0**-5, 2.0**-6),
     "error": (1.9114e-1, 1.0309e-1, 5.4352e-2, 2.8007e-2, 1.3828e-2),
     "order": (None, 0.89067, 0.92354, 0.95656, 1.0182),
-    "norm": "h1",
-    "source": "Table 1 of the paper (SPEC 5): relative H1 error on square meshes, reference h = 2^-8",
+    # the measure the paper's Table 1 prints (vemkit.vem.norms.paper_error, variable error_paper):
+    # |Pi_1^ref(I_ref u_h - u_ref)|_H1 / |Pi_1^ref u_ref|_H1, I_ref the bilinear interpolant at the
+    # vertices of the h = 2^-8 reference, H1 seminorm
+    "norm": "paper",
+    "source": "Table 1 of the paper (SPEC 5): relative H1-seminorm error of the bilinear interpolant at the "
+              "reference vertices, projected on the reference mesh, square meshes, reference h = 2^-8",
+    # h = 2^-5 is printed 2.80070e-2, one digit more than the others, and its sixth digit is not
+    # what the paper computed: the paper's order 0.95656 with its 5.4352e-2 at h = 2^-4 (both
+    # rounded) puts the error in [2.80064e-2, 2.80071e-2], and the paper's measure with Gauss
+    # quadrature on Gamma_C gives 5.43516e-2 and 2.80065e-2 (order 0.95656; SPEC 5). The
+    # comparison uses 2.8007e-2, five digits like the other levels.
 }
 
 

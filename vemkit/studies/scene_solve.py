@@ -1,17 +1,70 @@
-"""One solve, from a validated scene to a result Dataset: scene -> mesh -> problem -> solver -> Dataset."""
+"""One solve, from a validated scene to a result Dataset: scene -> mesh -> problem -> solver -> Dataset.
+
+Before any mesh is built, :func:`vemkit.config.limits.check_scene_resources` predicts cells, DOFs
+and peak memory from the scene alone and refuses a request beyond the limits. With ``verify=True`` a solve counts only if the independent
+residual check (:func:`vemkit.solvers.verification.verify_solution`) meets the scene's accuracy
+:func:`check_tolerance`; otherwise it raises VerificationError.
+"""
 
 from __future__ import annotations
 
 from vemkit.contact.problem import scene_problem
+from vemkit.exceptions import MeshError, ResultError, VerificationError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.mesh import Mesh
-from vemkit.solvers.dispatch import solve
+from vemkit.solvers.dispatch import floating_point_errors_raise, solve
+from vemkit.solvers.verification import CHECK_KEYS, verify_solution
+
+#: the independent check must meet min(max(CHECK_FACTOR * tol, CHECK_FLOOR), CHECK_CAP). Measured
+#: (paper scene, n = 2 ... 64, square/voronoi/triangle/hanging): ssn's check is <= 1e-13 at tol <=
+#: 1e-6 and ~1e-4 at tol = 1e-2; Uzawa's (stop=either) at most 6.2 tol (1.4e-8 at n = 64 triangles,
+#: tol = 1e-10). The floor is the
+#: studies' verification.DEFAULT_CHECK_TOL (rounding at large n and stiff contact), the cap keeps
+#: a loose tol from accepting a residual above 1e-3.
+CHECK_FACTOR = 1e3
+CHECK_FLOOR = 1e-6
+CHECK_CAP = 1e-3
 
 
-def solve_scene(scene, progress=None, mesh: Mesh | None = None):
-    """Solve a scene; returns (problem, solution, dataset)."""
+def check_tolerance(solver_options: dict) -> float:
+    """The accuracy the independent check must meet: min(max(CHECK_FACTOR * tol, CHECK_FLOOR),
+    CHECK_CAP), tol the loosest of solver.tol, eps_u and eps_lambda (README "Input rules and limits")."""
+    loosest = max(float(solver_options[k]) for k in ("tol", "eps_u", "eps_lambda")
+                  if solver_options.get(k) is not None)
+    return min(max(CHECK_FACTOR * loosest, CHECK_FLOOR), CHECK_CAP)
+
+
+def _verified(problem, solution, solver_options) -> dict:
+    tol = check_tolerance(solver_options)
+    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
+    if not checks["passed"]:
+        worst = max(CHECK_KEYS, key=lambda k: checks[k])
+        raise VerificationError(
+            f"{solution.method} stopped after {solution.iterations} iterations but the independent "
+            f"check fails: {worst} = {checks[worst]:.1e} > {tol:.1e} (from solver.tol); try "
+            "solver.method=ssn or a smaller solver.tol", solver=solution.method,
+            iterations=solution.iterations)
+    return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
+
+
+def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False):
+    """Solve a scene; returns (problem, solution, dataset).
+
+    ``verify``: raise VerificationError unless the independent check meets
+    :func:`check_tolerance`; the dataset then records ``check_worst`` and ``check_tolerance``.
+    """
     problem = scene_problem(scene, mesh)
+    if problem.mesh.n_cells == 0 or problem.n_dofs == 0:
+        raise MeshError(f"the mesh has {problem.mesh.n_cells} cells and {problem.n_dofs} free DOFs; "
+                        "nothing to solve: check discretization.mesh", key="discretization.mesh")
     solution = solve(problem, scene.solver_options, progress=progress)
     attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
-    ds = solution_dataset(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
+    if verify:
+        attrs.update(_verified(problem, solution, scene.solver_options))
+    try:
+        with floating_point_errors_raise():
+            ds = solution_dataset(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
+    except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
+        raise ResultError(f"the stresses of the solution overflow double precision ({error}); "
+                          "rescale the units of the scene (E, k, tractions)") from None
     return problem, solution, ds

@@ -38,7 +38,7 @@ from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outc
 
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import package_versions
-from vemkit.studies.sweep_dimensions import DIMENSION_NAMES, dimension_name
+from vemkit.studies.sweep_dimensions import dimension_name
 
 SHARED_PREFIXES = ("contact.", "solver.")  # keys that leave K, the load and the mesh unchanged
 QUANTITIES = {  # name: (long name, units)
@@ -46,7 +46,8 @@ QUANTITIES = {  # name: (long name, units)
     "contact_length": ("length of Gamma_C where u_nu - g_a > 0 (nodal weights)", "mm"),
     "stick_length": ("length of Gamma_C in contact and sticking (contact_state)", "mm"),
     "slip_length": ("length of Gamma_C in contact and slipping (contact_state)", "mm"),
-    "normal_force": ("resultant normal contact force sum_c w_c p_nu(u_nu - g_a)", "daN/mm"),
+    "normal_force": ("resultant normal contact force: the integral of p_nu(u_nu - g_a) over Gamma_C with the "
+                     "scene's contact quadrature (nodal: sum_c w_c p_nu)", "daN/mm"),
     "tangential_force": ("resultant tangential contact stress sum_c w_c sigma_tau (all Gamma_C vertices)", "daN/mm"),
     "residual": ("worst independent check of the discrete conditions (vemkit.studies.robustness)", "1"),
 }
@@ -99,6 +100,14 @@ class _Point:
         self.quantities, self.profiles = quantities or {}, profiles
 
 
+def _normal_force(problem, u, state) -> float:
+    """The resultant normal force with the problem's contact quadrature: sum_c F_c . nu_c."""
+    cb = problem.contact
+    if cb.quadrature == "nodal":
+        return float(np.sum(cb.weight * state.normal_pressure))
+    return float(np.sum(cb.normal_displacement(cb.normal_force(u, problem.law))))
+
+
 def point_quantities(problem, outcome: Outcome):
     """(quantities, profiles) of a converged solve; profiles ordered along Gamma_C by (x, y)."""
     from vemkit.solvers.solution import SLIP, STICK, contact_state
@@ -111,7 +120,7 @@ def point_quantities(problem, outcome: Outcome):
         "contact_length": float(np.sum(w[st.penetration > 0.0])),
         "stick_length": float(np.sum(w[st.state == STICK])),
         "slip_length": float(np.sum(w[st.state == SLIP])),
-        "normal_force": float(np.sum(w * st.normal_pressure)),
+        "normal_force": _normal_force(problem, sol.u, st),
         "tangential_force": float(np.sum(w * st.tangential_stress)),
         "residual": float(outcome.checks.get("worst", np.nan)),
     }
@@ -130,11 +139,9 @@ def _contact_problem(problem, scene):
 
     normal, friction = scene.normal_compliance, scene.friction_bound
     law = ContactLaw(normal.k, normal.m, friction.k, friction.m)
-    cb = problem.contact
-    gap = np.broadcast_to(np.asarray(scene.gap_expression(cb.coords[:, 0], cb.coords[:, 1]), dtype=float), (cb.size,))
-    if np.any(gap < 0) or not np.all(np.isfinite(gap)):
-        raise ValueError("contact.gap must be finite and >= 0 at every contact vertex (2.11)")
-    return replace(problem, law=law, contact=replace(cb, gap=gap.copy()), info=dict(problem.info))
+    gap = scene.gap_expression
+    contact = problem.contact.with_gap(lambda x, y: np.broadcast_to(gap(x, y), np.shape(x)))
+    return replace(problem, law=law, contact=contact, info=dict(problem.info))
 
 
 def run_grid(scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CHECK_TOL, progress=None) -> dict:

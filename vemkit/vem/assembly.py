@@ -159,6 +159,45 @@ def _find(vindices, lo, hi, col):
     return lo
 
 
+ROW_CHUNKS = 8  # threads' shares of the rows in the parallel assembly
+
+
+@numba.njit(cache=True)
+def chunk_rows(chunk, n_rows):
+    """The rows [lo, hi) of one of the ROW_CHUNKS contiguous shares."""
+    return chunk * n_rows // ROW_CHUNKS, (chunk + 1) * n_rows // ROW_CHUNKS
+
+
+@numba.njit(cache=True, inline="always")
+def add_block(data, p0, p1, K, i, j):
+    """The 2 x 2 block (vertex or node i, j) of an element matrix K into the CSR data of the two
+    scalar rows of i, at positions p0 (first component's row) and p1 (second's)."""
+    data[p0] += K[2 * i, 2 * j]
+    data[p0 + 1] += K[2 * i, 2 * j + 1]
+    data[p1] += K[2 * i + 1, 2 * j]
+    data[p1 + 1] += K[2 * i + 1, 2 * j + 1]
+
+
+@numba.njit(cache=True)
+def cells_of_rows(row_lo, row_hi, free_items, item_ptr, item_cells, offsets, ids, free_index):
+    """The cells touching the rows [row_lo, row_hi) (rows: free vertices or nodes ``free_items``;
+    ``item_ptr``/``item_cells`` the cells around each), each once: at its first row in the range, in
+    the order of the rows. A thread that owns these rows computes exactly these cells."""
+    out = []
+    for r0 in range(row_lo, row_hi):
+        item = free_items[r0]
+        for t in range(item_ptr[item], item_ptr[item + 1]):
+            c = item_cells[t]
+            first = True
+            for i in range(offsets[c], offsets[c + 1]):
+                if row_lo <= free_index[ids[i]] < r0:
+                    first = False
+                    break
+            if first:
+                out.append(c)
+    return out
+
+
 @numba.njit(cache=True)
 def _scatter_rows(row_lo, row_hi, vertices, offsets, cell_vertices, free_index, free_vertices, vc_ptr, vc, vindptr, vindices, lam, mu, stab, nmax, data):
     """Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
@@ -169,43 +208,29 @@ def _scatter_rows(row_lo, row_hi, vertices, offsets, cell_vertices, free_index, 
     px = np.empty(nmax)
     py = np.empty(nmax)
     rows = np.empty(nmax, dtype=np.int64)
-    for r0 in range(row_lo, row_hi):
-        v0 = free_vertices[r0]
-        for t in range(vc_ptr[v0], vc_ptr[v0 + 1]):
-            c = vc[t]
-            start = offsets[c]
-            n = offsets[c + 1] - start
-            first = True  # handle c once: at its first vertex inside the row range
-            for i in range(n):
-                v = cell_vertices[start + i]
-                px[i] = vertices[v, 0]
-                py[i] = vertices[v, 1]
-                rows[i] = free_index[v]
-                if row_lo <= rows[i] < r0:
-                    first = False
-            if not first:
+    for c in cells_of_rows(row_lo, row_hi, free_vertices, vc_ptr, vc, offsets, cell_vertices, free_index):
+        start = offsets[c]
+        n = offsets[c + 1] - start
+        for i in range(n):
+            rows[i] = free_index[cell_vertices[start + i]]
+            px[i] = vertices[cell_vertices[start + i], 0]
+            py[i] = vertices[cell_vertices[start + i], 1]
+        m = 2 * n
+        element_stiffness(px[:n], py[:n], lam, mu, stab, K[:m, :m], B[:, :m], P[:, :m], R[:m, :m])
+        for i in range(n):
+            r = rows[i]
+            if r < row_lo or r >= row_hi:
                 continue
-            m = 2 * n
-            element_stiffness(px[:n], py[:n], lam, mu, stab, K[:m, :m], B[:, :m], P[:, :m], R[:m, :m])
-            for i in range(n):
-                r = rows[i]
-                if r < row_lo or r >= row_hi:
+            lo = vindptr[r]
+            hi = vindptr[r + 1]
+            deg2 = 2 * (hi - lo)
+            base = 4 * lo
+            for j in range(n):
+                col = rows[j]
+                if col < 0:
                     continue
-                lo = vindptr[r]
-                hi = vindptr[r + 1]
-                deg2 = 2 * (hi - lo)
-                base = 4 * lo
-                for j in range(n):
-                    col = rows[j]
-                    if col < 0:
-                        continue
-                    k = _find(vindices, lo, hi, col) - lo
-                    p0 = base + 2 * k
-                    p1 = base + deg2 + 2 * k
-                    data[p0] += K[2 * i, 2 * j]
-                    data[p0 + 1] += K[2 * i, 2 * j + 1]
-                    data[p1] += K[2 * i + 1, 2 * j]
-                    data[p1 + 1] += K[2 * i + 1, 2 * j + 1]
+                k = _find(vindices, lo, hi, col) - lo
+                add_block(data, base + 2 * k, base + deg2 + 2 * k, K, i, j)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -219,13 +244,19 @@ def scatter_stiffness(vertices, offsets, cell_vertices, free_index, free_vertice
     nmax = 0
     for c in range(offsets.shape[0] - 1):
         nmax = max(nmax, offsets[c + 1] - offsets[c])
-    n_rows = free_vertices.shape[0]
-    n_chunks = 8
-    for chunk in numba.prange(n_chunks):
-        _scatter_rows(
-            chunk * n_rows // n_chunks, (chunk + 1) * n_rows // n_chunks, vertices, offsets, cell_vertices,
-            free_index, free_vertices, vc_ptr, vc, vindptr, vindices, lam, mu, stab, nmax, data,
-        )
+    for chunk in numba.prange(ROW_CHUNKS):
+        lo, hi = chunk_rows(chunk, free_vertices.shape[0])
+        _scatter_rows(lo, hi, vertices, offsets, cell_vertices, free_index, free_vertices, vc_ptr, vc, vindptr,
+                      vindices, lam, mu, stab, nmax, data)
+
+
+def sorted_csr(data, indices, indptr, n: int) -> sp.csr_matrix:
+    """The n x n CSR matrix of an assembled pattern (sorted column indices; 32-bit indptr if it fits)."""
+    if indptr[-1] < np.iinfo(np.int32).max:
+        indptr = indptr.astype(np.int32)
+    A = sp.csr_matrix((data, indices, indptr), shape=(n, n))
+    A.has_sorted_indices = True
+    return A
 
 
 def stiffness_matrix(mesh: Mesh, lam: float, mu: float, stabilization: str, dofs: DofMap | None = None):
@@ -242,9 +273,4 @@ def stiffness_matrix(mesh: Mesh, lam: float, mu: float, stabilization: str, dofs
         mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, dofs.free_index,
         dofs.free_vertices, vc_ptr, vc, vindptr, vindices, float(lam), float(mu), stab, data,
     )
-    n = dofs.n_free
-    if indptr[-1] < np.iinfo(np.int32).max:
-        indptr = indptr.astype(np.int32)
-    A = sp.csr_matrix((data, indices, indptr), shape=(n, n))
-    A.has_sorted_indices = True
-    return A
+    return sorted_csr(data, indices, indptr, dofs.n_free)

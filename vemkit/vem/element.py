@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from vemkit.vem.elasticity import elasticity_matrix
+from vemkit.mesh.geometry import polygon_area, polygon_areas
 
 STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
 
@@ -41,26 +41,20 @@ def stabilization_code(name: str) -> int:
 # Numba kernel
 # --------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
-def cell_coordinates(vertices, offsets, cell_vertices, c):
-    """(px, py): the vertex coordinates of cell c, in its (counter-clockwise) order."""
-    s = offsets[c]
-    n = offsets[c + 1] - s
+def polygon_coordinates(vertices, ids, start, n):
+    """(px, py) of the n vertices ids[start:start + n]."""
     px = np.empty(n)
     py = np.empty(n)
     for i in range(n):
-        px[i] = vertices[cell_vertices[s + i], 0]
-        py[i] = vertices[cell_vertices[s + i], 1]
+        px[i] = vertices[ids[start + i], 0]
+        py[i] = vertices[ids[start + i], 1]
     return px, py
 
 
 @numba.njit(cache=True)
-def polygon_area(px, py):
-    n = px.shape[0]
-    a = 0.0
-    for i in range(n):
-        j = (i + 1) % n
-        a += px[i] * py[j] - px[j] * py[i]
-    return 0.5 * a
+def cell_coordinates(vertices, offsets, cell_vertices, c):
+    """(px, py): the vertex coordinates of cell c, in its (counter-clockwise) order."""
+    return polygon_coordinates(vertices, cell_vertices, offsets[c], offsets[c + 1] - offsets[c])
 
 
 @numba.njit(cache=True)
@@ -205,7 +199,7 @@ def element_stiffness_reference(coords, lam, mu, stabilization="dofi-2mu"):
     coords = np.asarray(coords, float)
     n = coords.shape[0]
     x, y = coords[:, 0], coords[:, 1]
-    area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+    area = float(polygon_areas(coords, [0, n])[0])
     xb, yb = coords.mean(axis=0)
     mats, consts = _p1_basis(xb, yb)
     C = lambda e: lam * np.trace(e) * np.eye(2) + 2 * mu * e  # noqa: E731  (SPEC §1)

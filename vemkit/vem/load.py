@@ -13,6 +13,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from vemkit.mesh.geometry import polygon_area_centroid
 from vemkit.mesh.mesh import Mesh
 from vemkit.vem.element import cell_coordinates, projection_coefficients, strain_operator
 
@@ -38,19 +39,25 @@ def edge_quadrature(points: int = 5):
     return 0.5 * (t + 1.0), 0.5 * w
 
 
-def traction_load(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -> np.ndarray:
-    """(N, 2) nodal loads of int_e f2 . phi ds over ``edges`` (k, 2); traction(x, y) -> (f1, f2)."""
-    out = np.zeros((mesh.n_vertices, 2))
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    if edges.size == 0:
-        return out
+def traction_samples(mesh: Mesh, edges: np.ndarray, traction, points: int = 5):
+    """(t (Q,), |e| w_q (E, Q), f2 (E, Q, 2)): Gauss points on [0, 1], weights and the traction at
+    x = (1 - t) x_a + t x_b on every edge (a, b)."""
     t, w = edge_quadrature(points)
     pa, pb = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
     length = np.linalg.norm(pb - pa, axis=1)
     x = pa[:, None, :] * (1 - t)[None, :, None] + pb[:, None, :] * t[None, :, None]
     fx, fy = traction(x[..., 0], x[..., 1])
     f = np.stack([np.broadcast_to(fx, x.shape[:2]), np.broadcast_to(fy, x.shape[:2])], axis=-1)
-    weight = length[:, None] * w[None, :]
+    return t, length[:, None] * w[None, :], f
+
+
+def traction_load(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -> np.ndarray:
+    """(N, 2) nodal loads of int_e f2 . phi ds over ``edges`` (k, 2); traction(x, y) -> (f1, f2)."""
+    out = np.zeros((mesh.n_vertices, 2))
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if edges.size == 0:
+        return out
+    t, weight, f = traction_samples(mesh, edges, traction, points)
     to_a = np.einsum("eq,eqc->ec", weight * (1 - t)[None, :], f)
     to_b = np.einsum("eq,eqc->ec", weight * t[None, :], f)
     for comp in range(2):
@@ -81,18 +88,7 @@ def _body_force_scatter(vertices, offsets, cell_vertices, force, out):
         s = offsets[c]
         n = offsets[c + 1] - s
         px, py = cell_coordinates(vertices, offsets, cell_vertices, c)
-        area = 0.0
-        cx = 0.0
-        cy = 0.0
-        for i in range(n):
-            j = (i + 1) % n
-            cr = px[i] * py[j] - px[j] * py[i]
-            area += cr
-            cx += (px[i] + px[j]) * cr
-            cy += (py[i] + py[j]) * cr
-        area *= 0.5
-        cx /= 6.0 * area
-        cy /= 6.0 * area
+        area, cx, cy = polygon_area_centroid(px, py)
         B = np.empty((3, 2 * n))
         P = np.empty((6, 2 * n))
         strain_operator(px, py, area, B)

@@ -59,3 +59,12 @@ rule figure_convergence:
         "logs/figures/convergence.log",
     script:
         "../scripts/figure_convergence.py"
+
+
+# plotting reads one result file and writes two images: on a cluster these rules run where snakemake
+# runs (the login node), not as jobs; the README's "On a SLURM cluster" section says the same
+localrules:
+    figure_fields,
+    figure_deformed,
+    figure_contact,
+    figure_convergence,

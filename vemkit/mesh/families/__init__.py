@@ -1,4 +1,6 @@
-"""Mesh families of the unit square, by name: ``build_mesh("voronoi", 32, seed=1)``.
+"""Mesh families by name: ``build_mesh("voronoi", 32, seed=1)``, on any domain (SPEC §7):
+``build_mesh("square", h=2.0, domain={"polygon": ..., "sides": ..., "holes": ...})``.
+On the unit square (the default):
 
 - ``square``: n x n squares (no options);
 - ``triangle``: ``kind="delaunay"`` (default; options ``seed``, ``min_angle``) about 2 n² quality
@@ -7,6 +9,10 @@
   ``merge_tol``);
 - ``hanging``: n x n squares quadrisected ``levels`` times (``levels``, ``rule``, ``seed``,
   ``fraction``, ``contact_side``).
+
+On any other domain: ``triangle`` (delaunay) respects every side and hole, ``voronoi`` is clipped
+to it (holes included), ``square`` and ``hanging`` are cut cells (``cut.py``); every boundary edge
+is named after the side it lies on.
 """
 
 from __future__ import annotations
@@ -17,6 +23,8 @@ from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.square import square, structured_triangle
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
+from vemkit.exceptions import MeshError
+from vemkit.mesh.domain import cells_per_length, domain_from_spec
 from vemkit.mesh.mesh import Mesh
 
 FAMILIES = ("square", "triangle", "voronoi", "hanging")
@@ -31,27 +39,51 @@ _BUILDERS = {
 }
 
 
-def build_mesh(family: str, n: int, **options) -> Mesh:
-    """The mesh of ``family`` with n cells per side (n = 1/h), made with ``options``."""
+def family_builder(family: str, options: dict):
+    """The builder of ``family`` for ``options`` (``kind`` removed from them); MeshError (an
+    InputError) naming the family or the option that does not apply to it."""
     if family not in FAMILIES:
-        raise ValueError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}")
+        raise MeshError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}",
+                        key="family")
     key = family
     if family == "triangle":
         kind = options.pop("kind", "delaunay")
         if kind not in TRIANGLE_KINDS:
-            raise ValueError(f"triangle mesh kind {kind!r} is unknown; valid kinds: {', '.join(TRIANGLE_KINDS)}")
+            raise MeshError(f"triangle mesh kind {kind!r} is unknown; valid kinds: {', '.join(TRIANGLE_KINDS)}",
+                            key="kind")
         key = (family, kind)
     builder = _BUILDERS[key]
-    valid = [p for p in inspect.signature(builder).parameters if p != "n"]
+    valid = [p for p in inspect.signature(builder).parameters if p not in ("n", "domain")]
     unknown = sorted(set(options) - set(valid))
     if unknown:
         name = family if family != "triangle" else f"triangle (kind={key[1]})"
         listing = ", ".join(valid + (["kind"] if family == "triangle" else [])) or "none"
-        raise ValueError(f"mesh option {unknown[0]!r} is not valid for family {name}; valid options: {listing}")
-    return builder(n, **options)
+        raise MeshError(f"mesh option {unknown[0]!r} is not valid for family {name}; valid options: {listing}",
+                        key=unknown[0])
+    return builder
 
 
-__all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "square", "structured_triangle", "delaunay_triangle",
+def build_mesh(family: str, n: float | None = None, *, domain=None, h: float | None = None,
+               cells: float | None = None, **options) -> Mesh:
+    """The mesh of ``family`` on ``domain``, made with ``options``.
+
+    ``domain``: a :class:`~vemkit.mesh.domain.Domain`, its SPEC §7 mapping or None (the unit
+    square). Size: exactly one of ``n`` (cells per unit length, n = 1/h: about n² cells per unit
+    area), ``h`` or ``cells`` (about that many cells). On the unit square with a whole n every
+    family makes exactly the mesh it always made.
+    """
+    builder = family_builder(family, options)
+    region = domain_from_spec(domain)
+    n = cells_per_length(region, n, h, cells, 2.0 if family == "triangle" else 1.0)
+    if region.is_unit_square:
+        return builder(n, **options)
+    if builder is structured_triangle:
+        raise MeshError("triangle kind structured is a unit-square family; use kind delaunay on this domain",
+                        key="kind")
+    return builder(n, domain=region, **options)
+
+
+__all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "family_builder", "square", "structured_triangle", "delaunay_triangle",
            "voronoi", "hanging"]
 
 

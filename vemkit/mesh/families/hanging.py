@@ -13,32 +13,47 @@ Every square lists, counter-clockwise from its lower-left corner, all the vertic
 boundary: the corners of its smaller neighbours are hanging nodes, so a coarse square becomes a
 5-, 6-, ... vertex polygon with collinear vertices (SPEC §3). Coordinates are computed on the
 integer grid of the finest possible level and divided once, so shared vertices coincide exactly.
+
+On any other domain (``domain=``, a :class:`~vemkit.mesh.domain.Domain`) the same refinement runs on
+the squares of side 1/n that meet the domain (``contact_side``: any side name of the domain), and
+the refined squares are then cut to the domain (``cut.cut_hanging``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from vemkit.mesh.domain import UNIT_SQUARE, UNIT_SQUARE_SIDE_LINES, UNIT_SQUARE_SIDES
+from vemkit.mesh.families.cut import cut_hanging, quadrisect
 from vemkit.mesh.mesh import Mesh, tag_box_boundary
 
 RULES = ("contact", "random")
-SIDES = ("left", "right", "bottom", "top")
 
 
 def hanging(n: int, levels: int = 1, rule: str = "contact", seed: int = 0, fraction: float = 0.3,
-            contact_side: str = "bottom") -> Mesh:
-    """n x n squares refined ``levels`` times by ``rule`` ("contact" or "random")."""
-    n, levels = int(n), int(levels)
-    if n < 1:
-        raise ValueError(f"mesh n = {n}: the number of cells per side must be >= 1")
+            contact_side: str = "bottom", domain=None) -> Mesh:
+    """n x n squares refined ``levels`` times by ``rule`` ("contact" or "random").
+
+    On a :class:`~vemkit.mesh.domain.Domain` other than the unit square (or with n not an
+    integer): squares of side 1/n over the domain, refined, then cut (``cut.cut_hanging``).
+    """
+    levels = int(levels)
+    sides = UNIT_SQUARE_SIDES if domain is None else domain.side_names
     if levels < 0:
         raise ValueError(f"levels = {levels}: give a number of refinement rounds >= 0")
     if rule not in RULES:
         raise ValueError(f"rule = {rule!r}: valid rules are {', '.join(RULES)}")
-    if contact_side not in SIDES:
-        raise ValueError(f"contact_side = {contact_side!r}: valid sides are {', '.join(SIDES)}")
+    if contact_side not in sides and (rule == "contact" or domain is None):
+        raise ValueError(f"contact_side = {contact_side!r}: valid sides are {', '.join(sides)}")
     if rule == "random" and not 0.0 <= fraction <= 1.0:
         raise ValueError(f"fraction = {fraction}: give a fraction of cells between 0 and 1")
+    if (domain is not None and not domain.is_unit_square) or not float(n).is_integer():
+        if not n > 0:
+            raise ValueError(f"mesh n = {n}: the number of cells per unit length must be > 0")
+        return cut_hanging(domain or UNIT_SQUARE, n, levels, rule, seed, fraction, contact_side)
+    n = int(n)
+    if n < 1:
+        raise ValueError(f"mesh n = {n}: the number of cells per side must be >= 1")
     fine = n << levels  # grid points per side at the finest level
     unit = 1 << levels
     j, i = np.divmod(np.arange(n * n, dtype=np.int64), n)
@@ -50,7 +65,7 @@ def hanging(n: int, levels: int = 1, rule: str = "contact", seed: int = 0, fract
         else:
             chosen = np.zeros(squares.shape[0], dtype=bool)
             chosen[rng.choice(squares.shape[0], int(round(fraction * squares.shape[0])), replace=False)] = True
-        squares = _quadrisect(squares, chosen)
+        squares = quadrisect(squares, chosen)
     vertices, offsets, cell_vertices = _polygons(squares, fine)
     meta = {"family": "hanging", "n": n, "levels": levels, "rule": rule, "seed": int(seed)}
     if rule == "random":
@@ -61,23 +76,9 @@ def hanging(n: int, levels: int = 1, rule: str = "contact", seed: int = 0, fract
 
 
 def _touching(squares: np.ndarray, side: str, fine: int) -> np.ndarray:
-    x0, y0, s = squares.T
-    return {"left": x0 == 0, "bottom": y0 == 0, "right": x0 + s == fine, "top": y0 + s == fine}[side]
-
-
-def _quadrisect(squares: np.ndarray, chosen: np.ndarray) -> np.ndarray:
-    """Replace every chosen square, in place, by its four children (lower-left, lower-right, upper-right, upper-left)."""
-    copies = np.where(chosen, 4, 1)
-    out = np.repeat(squares, copies, axis=0)
-    child = np.arange(out.shape[0]) - np.repeat(np.cumsum(copies) - copies, copies)
-    split = np.repeat(chosen, copies)
-    half = out[:, 2] // 2
-    dx = np.array([0, 1, 1, 0])[child % 4]
-    dy = np.array([0, 0, 1, 1])[child % 4]
-    out[split, 0] += (dx * half)[split]
-    out[split, 1] += (dy * half)[split]
-    out[split, 2] = half[split]
-    return out
+    axis, fraction = UNIT_SQUARE_SIDE_LINES[side]
+    start, size = squares[:, axis], squares[:, 2]
+    return start == 0 if fraction == 0 else start + size == fine
 
 
 def _polygons(squares: np.ndarray, fine: int):

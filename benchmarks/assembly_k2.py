@@ -1,0 +1,91 @@
+"""k = 2 against k = 1 stiffness assembly, time per degree of freedom (issue 14, item 6 first half).
+Writes benchmarks/out/assembly_k2.{json,md}.
+
+    .venv/bin/python benchmarks/assembly_k2.py [--quick] [--repeat R]
+
+Both assemblies start from the mesh and end with the CSR matrix (sparsity pattern and dof
+numbering included; k = 2 builds its NodeMapK2 inside the timed call), all dofs free, `dofi-2mu`.
+The best of R runs after a JIT warm-up is kept; wall time and process CPU time (all threads) are
+both recorded, because the machine may be shared: CPU time per dof is the steadier comparison.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+
+
+OUT = Path(__file__).resolve().parent / "out"
+
+
+def timed(fn, repeat):
+    """(best wall s, best CPU s, result) over ``repeat`` runs."""
+    walls, cpus = [], []
+    for _ in range(repeat):
+        w, c = time.perf_counter(), time.process_time()
+        result = fn()
+        walls.append(time.perf_counter() - w)
+        cpus.append(time.process_time() - c)
+    return min(walls), min(cpus), result
+
+
+def case(n: int, repeat: int) -> dict:
+    from vemkit.mesh.families.square import square
+    from vemkit.vem.assembly import stiffness_matrix
+    from vemkit.vem.assembly_k2 import NodeMapK2, stiffness_matrix_k2
+    from vemkit.vem.elasticity import lame_parameters
+
+    lam, mu = lame_parameters(2000.0, 0.4)
+    warm = square(2)
+    stiffness_matrix(warm, lam, mu, "dofi-2mu")
+    stiffness_matrix_k2(warm, lam, mu, "dofi-2mu", NodeMapK2.from_clamped_edges(warm))
+    mesh = square(n)
+    t = time.perf_counter()
+    mesh.edges  # noqa: B018  (mesh topology, cached on the mesh: not part of either assembly)
+    row = {"mesh": f"{n}x{n} squares", "cells": mesh.n_cells, "mesh_edges_s": time.perf_counter() - t}
+    runs = {
+        "k1": lambda: stiffness_matrix(mesh, lam, mu, "dofi-2mu"),
+        "k2": lambda: stiffness_matrix_k2(mesh, lam, mu, "dofi-2mu", NodeMapK2.from_clamped_edges(mesh)),
+    }
+    for k, fn in runs.items():
+        wall, cpu, A = timed(fn, repeat)
+        row[k] = {"dofs": A.shape[0], "nnz": int(A.nnz), "wall_s": wall, "cpu_s": cpu,
+                  "wall_us_per_dof": 1e6 * wall / A.shape[0], "cpu_us_per_dof": 1e6 * cpu / A.shape[0]}
+    row["wall_ratio_per_dof"] = row["k2"]["wall_us_per_dof"] / row["k1"]["wall_us_per_dof"]
+    row["cpu_ratio_per_dof"] = row["k2"]["cpu_us_per_dof"] / row["k1"]["cpu_us_per_dof"]
+    return row
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="64^2 and 128^2 (a smoke test, not the target)")
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    sizes = [64, 128] if args.quick else [256, 512]
+    rows = [case(n, args.repeat) for n in sizes]
+    command = "python benchmarks/assembly_k2.py" + (" --quick" if args.quick else "") + f" --repeat {args.repeat}"
+    met = {f"{r['mesh']}: k2/k1 wall time per dof <= 2": r["wall_ratio_per_dof"] <= 2.0 for r in rows}
+    met.update({f"{r['mesh']}: k2/k1 CPU time per dof <= 2": r["cpu_ratio_per_dof"] <= 2.0 for r in rows})
+    record = {"command": command, "machine": f"{platform.machine()}, {platform.python_implementation()} "
+              f"{platform.python_version()}", "cases": rows, "targets": met}
+    OUT.mkdir(exist_ok=True)
+    (OUT / "assembly_k2.json").write_text(json.dumps(record, indent=2))
+    lines = ["# k = 2 against k = 1 assembly (time per dof)", "", f"`{command}` on {record['machine']}", "",
+             "| mesh | k | dofs | nnz | wall s | CPU s | wall us/dof | CPU us/dof |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        for k in ("k1", "k2"):
+            x = r[k]
+            lines.append(f"| {r['mesh']} | {k[1]} | {x['dofs']} | {x['nnz']} | {x['wall_s']:.3f} | {x['cpu_s']:.3f} | "
+                         f"{x['wall_us_per_dof']:.3f} | {x['cpu_us_per_dof']:.3f} |")
+    lines += ["", "| mesh | k2/k1 wall per dof | k2/k1 CPU per dof |", "|---|---|---|"]
+    lines += [f"| {r['mesh']} | {r['wall_ratio_per_dof']:.2f} | {r['cpu_ratio_per_dof']:.2f} |" for r in rows]
+    lines += ["", "Targets: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in met.items())]
+    (OUT / "assembly_k2.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,100 @@
+"""The package's shape: layers import only layers below them; the core needs no workflow tools."""
+
+import ast
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "vemkit"
+#: the layers, lowest first (vemkit/__init__.py documents the same order)
+LAYERS = ("exceptions", "config", "mesh", "vem", "contact", "solvers", "io", "studies", "report", "cli")
+
+
+def _layer(module: str) -> int:
+    """Layer of a dotted vemkit module name (``vemkit.solvers.ssn`` -> 5)."""
+    return LAYERS.index(module.split(".")[1])
+
+
+def _modules():
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if len(parts) > 1:  # vemkit/__init__.py is the public API, above every layer
+            yield ".".join(parts), path
+
+
+def _imported(path: Path, module: str):
+    """Every vemkit module imported anywhere in a file (function-level imports included)."""
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            yield from (a.name for a in node.names if a.name.startswith("vemkit."))
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(package.split(".")[: len(package.split(".")) - node.level + 1] + ([base] if base else []))
+            if base == "vemkit":
+                yield from (f"vemkit.{a.name}" for a in node.names if a.name in LAYERS)
+            elif base.startswith("vemkit."):
+                yield base
+
+
+@pytest.mark.parametrize("module, path", list(_modules()), ids=lambda v: str(v) if isinstance(v, str) else "")
+def test_no_module_imports_from_a_layer_above_it(module, path):
+    upward = [name for name in _imported(path, module) if _layer(name) > _layer(module)]
+    assert not upward, f"{module} (layer {LAYERS[_layer(module)]}) imports {upward} from a layer above it"
+
+
+def test_every_subpackage_says_what_it_owns_and_may_import():
+    for layer in LAYERS[1:-1]:
+        doc = " ".join((ast.get_docstring(ast.parse((PACKAGE / layer / "__init__.py").read_text(encoding="utf-8")))
+                        or "").split())
+        assert doc and f"Layer {LAYERS.index(layer)}" in doc and "Imports from vemkit" in doc, layer
+
+
+_BLOCK = """
+import importlib.abc, json, os, sys
+class Block(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.split('.')[0] in {blocked!r}:
+            raise ImportError('blocked for this test: ' + name)
+sys.meta_path.insert(0, Block())
+"""
+
+
+def _python(code: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+
+
+def test_the_core_imports_and_solves_without_snakemake_or_matplotlib(tmp_path):
+    core = [m for m, _ in _modules() if _layer(m) <= LAYERS.index("studies")]
+    scene = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+    code = _BLOCK.format(blocked=["snakemake", "matplotlib"]) + f"""
+import importlib
+for name in {core!r}:
+    importlib.import_module(name)
+from vemkit.cli import main
+assert main(["solve", {str(scene)!r}, "-o", {str(tmp_path / 'out.nc')!r}, "--set", "discretization.mesh.n=4", "-q"]) == 0
+"""
+    run = _python(code)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert (tmp_path / "out.nc").is_file()
+
+
+def test_importing_vemkit_has_no_side_effects():
+    run = _python("import json, os, sys; before = dict(os.environ); import vemkit; "
+                  "print(json.dumps([dict(os.environ) == before, sorted(m for m in sys.modules "
+                  "if m.split('.')[0] in ('numpy', 'matplotlib', 'numba'))]))")
+    unchanged, heavy = json.loads(run.stdout)
+    assert unchanged and heavy == []
+
+
+def test_the_public_api_resolves():
+    import vemkit
+
+    for name in vemkit.__all__:
+        assert getattr(vemkit, name) is not None

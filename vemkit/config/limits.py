@@ -1,0 +1,172 @@
+"""What vemkit accepts, and what a request will cost before it is spent (issue 9).
+
+Size: a solve of D degrees of freedom peaks at about ``BASE_BYTES + BYTES_PER_DOF * D`` of
+memory (mesh, assembly, AMG hierarchy or sparse factorization, semismooth Newton or Uzawa, the
+result Dataset and its netCDF file). The constants are the peak resident memory (ru_maxrss) of
+``vemkit solve`` on the paper scene, measured for the square, voronoi, triangle and hanging
+families at n = 64 ... 512 with both solvers, rounded up (README "Input rules and limits").
+
+A request is refused, with the estimate in the message, when its DOFs exceed ``max_dofs``
+(default :data:`DEFAULT_MAX_DOFS`; ``vemkit solve --max-dofs`` raises it) or its estimated peak
+memory exceeds :data:`MEMORY_FRACTION` of the memory available to the process (MemAvailable,
+a cgroup limit, RLIMIT_AS, whichever is smallest) — that one always.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import resource
+from typing import NamedTuple
+
+from vemkit.exceptions import ResourceLimitError
+
+__all__ = ["BASE_BYTES", "BYTES_PER_DOF", "DEFAULT_MAX_DOFS", "MEMORY_FRACTION", "Resources",
+           "available_memory", "check_resources", "check_scene_resources", "domain_area", "estimate_mesh",
+           "estimate_resources", "scene_resources"]
+
+DEFAULT_MAX_DOFS = 4_000_000  # the paper's finest level (n = 1024) has 2.1 million on squares
+BASE_BYTES = 400 * 2**20  # Python with numpy, scipy, numba, xarray, netCDF4 loaded
+BYTES_PER_DOF = 2_500  # measured 1.0-1.6 kB (see the module docstring); a margin on top
+MEMORY_FRACTION = 0.8
+
+
+class Resources(NamedTuple):
+    """A prediction: mesh cells and vertices, degrees of freedom, peak memory in bytes."""
+
+    cells: int
+    vertices: int
+    dofs: int
+    peak_bytes: int
+
+    def describe(self) -> str:
+        return (f"about {self.cells:,} cells, {self.dofs:,} DOFs and "
+                f"{_gib(self.peak_bytes)} of memory")
+
+
+def _gib(count: float) -> str:
+    return f"{count / 2**30:.1f} GiB" if count >= 2**30 else f"{count / 2**20:.0f} MiB"
+
+
+def estimate_resources(cells: int, vertices: int) -> Resources:
+    """The prediction for a mesh of ``cells`` and ``vertices`` (2 DOFs per vertex, an upper bound)."""
+    dofs = 2 * int(vertices)
+    return Resources(int(cells), int(vertices), dofs, BASE_BYTES + BYTES_PER_DOF * dofs)
+
+
+def domain_area(domain) -> float:
+    """Area of a scene's ``domain`` (SPEC §7): 1 for the unit square, else the shoelace area of
+    its outer polygon (holes ignored: an upper bound)."""
+    if not isinstance(domain, dict) or "polygon" not in domain:
+        return 1.0
+    corners = domain["polygon"]
+    twice = sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(corners, corners[1:] + corners[:1]))
+    return max(abs(float(twice)) / 2.0, 1e-300)
+
+
+def _cells_per_length(options: dict, area: float, cells_per_square: float) -> float:
+    if options.get("n") is not None:
+        return float(options["n"])
+    if options.get("h") is not None:
+        return 1.0 / float(options["h"])
+    if options.get("cells") is not None:
+        return math.sqrt(float(options["cells"]) / (cells_per_square * area))
+    return 1.0
+
+
+def estimate_mesh(mesh_options: dict, area: float = 1.0) -> tuple[int, int]:
+    """(cells, vertices) of the mesh ``discretization.mesh`` asks for, without building it.
+
+    On the unit square with n cells per side: exact for square (n², (n+1)²) and structured
+    triangles; Delaunay triangles 2 n² within 2 % (triangle.py) and about (n+1)² vertices; Voronoi
+    n² cells, 2 n² + 2 n vertices; hanging: refinement at a side adds 3 n (2^levels - 1) cells,
+    random refinement multiplies them by (1 + 3 fraction) per level, vertices <= 1.5 cells +
+    4 n 2^levels + 1 (upper bounds, checked against the families in tests/config). Any other
+    domain: the same with n √area cells per side.
+    """
+    family = mesh_options.get("family")
+    triangles = family == "triangle"
+    n = math.ceil(_cells_per_length(mesh_options, area, 2.0 if triangles else 1.0) * math.sqrt(area))
+    if family == "square" or (triangles and mesh_options.get("kind") == "structured"):
+        return (2 if triangles else 1) * n * n, (n + 1) ** 2
+    if triangles:
+        return (204 * n * n) // 100 + 1, (105 * (n + 1) ** 2) // 100 + 8
+    if family == "voronoi":
+        return n * n, 2 * n * n + 2 * n + 4
+    levels = int(mesh_options.get("levels", 1))
+    if mesh_options.get("rule", "contact") == "random":
+        cells = int(n * n * (1.0 + 3.0 * float(mesh_options.get("fraction", 0.3))) ** levels) + 1
+    else:
+        cells = n * n + 3 * n * (2**levels - 1)
+    return cells, (3 * cells) // 2 + 4 * n * 2**levels + 1
+
+
+def _read_int(path: str) -> int | None:
+    try:
+        with open(path, encoding="ascii") as handle:
+            text = handle.read().split()[0]
+    except (OSError, IndexError):
+        return None
+    return int(text) if text.isdigit() else None
+
+
+def available_memory() -> int | None:
+    """Bytes this process may still use (None if unknown): the smallest of MemAvailable, the
+    cgroup memory limit minus its usage, and the address-space limit (RLIMIT_AS)."""
+    candidates = []
+    try:
+        with open("/proc/meminfo", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("MemAvailable:"):
+                    candidates.append(int(line.split()[1]) * 1024)
+    except (OSError, ValueError, IndexError):
+        pass
+    limit = _read_int("/sys/fs/cgroup/memory.max")
+    if limit is not None and limit < 2**60:
+        candidates.append(limit - (_read_int("/sys/fs/cgroup/memory.current") or 0))
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        candidates.append(soft)
+    if not candidates and hasattr(os, "sysconf"):
+        try:
+            candidates.append(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+        except (OSError, ValueError):
+            pass
+    return max(min(candidates), 0) if candidates else None
+
+
+def check_resources(estimate: Resources, max_dofs: int | None = DEFAULT_MAX_DOFS,
+                    what: str = "the scene", fix: str = "a smaller discretization.mesh.n") -> None:
+    """ResourceLimitError if ``estimate`` exceeds ``max_dofs`` or the machine (message: the
+    estimate, the limit and the fix)."""
+    if max_dofs is not None and estimate.dofs > max_dofs:
+        raise ResourceLimitError(
+            f"{what} needs {estimate.describe()}, more than the limit of {max_dofs:,} DOFs; "
+            f"use {fix}, or raise the limit with --max-dofs", key="max_dofs",
+            estimate=estimate._asdict())
+    free = available_memory()
+    if free is not None and estimate.peak_bytes > MEMORY_FRACTION * free:
+        raise ResourceLimitError(
+            f"{what} needs {estimate.describe()}, more than this machine has available "
+            f"({_gib(free)}); use {fix}", key="memory", estimate=estimate._asdict())
+
+
+def scene_resources(scene) -> Resources | None:
+    """Cells, DOFs and peak memory of solving ``scene``, predicted without building its mesh
+    (None for a mesh read from a file: its size is known once it is read)."""
+    if "family" not in scene.mesh_options:
+        return None
+    return estimate_resources(*estimate_mesh(scene.mesh_options, domain_area(scene.domain)))
+
+
+def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS) -> Resources | None:
+    """The prediction of :func:`scene_resources`; ResourceLimitError beyond ``max_dofs`` or the
+    machine's memory."""
+    estimate = scene_resources(scene)
+    if estimate is None:
+        return None
+    options = scene.mesh_options
+    size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells"))
+    check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
+                    fix="a coarser discretization.mesh")
+    return estimate

@@ -1,0 +1,156 @@
+"""The pieces of one semismooth Newton step (vemkit.solvers.ssn, whose docstring has the maths).
+
+Linear algebra: stiffness diagonals in a direction, rank-one contact blocks, the basis Z that
+eliminates the stick constraints, and the solver of the reduced systems Z^T A Z y = Z^T r (direct,
+or CG/GMRES preconditioned by the projected AMG V-cycle of K, rebuilt for A when CG needs
+REBUILD_FACTOR times the iterations per decade of the first solve). Globalisation: the line search.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from vemkit.exceptions import LinearSolveError
+from vemkit.solvers.linear import linear_solver
+
+REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
+MIN_REBUILD_ITERATIONS = 20
+MAX_REBUILDS = 10
+ARMIJO = 1e-4
+MIN_STEP = 2.0**-30
+MAX_EXPANSION = 64.0  # largest step length tried when the energy still falls steeply after a full step
+EXPAND_SLOPE = 0.1  # ... "steeply": the slope at the full step is still this fraction of the initial one
+
+
+def direction_diagonal(K, cb, direction):
+    """d_c^T K_cc d_c at each contact vertex (the stiffness diagonal in direction d)."""
+    i, j = cb.dofs[:, 0], cb.dofs[:, 1]
+    Kii = np.asarray(K[i, i]).ravel()
+    Kjj = np.asarray(K[j, j]).ravel()
+    Kij = np.asarray(K[i, j]).ravel()
+    return direction[:, 0] ** 2 * Kii + 2 * direction[:, 0] * direction[:, 1] * Kij + direction[:, 1] ** 2 * Kjj
+
+
+def stick_basis(cb, stick, n):
+    """Orthonormal Z (n x (n - |stick|)) spanning {v : tau_c . v_c = 0 for stick c}: v_c = a nu_c there."""
+    first, second = cb.dofs[stick, 0], cb.dofs[stick, 1]
+    keep = np.ones(n, dtype=bool)
+    keep[second] = False
+    column = np.cumsum(keep) - 1
+    rows = np.flatnonzero(keep)
+    vals = np.ones(rows.size)
+    vals[column[first]] = cb.normal[stick, 0]
+    rows = np.concatenate([rows, second])
+    cols = np.concatenate([np.arange(vals.size), column[first]])
+    vals = np.concatenate([vals, cb.normal[stick, 1]])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, int(keep.sum())))
+
+
+class ReducedSolver:
+    """Solves Z^T A Z y = Z^T r for the Newton steps (direct, or CG with the projected AMG V-cycle)."""
+
+    def __init__(self, problem, base, baseline):
+        self.problem = problem
+        self.method = base.method
+        self.preconditioner = getattr(base, "preconditioner", None)
+        self.rebuilds = 0
+        self.baseline = baseline  # CG iterations per decade of residual reduction with K
+
+    def solve(self, A, Z, rhs, eta, penalty, symmetric=True):
+        """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs)."""
+        b = rhs if Z is None else Z.T @ rhs
+        A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
+        lift = (lambda y: y) if Z is None else (lambda y: Z @ y)
+        if self.method == "direct":
+            if symmetric:
+                return lift(linear_solver(A_red, "direct").solve(b)), 1
+            y = spla.splu(A_red.tocsc()).solve(b)
+            if not np.all(np.isfinite(y)):
+                raise LinearSolveError(
+                    "the direct solve of the Newton step produced non-finite values", solver="direct", iterations=1
+                )
+            return lift(y), 1
+        if np.linalg.norm(b) == 0.0:
+            return np.zeros(A.shape[0]), 0
+        krylov = spla.cg if symmetric else _gmres
+        y, its = self._krylov(krylov, A_red, Z, b, eta)
+        decades = max(np.log10(1.0 / eta), 1.0)
+        if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
+            hierarchy = linear_solver(A + penalty(), "amg", near_nullspace=self.problem.near_nullspace)
+            self.preconditioner = hierarchy.preconditioner
+            self.rebuilds += 1
+            y, more = self._krylov(krylov, A_red, Z, b, eta, x0=y)
+            its += more
+        return lift(y), its
+
+    def _krylov(self, krylov, A_red, Z, b, eta, x0=None):
+        full, M = self.preconditioner, self.preconditioner
+        if Z is not None:
+            M = spla.LinearOperator(A_red.shape, matvec=lambda v: Z.T @ (full @ (Z @ v)), dtype=float)
+        count = [0]
+
+        def callback(_):
+            count[0] += 1
+
+        y, info = krylov(A_red, b, x0=x0, rtol=eta, atol=0.0, maxiter=5000, M=M, callback=callback)
+        if info != 0 or not np.all(np.isfinite(y)):
+            raise LinearSolveError(
+                f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
+                f"try solver.linear=direct",
+                solver="amg", iterations=count[0],
+            )
+        return y, count[0]
+
+
+def _gmres(A, b, x0, rtol, atol, maxiter, M, callback):
+    """GMRES (restart 50) with the cg call signature; callback once per inner iteration."""
+    return spla.gmres(
+        A, b, x0=x0, rtol=rtol, atol=atol, restart=50, maxiter=maxiter, M=M, callback=callback, callback_type="pr_norm"
+    )
+
+
+def line_search(point, trial, slope, d0, energy_merit):
+    """Step length along the Newton direction; returns (alpha, the point reached).
+
+    The full step is taken when it reduces the residual merit theta (fast local convergence).
+    Otherwise, for the reduced law, Armijo backtracking on the convex energy, which the Newton
+    direction descends (d0 < 0); after an accepted full step that still descends steeply the step is
+    doubled while the energy keeps falling (a power law m_nu > 1 approached from deep penetration
+    needs steps of about m_nu). Without an energy (m_tau > 0) backtracking on theta. If nothing
+    decreases, the full step is taken (an active-set change may need it).
+    """
+    full = trial(1.0)
+    descent = energy_merit and d0 < 0.0
+    if descent and full.energy <= point.energy + ARMIJO * d0:
+        alpha, best = 1.0, full
+        low, low_slope = 1.0, slope(full)
+        while low < MAX_EXPANSION and low_slope < EXPAND_SLOPE * d0:
+            high = 2.0 * low
+            candidate = trial(high)
+            high_slope = slope(candidate)
+            if candidate.energy < best.energy:
+                alpha, best = high, candidate
+            if high_slope >= 0.0 or not candidate.energy < best.energy:
+                # the minimizer along the line lies in (low, high): one secant step on the slope
+                secant = low - low_slope * (high - low) / (high_slope - low_slope)
+                if low < secant < high:
+                    candidate = trial(secant)
+                    if candidate.energy < best.energy:
+                        alpha, best = secant, candidate
+                break
+            low, low_slope = high, high_slope
+        return alpha, best
+    if full.theta <= (1.0 - ARMIJO) * point.theta:
+        return 1.0, full
+    alpha = 0.5
+    while alpha >= MIN_STEP:
+        candidate = trial(alpha)
+        if descent:
+            if candidate.energy <= point.energy + ARMIJO * alpha * d0:
+                return alpha, candidate
+        elif candidate.theta <= (1.0 - ARMIJO * alpha) * point.theta:
+            return alpha, candidate
+        alpha *= 0.5
+    return 1.0, full
