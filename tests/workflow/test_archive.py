@@ -28,12 +28,16 @@ RTOL = 1e-6
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def archive():
-    path = ARCHIVE / "table1.nc"
+def _archived(name: str):
+    path = ARCHIVE / name
     if not path.exists():
         pytest.skip(f"{path} is missing: run `snakemake -j2 archive`")
     return read_convergence(path)
+
+
+@pytest.fixture(scope="module")
+def archive():
+    return _archived("table1.nc")
 
 
 def _solve(scene_file, parameters, family, n, stab):
@@ -77,10 +81,7 @@ def test_archived_table1_with_gauss_quadrature_has_every_printed_digit(archive):
 
 @pytest.fixture(scope="module")
 def convergence_archive():
-    path = ARCHIVE / "convergence.nc"
-    if not path.exists():
-        pytest.skip(f"{path} is missing: run `snakemake -j2 archive`")
-    return read_convergence(path)
+    return _archived("convergence.nc")
 
 
 def test_archived_convergence_has_the_papers_measure_on_every_family(convergence_archive):

@@ -129,15 +129,17 @@ def _stop_reason(estimate: float, n_dofs: int, step: int, settings: AdaptivitySe
     return None
 
 
-HISTORY_ATTRS = {  # name: (long name, units); n_dofs, n_cells, iterations as in the convergence records
-    **{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
-    "estimate": ("relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
-    "true_error": ("relative H1-seminorm error against the exact or reference solution", "1"),
-    "effectivity": ("estimate / true_error", "1"),
-    "marked": ("cells marked for refinement (0: the last step)", "1"),
-    "wall_time": ("wall time of the step: assembly, solve, estimate, refinement", "s"),
-    "solve_time": ("assembly and contact solve", "s"),
-}
+_STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop records
+    ("estimate", "relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
+    ("true_error", "relative H1-seminorm error against the exact or reference solution", "1"),
+    ("effectivity", "estimate / true_error", "1"),
+    ("marked", "cells marked for refinement (0: the last step)", "1"),
+    ("wall_time", "wall time of the step: assembly, solve, estimate, refinement", "s"),
+    ("solve_time", "assembly and contact solve", "s"),
+)
+#: name: (long name, units) of the per-step history; n_dofs, n_cells, iterations as in the convergence records
+HISTORY_ATTRS = {**{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
+                 **{name: (long_name, units) for name, long_name, units in _STEP_VARIABLES}}
 
 
 def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:

@@ -19,7 +19,7 @@ rule table1_dataset:
     log:
         "logs/table1_dataset.log",
     script:
-        "../scripts/convergence.py"
+        "../scripts/table1_dataset.py"
 
 
 rule convergence_dataset:
@@ -38,7 +38,7 @@ rule convergence_dataset:
     log:
         "logs/convergence_dataset.log",
     script:
-        "../scripts/convergence.py"
+        "../scripts/convergence_dataset.py"
 
 
 rule archive:
