@@ -25,6 +25,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/assembly.py
 	$(BIN)/python benchmarks/contact.py
 	$(BIN)/python benchmarks/sweep.py
+	$(BIN)/python benchmarks/meshing.py
+	$(BIN)/python benchmarks/assembly_k2.py
 
 clean-results:
 	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs
