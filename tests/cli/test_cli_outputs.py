@@ -61,7 +61,9 @@ def test_a_signal_at_any_moment_leaves_the_earlier_file_and_no_temporary(tmp_pat
         assert time.perf_counter() - start < 10, f"{signame} after {delay} s: not prompt"
         assert "Traceback" not in stderr, stderr
         assert not _leftovers(tmp_path), (delay, _leftovers(tmp_path))
-        if delay < 1.0:  # Python may still be starting (before vemkit handles signals)
+        if delay < 1.0 or process.returncode == -getattr(signal, signame):
+            # Python was still starting (under load this can take seconds): the default action
+            # ended it before vemkit handled signals; nothing of the earlier file may change
             assert out.read_bytes() == EARLIER
         elif process.returncode == 0 or "wrote" in stderr:  # it had finished: a complete result
             assert process.returncode in (0, status), (delay, process.returncode, stderr)

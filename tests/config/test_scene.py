@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from vemkit.config.scene import Scene, load_scene, scene_from_dict, scene_from_yaml, scene_schema
-from vemkit.exceptions import SceneError
+from vemkit.exceptions import InputError, SceneError
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 
 # SPEC §6, "minimal form of the paper scene", verbatim.
@@ -103,7 +103,9 @@ def test_schema_ships_as_package_data_and_is_strict():
 
     found = list(objects(schema))
     assert len(found) > 8
-    assert all(node.get("additionalProperties") is False for node in found)
+    # every mapping is closed: fixed keys (additionalProperties false), or a map from side names
+    # (propertyNames) whose unknown sides the semantic checks refuse
+    assert all(node.get("additionalProperties") is False or "propertyNames" in node for node in found)
 
 
 def test_defaults_come_from_the_schema_and_the_filled_scene_validates(paper):
@@ -163,7 +165,6 @@ def test_overrides_change_the_scene(paper):
     ("foo=1", "foo"),
     ("material.G=1", "material.G"),
     ("contact.frction.k=1", "contact.frction"),
-    ("boundary.neumann.front={traction: [0, 0]}", "boundary.neumann.front"),
     ("material.E.x=1", "material.E"),
     ("body_force[2]=1", "body_force"),
     ("solver.method", "solver.method"),
@@ -315,3 +316,47 @@ def test_first_problem_in_file_order_is_reported():
     assert rejection(data).startswith("material.E = -1.0")
     assert Scene is type(scene_from_dict(SPEC_PAPER_SCENE))
     assert json.dumps(scene_from_dict(SPEC_PAPER_SCENE).data)  # plain data only
+
+
+def test_an_unknown_side_in_an_override_names_the_sides_of_the_domain():
+    """Side names belong to the domain (SPEC §7), so an override cannot know them: the scene check
+    refuses the unknown side and lists the valid ones."""
+    message = rejection(overrides=["boundary.neumann.front={traction: [0, 0]}"])
+    assert "'front'" in message and "left, right, bottom, top" in message
+
+
+# -- any domain (SPEC §7) -------------------------------------------------------------------------
+def _plate(**extra):
+    data = yaml.safe_load(PAPER.read_text())
+    data["domain"] = {"polygon": [[0, 0], [4, 0], [4, 2], [0, 2]], "sides": ["base", "right", "top", "left"],
+                      "holes": [{"circle": [2.0, 1.0, 0.4], "side": "hole"}]}
+    data["boundary"] = {"dirichlet": ["left"], "neumann": {"right": {"traction": [1.0, 0.0]}}, "contact": ["base"]}
+    data.update(extra)
+    return data
+
+
+def test_a_scene_describes_its_own_body_and_its_sides():
+    scene = scene_from_dict(_plate())
+    assert scene.sides == ("base", "right", "top", "left", "hole")
+    assert scene.neumann_sides == ("right",) and scene.contact_sides == ("base",)
+    with pytest.raises(SceneError, match=r"boundary.neumann.front: unknown boundary name 'front'; the domain has "
+                                         r"sides base, right, top, left, hole"):
+        scene_from_dict(_plate(boundary={"dirichlet": ["left"], "neumann": {"front": {"traction": [0, 0]}}}))
+
+
+@pytest.mark.parametrize("domain, says", [
+    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c"]}, "domain.sides"),
+    ({"polygon": [[0, 0], [0, 1], [1, 1], [1, 0]], "sides": ["a", "b", "c", "d"]}, "clockwise"),
+    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c", "d"],
+      "holes": [{"circle": [3.0, 3.0, 0.5], "side": "h"}]}, "domain.holes[0]"),
+    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c", "d"],
+      "holes": [{"circle": [0.5, 0.5, 0.0], "side": "h"}]}, "domain.holes[0]"),
+])
+def test_a_broken_body_is_refused_in_one_line(domain, says):
+    data = yaml.safe_load(PAPER.read_text())
+    data["domain"] = domain
+    data["boundary"] = {"dirichlet": ["a"], "neumann": {}, "contact": []}
+    data.pop("contact")
+    with pytest.raises(InputError) as caught:
+        scene_from_dict(data)
+    assert says in str(caught.value) and "\n" not in str(caught.value)

@@ -9,7 +9,7 @@ import shapely
 
 from vemkit.exceptions import InputError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.mesh.domain import UNIT_SQUARE, UNIT_SQUARE_SIDES, CircleHole, domain_from_spec
+from vemkit.config.domain import UNIT_SQUARE, UNIT_SQUARE_SIDES, CircleHole, domain_from_spec
 from vemkit.mesh.families import build_mesh
 from vemkit.vem.assembly import stiffness_matrix
 from vemkit.vem.elasticity import lame_parameters

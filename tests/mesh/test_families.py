@@ -8,7 +8,7 @@ from vemkit.mesh.families import FAMILIES, build_mesh
 from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
-from vemkit.mesh.domain import UNIT_SQUARE_SIDES
+from vemkit.config.domain import UNIT_SQUARE_SIDES
 from vemkit.mesh.checks import validate_mesh
 
 CASES = [

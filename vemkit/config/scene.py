@@ -22,6 +22,7 @@ import jsonschema
 import numpy as np
 import yaml
 
+from vemkit.config.domain import UNIT_SQUARE_SIDES, Domain, domain_from_spec
 from vemkit.config.expressions import Expression, compile_expression
 from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
 from vemkit.exceptions import ExpressionError, SceneError
@@ -29,8 +30,6 @@ from vemkit.exceptions import ExpressionError, SceneError
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
            "scene_schema"]
 
-# the unit square's sides, as vemkit.mesh.domain.UNIT_SQUARE_SIDES (config is the layer below mesh)
-DOMAIN_SIDES = {"unit_square": ("left", "right", "bottom", "top")}
 # points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
 _UNIT_SQUARE_SIDE_POINTS = {
     "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
@@ -102,6 +101,8 @@ def _apply_override(data: dict, override: str) -> None:
                 raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
                                  f"{_suggest(segment, node['properties'])}")
             node = _resolve(node["properties"][segment])
+        elif isinstance(node.get("additionalProperties"), dict):  # a map: side name -> entry
+            node = _resolve(node["additionalProperties"])
         elif "items" in node and segment.isdigit():
             node, segment = _resolve(node["items"]), int(segment)
         else:
@@ -161,13 +162,9 @@ def _document_order(data, error) -> tuple:
 def _schema_error_message(error, fix=_scene_fix) -> str:
     path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
     key, value = _key(path), error.instance
-    side_names = ", ".join(_validator().schema["$defs"]["side"]["enum"])
     if keyword == "additionalProperties":
         allowed = list(schema.get("properties", {}))
         extra = next(k for k in value if k not in allowed)
-        if key == "boundary.neumann":
-            return f"{key}.{extra}: unknown boundary name {extra!r}; the unit_square has sides " \
-                   f"{side_names}; fix the scene"
         return f"{_key([*path, extra])}: unknown key{_suggest(extra, allowed)}; {fix(None)}"
     if keyword == "required":
         missing = next(k for k in error.validator_value if k not in value)
@@ -178,9 +175,8 @@ def _schema_error_message(error, fix=_scene_fix) -> str:
                f"--set {_key([*path, missing])}=..."
     if keyword == "minItems" and key == "boundary.dirichlet":
         return f"boundary.dirichlet = []: {NO_DIRICHLET}"
-    if keyword == "enum" and schema == _validator().schema["$defs"]["side"]:
-        return f"{key} = {_show(value)}: unknown boundary name; the unit_square has sides " \
-               f"{side_names}; fix the scene or --set {key}=..."
+    if keyword == "pattern" and schema == _validator().schema["$defs"]["side"]:
+        return f"{key} = {_show(value)}: not a side name (letters, digits, _ and -); fix the scene"
     bound = error.validator_value
     if keyword == "type":
         types = [bound] if isinstance(bound, str) else bound
@@ -231,14 +227,17 @@ def _normalized(value, node: dict):
 
 def _semantic_checks(data: dict) -> dict:
     """Checks beyond the schema; returns the compiled expressions by key."""
-    sides = DOMAIN_SIDES[data["domain"]]
+    domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
+    sides = UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
     boundary = data["boundary"]
     owner = {}
     for part in ("dirichlet", "neumann", "contact"):
-        for side in boundary[part]:
+        for index, side in enumerate(boundary[part]):
             if side not in sides:
-                raise SceneError(f"boundary.{part}: unknown boundary name {side!r}; the "
-                                 f"{data['domain']} has sides {', '.join(sides)}")
+                where = f"boundary.{part}.{side}: unknown boundary name {side!r}" if part == "neumann" else \
+                    f"boundary.{part}[{index}] = {side!r}: unknown boundary name"
+                raise SceneError(f"{where}; the {_domain_name(data)} has sides {', '.join(sides)}; fix the scene",
+                                 key=f"boundary.{part}")
             if side in owner:
                 raise SceneError(f"boundary: side {side!r} is listed in both {owner[side]} and "
                                  f"{part}; a side has one boundary condition")
@@ -254,8 +253,12 @@ def _semantic_checks(data: dict) -> dict:
     s = (np.arange(_PROBES) + 0.5) / _PROBES
     inside = np.meshgrid(s, s)
     probes = [("body_force", data["body_force"], inside)]
+    if not domain.is_unit_square:
+        x0, y0, x1, y1 = domain.bounds
+        inside = (x0 + (x1 - x0) * inside[0], y0 + (y1 - y0) * inside[1])
+        probes = [("body_force", data["body_force"], inside)]
     for side, entry in boundary["neumann"].items():
-        points = _UNIT_SQUARE_SIDE_POINTS[side](s)
+        points = _side_points(domain, side, s)
         probes.append((f"boundary.neumann.{side}.traction", entry["traction"], points))
     compiled = {}
     for key, pair, points in probes:
@@ -265,7 +268,7 @@ def _semantic_checks(data: dict) -> dict:
     if "contact" in data:
         gap = compiled["contact.gap"] = _compile("contact.gap", data["contact"]["gap"])
         for side in boundary["contact"]:
-            x, y = _UNIT_SQUARE_SIDE_POINTS[side](np.linspace(0.0, 1.0, _PROBES + 1))
+            x, y = _side_points(domain, side, np.linspace(0.0, 1.0, _PROBES + 1))
             values = _evaluate(gap, (x, y))
             if values.min() < 0:
                 i = int(np.argmin(values))
@@ -273,6 +276,23 @@ def _semantic_checks(data: dict) -> dict:
                                  f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
                                  "g_a must be >= 0); fix the scene or --set contact.gap=...")
     return compiled
+
+
+def _domain_name(data) -> str:
+    return "unit_square" if data["domain"] == "unit_square" else "domain"
+
+
+def _side_points(domain: Domain, side: str, s: np.ndarray):
+    """Points (x, y) on a side at the parameters s of each of its edges (the unit square: as one
+    straight side)."""
+    if domain.is_unit_square:
+        return _UNIT_SQUARE_SIDE_POINTS[side](s)
+    x0, y0, x1, y1 = domain.bounds
+    polygonal = domain.discretize(max(x1 - x0, y1 - y0) / _PROBES)
+    segments = polygonal.segments[polygonal.segment_sides == side]
+    a, b = polygonal.points[segments[:, 0]], polygonal.points[segments[:, 1]]
+    points = (a[:, None, :] + s[None, :, None] * (b - a)[:, None, :]).reshape(-1, 2)
+    return points[:, 0], points[:, 1]
 
 
 def _compile(key: str, value) -> Expression:
@@ -356,7 +376,8 @@ class Scene:
     @property
     def sides(self) -> tuple:
         """All sides of the domain; sides not listed under boundary are traction-free."""
-        return DOMAIN_SIDES[self.domain]
+        domain = domain_from_spec(self.domain)
+        return UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
 
     def lame(self) -> tuple[float, float]:
         """``(lambda_star, mu)`` of the paper's plane-stress C: Eν/(1−ν²), E/(2(1+ν)) (SPEC §1)."""

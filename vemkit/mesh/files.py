@@ -36,7 +36,7 @@ import xugrid
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.mesh.domain import SIDE_NAME
+from vemkit.config.domain import SIDE_NAME
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
 

@@ -19,7 +19,7 @@ from functools import cached_property
 
 import numpy as np
 
-from vemkit.mesh.domain import UNIT_SQUARE_SIDE_LINES
+from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
 from vemkit.mesh.geometry import polygon_areas
 
 

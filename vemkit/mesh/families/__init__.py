@@ -24,7 +24,7 @@ from vemkit.mesh.families.square import square, structured_triangle
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
 from vemkit.exceptions import MeshError
-from vemkit.mesh.domain import cells_per_length, domain_from_spec
+from vemkit.config.domain import cells_per_length, domain_from_spec
 from vemkit.mesh.mesh import Mesh
 
 FAMILIES = ("square", "triangle", "voronoi", "hanging")
@@ -67,7 +67,7 @@ def build_mesh(family: str, n: float | None = None, *, domain=None, h: float | N
                cells: float | None = None, **options) -> Mesh:
     """The mesh of ``family`` on ``domain``, made with ``options``.
 
-    ``domain``: a :class:`~vemkit.mesh.domain.Domain`, its SPEC §7 mapping or None (the unit
+    ``domain``: a :class:`~vemkit.config.domain.Domain`, its SPEC §7 mapping or None (the unit
     square). Size: exactly one of ``n`` (cells per unit length, n = 1/h: about n² cells per unit
     area), ``h`` or ``cells`` (about that many cells). On the unit square with a whole n every
     family makes exactly the mesh it always made.
@@ -91,4 +91,5 @@ def scene_mesh(scene) -> Mesh:
     """The mesh a scene (``vemkit.config.Scene``) asks for."""
     opts = scene.mesh_options
     family, n = opts.pop("family"), opts.pop("n")
-    return build_mesh(family, n, **opts)  # options were checked by the scene schema and build_mesh
+    # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7)
+    return build_mesh(family, n, domain=scene.domain, **opts)

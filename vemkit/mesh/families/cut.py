@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from vemkit.mesh.domain import Domain, PolygonalDomain
+from vemkit.config.domain import Domain, PolygonalDomain
 from vemkit.mesh.families.polygons import Pieces, conforming_mesh, merge_small_cells, tag_sides, without_holes
 from vemkit.mesh.mesh import Mesh
 

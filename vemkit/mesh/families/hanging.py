@@ -14,7 +14,7 @@ boundary: the corners of its smaller neighbours are hanging nodes, so a coarse s
 5-, 6-, ... vertex polygon with collinear vertices (SPEC §3). Coordinates are computed on the
 integer grid of the finest possible level and divided once, so shared vertices coincide exactly.
 
-On any other domain (``domain=``, a :class:`~vemkit.mesh.domain.Domain`) the same refinement runs on
+On any other domain (``domain=``, a :class:`~vemkit.config.domain.Domain`) the same refinement runs on
 the squares of side 1/n that meet the domain (``contact_side``: any side name of the domain), and
 the refined squares are then cut to the domain (``cut.cut_hanging``).
 """
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.mesh.domain import UNIT_SQUARE, UNIT_SQUARE_SIDE_LINES, UNIT_SQUARE_SIDES
+from vemkit.config.domain import UNIT_SQUARE, UNIT_SQUARE_SIDE_LINES, UNIT_SQUARE_SIDES
 from vemkit.mesh.families.cut import cut_hanging, quadrisect
 from vemkit.mesh.mesh import Mesh, tag_box_boundary
 
@@ -34,7 +34,7 @@ def hanging(n: int, levels: int = 1, rule: str = "contact", seed: int = 0, fract
             contact_side: str = "bottom", domain=None) -> Mesh:
     """n x n squares refined ``levels`` times by ``rule`` ("contact" or "random").
 
-    On a :class:`~vemkit.mesh.domain.Domain` other than the unit square (or with n not an
+    On a :class:`~vemkit.config.domain.Domain` other than the unit square (or with n not an
     integer): squares of side 1/n over the domain, refined, then cut (``cut.cut_hanging``).
     """
     levels = int(levels)

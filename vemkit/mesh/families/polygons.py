@@ -19,7 +19,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from vemkit.mesh.domain import PolygonalDomain
+from vemkit.config.domain import PolygonalDomain
 from vemkit.mesh.geometry import bin_boxes, counter_clockwise
 from vemkit.mesh.mesh import Mesh
 

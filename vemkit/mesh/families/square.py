@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.mesh.domain import UNIT_SQUARE, UNIT_SQUARE_SIDE_LINES
+from vemkit.config.domain import UNIT_SQUARE, UNIT_SQUARE_SIDE_LINES
 from vemkit.mesh.families.cut import cut_squares
 from vemkit.mesh.mesh import Mesh
 
@@ -33,7 +33,7 @@ def _box_sides(n: int) -> dict:
 def square(n: int, domain=None) -> Mesh:
     """n x n axis-aligned squares of side h = 1/n.
 
-    On a :class:`~vemkit.mesh.domain.Domain` other than the unit square (or with n not an
+    On a :class:`~vemkit.config.domain.Domain` other than the unit square (or with n not an
     integer): the grid of squares of side 1/n clipped to the domain (cut cells, ``cut.cut_squares``).
     """
     if (domain is not None and not domain.is_unit_square) or not float(n).is_integer():

@@ -12,7 +12,7 @@ apart compared with the mesh size, so they change the mesh without spoiling its 
 same (n, seed, min_angle) always gives the same mesh. Below n = 4 there is no room for them and
 the seed has no effect.
 
-On any other domain (:class:`~vemkit.mesh.domain.Domain`) the input is every side of the outer
+On any other domain (:class:`~vemkit.config.domain.Domain`) the input is every side of the outer
 polygon and of the holes as segments (circles as polygons with edges of about h = 1/n), a point
 inside every hole, and about ``n √area`` seeded points on a coarse jittered grid kept at least
 1/n inside the domain; the target is ``round(2 n² · area)`` triangles. Triangle may split a
@@ -25,7 +25,7 @@ import numpy as np
 import shapely
 import triangle as shewchuk
 
-from vemkit.mesh.domain import UNIT_SQUARE_CORNERS
+from vemkit.config.domain import UNIT_SQUARE_CORNERS
 from vemkit.mesh.families.polygons import tag_sides
 from vemkit.mesh.mesh import Mesh, tag_box_boundary
 
@@ -36,7 +36,7 @@ _MAX_AREA_ROUNDS = 12
 
 def delaunay_triangle(n: float, seed: int = 0, min_angle: float = 28.0, domain=None) -> Mesh:
     """About ``round(2 n² · area)`` quality Delaunay triangles (no angle below ``min_angle`` degrees)
-    of ``domain`` (a :class:`~vemkit.mesh.domain.Domain`; default the unit square)."""
+    of ``domain`` (a :class:`~vemkit.config.domain.Domain`; default the unit square)."""
     if not 0.0 < min_angle <= 33.0:
         raise ValueError(f"min_angle = {min_angle}: Triangle guarantees quality only for 0 < min_angle <= 33 degrees")
     if domain is None or domain.is_unit_square:

@@ -14,7 +14,7 @@ keep its circumcentres as vertices; clipped cells get their new vertices from sh
 merged by distance (``merge_tol · h``, h the mean cell size), which makes the mesh conforming
 and removes edges shorter than that tolerance (they collapse to a point).
 
-Holes (a :class:`~vemkit.mesh.domain.Domain`; circles as polygons with edges of about 1/n):
+Holes (a :class:`~vemkit.config.domain.Domain`; circles as polygons with edges of about 1/n):
 a cell is inside when its vertices are and the domain's boundary does not pass through it; a
 clipped piece that would enclose a whole hole is cut in two through the hole. Every boundary edge
 takes the name of the side it lies on.
@@ -33,7 +33,7 @@ import shapely
 import triangle as shewchuk
 
 from vemkit.mesh.geometry import areas_centroids, bin_boxes, counter_clockwise, ranges
-from vemkit.mesh.domain import Domain
+from vemkit.config.domain import Domain
 from vemkit.mesh.families.polygons import merged_mesh, tag_sides, without_holes
 from vemkit.mesh.mesh import Mesh, tag_box_boundary
 
@@ -44,7 +44,7 @@ def voronoi(n: float, seed: int = 0, lloyd_iterations: int = 30, domain=None, an
             merge_tol: float = 1e-9) -> Mesh:
     """About ``n²`` centroidal Voronoi cells per unit area of ``domain``.
 
-    ``domain``: a :class:`~vemkit.mesh.domain.Domain` (holes allowed; boundary parts named by its
+    ``domain``: a :class:`~vemkit.config.domain.Domain` (holes allowed; boundary parts named by its
     sides), a shapely Polygon without holes (one boundary part ``boundary``) or None (unit square).
     """
     n = int(n) if float(n).is_integer() else float(n)
