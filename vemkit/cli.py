@@ -2,6 +2,7 @@
 
     vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
     vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu] [--max-dofs N] [-q]
+    vemkit mesh --scene SCENE.yaml -o MESH.nc [--set key.path=value ...] [--vtu MESH.vtu] [-q]
 
 Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy).
 Any failure is one line ``vemkit: error: ...`` naming the input and the fix, exit status 2: a bad
@@ -106,22 +107,45 @@ def cmd_solve(args) -> int:
     return 0
 
 
-def cmd_mesh(args) -> int:
+def _family_mesh(args):
+    """The mesh of ``vemkit mesh FAMILY N [--option ...]`` (unit square), resources checked first."""
     from vemkit.config.limits import check_resources, estimate_mesh, estimate_resources
     from vemkit.config.mesh_options import mesh_request
 
-    output, vtu = _outputs(args, [])
+    if args.family is None or args.n is None or args.set:
+        raise InputError("vemkit mesh: give FAMILY N (the unit square) or --scene SCENE.yaml [--set ...], "
+                         "not both", key="arguments")
     options = mesh_request(args.family, args.n, args.option or ())
     estimate = estimate_resources(*estimate_mesh(options))  # before anything is built
     family, n = options.pop("family"), options.pop("n")
     check_resources(estimate, args.max_dofs, what=f"the {family} mesh with N = {n}", fix="a smaller N")
+    from vemkit.mesh.families import build_mesh
+
+    return build_mesh(family, n, **options), family
+
+
+def _scene_mesh(args):
+    """The mesh a scene's discretization.mesh and domain ask for (SPEC §8: vemkit mesh --scene)."""
+    from vemkit.config.limits import check_scene_resources
+    from vemkit.config.scene import load_scene
+    from vemkit.mesh.families import scene_mesh
+
+    if args.family is not None or args.n is not None or args.option:
+        raise InputError("vemkit mesh --scene takes the mesh from the scene: drop FAMILY N and --option "
+                         "(use --set discretization.mesh.KEY=VALUE)", key="arguments")
+    scene = load_scene(args.scene, args.set or ())
+    check_scene_resources(scene, args.max_dofs)
+    return scene_mesh(scene), scene.mesh_options["family"]
+
+
+def cmd_mesh(args) -> int:
+    output, vtu = _outputs(args, [args.scene] if args.scene else [])
+    mesh, family = _scene_mesh(args) if args.scene else _family_mesh(args)
 
     from vemkit.io.output_files import atomic_outputs
     from vemkit.mesh.checks import validate_mesh
-    from vemkit.mesh.families import build_mesh
     from vemkit.mesh.files import write_ugrid, write_vtu
 
-    mesh = build_mesh(family, n, **options)
     validate_mesh(mesh)
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_ugrid(mesh, output_part)
@@ -165,9 +189,12 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--max-dofs", **limit)
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress display and no summary line")
     solve.set_defaults(func=cmd_solve)
-    mesh = sub.add_parser("mesh", help="build a mesh of a family and write it as UGRID netCDF")
-    mesh.add_argument("family", help="square, triangle, voronoi or hanging")
-    mesh.add_argument("n", type=int, help="cells per side (h = 1/n)")
+    mesh = sub.add_parser("mesh", help="build a mesh (of a family on the unit square, or of a scene's body) "
+                                       "and write it as UGRID netCDF")
+    mesh.add_argument("family", nargs="?", help="square, triangle, voronoi or hanging")
+    mesh.add_argument("n", nargs="?", type=int, help="cells per side (h = 1/n)")
+    mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead (SPEC §8)")
+    mesh.add_argument("--set", action="append", metavar="KEY=VALUE", help="with --scene: override a scene value")
     mesh.add_argument("-o", "--output", required=True, help="mesh file (netCDF4, UGRID)")
     mesh.add_argument("--option", action="append", metavar="KEY=VALUE", help="family option, e.g. seed=3, kind=delaunay")
     mesh.add_argument("--vtu", help="also write a VTU file")

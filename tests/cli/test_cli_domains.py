@@ -26,3 +26,30 @@ def test_cooks_membrane_meets_the_published_displacement(tmp_path, family):
     mid = np.argmin(np.where(on_edge, np.abs(y - 52.0), np.inf))
     assert abs(y[mid] - 52.0) < 0.5
     assert abs(v[mid] - REFERENCE) < 0.02 * REFERENCE
+
+
+def _vemkit(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd)
+
+
+@pytest.mark.parametrize("family", ["square", "voronoi"])
+def test_vemkit_mesh_scene_meshes_the_body_with_its_sides(tmp_path, family):
+    from vemkit.mesh.files import read_ugrid
+
+    out = tmp_path / "cook-mesh.nc"
+    run = _vemkit("mesh", "--scene", COOK, "-o", out, "-q", "--set", f"discretization.mesh.family={family}")
+    assert run.returncode == 0, run.stderr
+    mesh = read_ugrid(out)
+    assert set(mesh.boundary) == {"bottom", "load", "top", "clamped"}
+    assert np.isclose(mesh.cell_areas.sum(), 1440.0)  # the shoelace area of Cook's panel
+    loaded = mesh.vertices[np.unique(mesh.boundary["load"])]
+    assert np.allclose(loaded[:, 0], 48.0) and np.isclose(np.ptp(loaded[:, 1]), 16.0)
+
+
+@pytest.mark.parametrize("args", [["-o", "m.nc"], ["square", "4", "--scene", COOK, "-o", "m.nc"],
+                                  ["square", "4", "--set", "discretization.mesh.n=3", "-o", "m.nc"]])
+def test_vemkit_mesh_wants_a_family_or_a_scene_not_both(tmp_path, args):
+    run = _vemkit("mesh", *args, cwd=tmp_path)
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
+    assert run.stderr.startswith("vemkit: error: vemkit mesh") and not (tmp_path / "m.nc").exists()
