@@ -13,16 +13,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import resource
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-OUT = Path(__file__).resolve().parent / "out"
+from _common import MACHINE, OUT
 
 
 def best_of(fn, repeat):
@@ -123,7 +121,7 @@ def main():
         solves.append(json.loads(out.stdout.strip().splitlines()[-1]))
     record = {
         "command": "python benchmarks/assembly.py" + (" --quick" if args.quick else ""),
-        "machine": f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}",
+        "machine": MACHINE,
         "assembly": assembly, "speedup_vs_scikit_fem": speedup, "linear_solves": solves,
         "targets": {"speedup >= 10": speedup >= 10, "1024^2 squares <= 2 s": (not args.quick) and assembly[2]["seconds"] <= 2.0,
                     "h = 2^-8 solve <= 2 s": (not args.quick) and solves[0]["total_s"] <= 2.0,

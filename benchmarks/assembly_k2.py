@@ -11,14 +11,10 @@ both recorded, because the machine may be shared: CPU time per dof is the steadi
 
 from __future__ import annotations
 
-import argparse
-import json
-import platform
 import time
-from pathlib import Path
 
 
-OUT = Path(__file__).resolve().parent / "out"
+from _common import MACHINE, quick_parser, targets_line, write_report
 
 
 def timed(fn, repeat):
@@ -60,19 +56,13 @@ def case(n: int, repeat: int) -> dict:
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="64^2 and 128^2 (a smoke test, not the target)")
-    parser.add_argument("--repeat", type=int, default=5)
-    args = parser.parse_args()
+    args = quick_parser(__doc__, "64^2 and 128^2", repeat=5).parse_args()
     sizes = [64, 128] if args.quick else [256, 512]
     rows = [case(n, args.repeat) for n in sizes]
     command = "python benchmarks/assembly_k2.py" + (" --quick" if args.quick else "") + f" --repeat {args.repeat}"
     met = {f"{r['mesh']}: k2/k1 wall time per dof <= 2": r["wall_ratio_per_dof"] <= 2.0 for r in rows}
     met.update({f"{r['mesh']}: k2/k1 CPU time per dof <= 2": r["cpu_ratio_per_dof"] <= 2.0 for r in rows})
-    record = {"command": command, "machine": f"{platform.machine()}, {platform.python_implementation()} "
-              f"{platform.python_version()}", "cases": rows, "targets": met}
-    OUT.mkdir(exist_ok=True)
-    (OUT / "assembly_k2.json").write_text(json.dumps(record, indent=2))
+    record = {"command": command, "machine": MACHINE, "cases": rows, "targets": met}
     lines = ["# k = 2 against k = 1 assembly (time per dof)", "", f"`{command}` on {record['machine']}", "",
              "| mesh | k | dofs | nnz | wall s | CPU s | wall us/dof | CPU us/dof |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -82,9 +72,8 @@ def main():
                          f"{x['wall_us_per_dof']:.3f} | {x['cpu_us_per_dof']:.3f} |")
     lines += ["", "| mesh | k2/k1 wall per dof | k2/k1 CPU per dof |", "|---|---|---|"]
     lines += [f"| {r['mesh']} | {r['wall_ratio_per_dof']:.2f} | {r['cpu_ratio_per_dof']:.2f} |" for r in rows]
-    lines += ["", "Targets: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in met.items())]
-    (OUT / "assembly_k2.md").write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    lines += ["", targets_line(met)]
+    write_report("assembly_k2", record, lines)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import resource
 import subprocess
 import sys
@@ -20,7 +19,7 @@ import time
 from pathlib import Path
 
 
-OUT = Path(__file__).resolve().parent / "out"
+from _common import MACHINE, OUT
 PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
 
 
@@ -84,7 +83,7 @@ def main():
         }
     record = {
         "command": "python benchmarks/contact.py" + (" --quick" if args.quick else ""),
-        "machine": f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}",
+        "machine": MACHINE,
         "rows": rows, "targets": targets,
     }
     OUT.mkdir(exist_ok=True)

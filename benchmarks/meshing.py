@@ -11,16 +11,12 @@ its largest neighbour's. Target: <= 10 s per family.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import platform
 import time
-from pathlib import Path
 
 import numpy as np
 
-OUT = Path(__file__).resolve().parent / "out"
+from _common import MACHINE, quick_parser, targets_line, write_report
 PLATE = {
     "polygon": [[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]],
     "sides": ["bottom", "right", "top", "left"],
@@ -64,20 +60,15 @@ def case(family: str, options: dict, cells: int, repeat: int) -> dict:
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="10 000 cells (a smoke test, not the target)")
-    parser.add_argument("--repeat", type=int, default=2)
-    args = parser.parse_args()
+    args = quick_parser(__doc__, "10 000 cells", repeat=2).parse_args()
     cells = 10_000 if args.quick else 100_000
     results = [case(family, options, cells, args.repeat) for family, options in FAMILIES]
     record = {
         "command": "python benchmarks/meshing.py" + (" --quick" if args.quick else ""),
-        "machine": f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}",
+        "machine": MACHINE,
         "domain": PLATE, "results": results, "load_average": [round(x, 2) for x in os.getloadavg()],
         "targets": {f"{r['family']} <= 10 s": (not args.quick) and r["seconds"] <= 10.0 for r in results},
     }
-    OUT.mkdir(exist_ok=True)
-    (OUT / "meshing.json").write_text(json.dumps(record, indent=2))
     lines = ["# Meshing benchmark: a plate with three circular holes", "", f"`{record['command']}` on {record['machine']}",
              "", "| family | options | cells | vertices | seconds | CPU seconds | validate_mesh s | worst area ratio |",
              "|---|---|---|---|---|---|---|---|"]
@@ -87,9 +78,8 @@ def main():
                      f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {'' if ratio is None else f'{ratio:.3f}'} |")
     lines += ["", f"Load average while running (1, 5, 15 min): {record['load_average']}. On a shared machine "
               "the wall time includes waiting for a core; the CPU time is the process's own.",
-              "", "Targets (wall time): " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in record["targets"].items())]
-    (OUT / "meshing.md").write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+              "", targets_line(record["targets"], "Targets (wall time)")]
+    write_report("meshing", record, lines)
 
 
 if __name__ == "__main__":

@@ -64,6 +64,17 @@ def nonconvex_mesh():
     return mesh
 
 
+def assert_no_nan_stored(path) -> None:
+    """Every float variable of a netCDF file holds finite numbers (undefined entries: _FillValue)."""
+    import netCDF4
+
+    with netCDF4.Dataset(path) as nc:
+        nc.set_auto_mask(False)
+        for name, var in nc.variables.items():
+            if var.dtype is not str and var.dtype.kind == "f":
+                assert np.all(np.isfinite(var[:])), name
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)

@@ -1,0 +1,32 @@
+"""Shared by the benchmark scripts: the machine they ran on, the command line, the output files."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+from pathlib import Path
+
+OUT = Path(__file__).resolve().parent / "out"  # ignored by git
+MACHINE = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
+
+
+def quick_parser(doc: str, quick_help: str, repeat: int | None = None) -> argparse.ArgumentParser:
+    """--quick (a smoke test, not the target) and, if given, --repeat (best of how many runs)."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help=f"{quick_help} (a smoke test, not the target)")
+    if repeat is not None:
+        parser.add_argument("--repeat", type=int, default=repeat)
+    return parser
+
+
+def write_report(name: str, record: dict, lines: list) -> None:
+    """benchmarks/out/NAME.json (the record) and NAME.md (the lines), and the lines on stdout."""
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / f"{name}.json").write_text(json.dumps(record, indent=2))
+    (OUT / f"{name}.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def targets_line(targets: dict, prefix: str = "Targets") -> str:
+    return f"{prefix}: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in targets.items())
