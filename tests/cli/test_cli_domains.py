@@ -53,3 +53,21 @@ def test_vemkit_mesh_wants_a_family_or_a_scene_not_both(tmp_path, args):
     run = _vemkit("mesh", *args, cwd=tmp_path)
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
     assert run.stderr.startswith("vemkit: error: vemkit mesh") and not (tmp_path / "m.nc").exists()
+
+
+def test_a_scene_solves_on_a_mesh_file_named_relative_to_it(tmp_path):
+    """SPEC §8: `vemkit mesh --scene` writes Cook's mesh, a scene in another folder names it by a
+    relative path and solves to the same displacement as meshing the scene itself."""
+    folder = tmp_path / "study"
+    folder.mkdir()
+    assert _vemkit("mesh", "--scene", COOK, "-o", folder / "cook-mesh.nc", "-q").returncode == 0
+    text = COOK.read_text().replace("mesh: {family: square, n: 1}", "mesh: {file: cook-mesh.nc}")
+    (folder / "cook-file.yaml").write_text(text)
+    solved = [_vemkit("solve", scene, "-o", tmp_path / f"{name}.nc", "-q", cwd=tmp_path)
+              for name, scene in (("family", COOK), ("file", folder / "cook-file.yaml"))]
+    assert all(run.returncode == 0 for run in solved), [run.stderr for run in solved]
+    with xr.open_dataset(tmp_path / "family.nc") as a, xr.open_dataset(tmp_path / "file.nc") as b:
+        np.testing.assert_allclose(a["u2"].values, b["u2"].values, rtol=1e-12)
+    missing = _vemkit("solve", COOK, "-o", tmp_path / "x.nc", "--set", "discretization.mesh={file: nowhere.msh}")
+    assert missing.returncode == 2 and "nowhere.msh: no such mesh file" in missing.stderr
+    assert len(missing.stderr.splitlines()) == 1 and not (tmp_path / "x.nc").exists()

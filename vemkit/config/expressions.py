@@ -22,9 +22,9 @@ import numpy as np
 
 from vemkit.exceptions import ExpressionError
 
-__all__ = ["Expression", "ExpressionError", "compile_expression"]
+__all__ = ["Expression", "ExpressionError", "compile_expression", "vector_field"]
 
-MAX_EXPRESSION_LENGTH = 500
+MAX_EXPRESSION_LENGTH = 2000
 MAX_NESTING_DEPTH = 100
 VARIABLES = ("x", "y")
 CONSTANTS = {"pi": math.pi}
@@ -252,3 +252,9 @@ def compile_expression(value, *, name: str = "expression") -> Expression:
             raise compiler.fail(f"evaluates to {compiled}; the expression must be finite", hint=False)
         return Expression(text, name, variables, compiled, None)
     return Expression(text, name, variables, None, compiled)
+
+
+def vector_field(expressions):
+    """(fx, fy) Expressions as one field (x, y) -> (fx(x, y), fy(x, y)) (each broadcast to x, y)."""
+    fx, fy = expressions
+    return lambda x, y: (fx(x, y), fy(x, y))

@@ -19,26 +19,19 @@ from pathlib import Path
 from typing import NamedTuple
 
 import jsonschema
-import numpy as np
 import yaml
 
-from vemkit.config.domain import UNIT_SQUARE_SIDES, Domain, domain_from_spec
-from vemkit.config.expressions import Expression, compile_expression
+from vemkit.config.boundary_conditions import (boundary_expressions, check_contact,
+                                               check_mesh_size, check_sides, compile_checked,
+                                               evaluate_checked, inside_points)
+from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
+from vemkit.config.expressions import Expression
 from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
-from vemkit.exceptions import ExpressionError, SceneError
+from vemkit.exceptions import SceneError
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
            "scene_schema"]
 
-# points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
-_UNIT_SQUARE_SIDE_POINTS = {
-    "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
-    "bottom": lambda s: (s, 0.0 * s), "top": lambda s: (s, 0.0 * s + 1.0),
-}
-#: contact.normal.k / material.E above this is refused (README "Input rules and limits"): measured,
-#: ssn's independent check is 5e-9 at k/E = 5e8 and fails at 5e11 (paper scene, n = 8)
-MAX_NORMAL_K_OVER_E = 1e9
-_PROBES = 16  # points per side (and per direction inside) where expressions are test-evaluated
 NO_DIRICHLET = "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]"
 _TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
                "object": "a mapping", "array": "a list", "null": "null", "boolean": "true/false"}
@@ -86,6 +79,11 @@ def _show(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+#: an override of discretization.mesh.KEY removes these keys: one size (SPEC §7), or a file
+_MESH_SIZE_KEYS = {"n": ("h", "cells", "file"), "h": ("n", "cells", "file"), "cells": ("n", "h", "file"),
+                   "file": ("n", "h", "cells", "family")}
+
+
 # -- overrides -----------------------------------------------------------------------------------
 def _apply_override(data: dict, override: str) -> None:
     """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema."""
@@ -117,6 +115,9 @@ def _apply_override(data: dict, override: str) -> None:
         if segments[position + 1:]:
             container = container[segment]
         else:
+            if path[:2] == ["discretization", "mesh"] and segment in _MESH_SIZE_KEYS:
+                for other in _MESH_SIZE_KEYS[segment]:  # a new size replaces the scene's own
+                    container.pop(other, None)
             container[segment] = value
 
 
@@ -225,88 +226,22 @@ def _normalized(value, node: dict):
     return value
 
 
-def _semantic_checks(data: dict) -> dict:
-    """Checks beyond the schema; returns the compiled expressions by key."""
+def _semantic_checks(data: dict, given: dict) -> dict:
+    """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
+    written (before the defaults were filled in)."""
+    check_mesh_size(data["discretization"]["mesh"])
     domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
-    sides = UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
-    boundary = data["boundary"]
-    owner = {}
-    for part in ("dirichlet", "neumann", "contact"):
-        for index, side in enumerate(boundary[part]):
-            if side not in sides:
-                where = f"boundary.{part}.{side}: unknown boundary name {side!r}" if part == "neumann" else \
-                    f"boundary.{part}[{index}] = {side!r}: unknown boundary name"
-                raise SceneError(f"{where}; the {_domain_name(data)} has sides {', '.join(sides)}; fix the scene",
-                                 key=f"boundary.{part}")
-            if side in owner:
-                raise SceneError(f"boundary: side {side!r} is listed in both {owner[side]} and "
-                                 f"{part}; a side has one boundary condition")
-            owner[side] = part
-    if boundary["contact"] and "contact" not in data:
-        raise SceneError(f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
-                         "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}")
-    if "contact" in data and data["contact"]["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
-        raise SceneError(f"contact.normal.k = {data['contact']['normal']['k']:g}: must be at most "
-                         f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "
-                         "(stiffer is rigid contact, beyond double precision); fix the scene or "
-                         "--set contact.normal.k=...", key="contact.normal.k")
-    s = (np.arange(_PROBES) + 0.5) / _PROBES
-    inside = np.meshgrid(s, s)
-    probes = [("body_force", data["body_force"], inside)]
-    if not domain.is_unit_square:
-        x0, y0, x1, y1 = domain.bounds
-        inside = (x0 + (x1 - x0) * inside[0], y0 + (y1 - y0) * inside[1])
-        probes = [("body_force", data["body_force"], inside)]
-    for side, entry in boundary["neumann"].items():
-        points = _side_points(domain, side, s)
-        probes.append((f"boundary.neumann.{side}.traction", entry["traction"], points))
-    compiled = {}
-    for key, pair, points in probes:
-        compiled[key] = tuple(_compile(f"{key}[{i}]", pair[i]) for i in (0, 1))
-        for expression in compiled[key]:
-            _evaluate(expression, points)
+    from_file = "file" in data["discretization"]["mesh"]
+    check_sides(data, None if from_file else
+                 (UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names))
+    probed = None if from_file else domain
+    compiled = boundary_expressions(data, probed)
+    compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", data["body_force"][i]) for i in (0, 1))
+    for expression in compiled["body_force"]:
+        evaluate_checked(expression, inside_points(domain))
     if "contact" in data:
-        gap = compiled["contact.gap"] = _compile("contact.gap", data["contact"]["gap"])
-        for side in boundary["contact"]:
-            x, y = _side_points(domain, side, np.linspace(0.0, 1.0, _PROBES + 1))
-            values = _evaluate(gap, (x, y))
-            if values.min() < 0:
-                i = int(np.argmin(values))
-                raise SceneError(f"contact.gap = {_show(data['contact']['gap'])}: is {values[i]:.6g} "
-                                 f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
-                                 "g_a must be >= 0); fix the scene or --set contact.gap=...")
+        check_contact(data, given.get("contact", {}), probed, compiled)
     return compiled
-
-
-def _domain_name(data) -> str:
-    return "unit_square" if data["domain"] == "unit_square" else "domain"
-
-
-def _side_points(domain: Domain, side: str, s: np.ndarray):
-    """Points (x, y) on a side at the parameters s of each of its edges (the unit square: as one
-    straight side)."""
-    if domain.is_unit_square:
-        return _UNIT_SQUARE_SIDE_POINTS[side](s)
-    x0, y0, x1, y1 = domain.bounds
-    polygonal = domain.discretize(max(x1 - x0, y1 - y0) / _PROBES)
-    segments = polygonal.segments[polygonal.segment_sides == side]
-    a, b = polygonal.points[segments[:, 0]], polygonal.points[segments[:, 1]]
-    points = (a[:, None, :] + s[None, :, None] * (b - a)[:, None, :]).reshape(-1, 2)
-    return points[:, 0], points[:, 1]
-
-
-def _compile(key: str, value) -> Expression:
-    try:
-        return compile_expression(value, name=key)
-    except ExpressionError as error:
-        raise SceneError(str(error)) from None
-
-
-def _evaluate(expression: Expression, points) -> np.ndarray:
-    try:
-        return expression(*points)
-    except ExpressionError as error:
-        raise SceneError(str(error)) from None
 
 
 # -- the scene -----------------------------------------------------------------------------------
@@ -364,10 +299,14 @@ class Scene:
     contact_quadrature = _field("discretization", "contact_quadrature")
     contact_gauss_points = _field("discretization", "contact_gauss_points",
                                   doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
+    order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
     mesh_options = _field("discretization", "mesh", convert=dict,
-                          doc="discretization.mesh: family, n and the family options given (a copy)")
+                          doc="discretization.mesh: family, n / h / cells (or file) and the family "
+                              "options given (a copy)")
     solver_options = _field("solver", convert=dict,
                             doc="solver, defaults filled; rho/eps_u/eps_lambda may be None (a copy)")
+    adaptivity_options = _field("adaptivity", convert=copy.deepcopy,
+                                doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)")
     body_force = property(lambda self: self._expressions["body_force"],
                           doc="(Expression, Expression): the volume force f1")
     gap_expression = property(lambda self: self._expressions.get("contact.gap"),
@@ -384,12 +323,42 @@ class Scene:
         return self.E * self.nu / (1.0 - self.nu**2), self.E / (2.0 * (1.0 + self.nu))
 
     def traction(self, side: str) -> tuple[Expression, Expression]:
-        """The prescribed traction f2 on a Neumann side; KeyError for other sides."""
+        """The prescribed traction f2 on a Neumann side; KeyError for other sides (and pressure sides)."""
         key = f"boundary.neumann.{side}.traction"
         if key not in self._expressions:
-            raise KeyError(f"{side!r} is not a Neumann side of this scene "
+            raise KeyError(f"{side!r} is not a Neumann side with a traction in this scene "
                            f"(neumann sides: {', '.join(self.neumann_sides) or 'none'})")
         return self._expressions[key]
+
+    def pressure(self, side: str) -> Expression | None:
+        """The normal pressure p of a Neumann side (traction = -p nu); None for a traction side."""
+        return self._expressions.get(f"boundary.neumann.{side}.pressure")
+
+    @property
+    def dirichlet(self) -> dict:
+        """side -> (u1, u2) prescribed on Gamma_D: Expressions, None for a free component (SPEC §7)."""
+        return {side: self._expressions[f"boundary.dirichlet.{side}"] for side in self.dirichlet_sides}
+
+    @property
+    def exact_displacement(self) -> tuple[Expression, Expression] | None:
+        """The scene's exact displacement (SPEC §7 ``exact:``), None if it gives none."""
+        return self._expressions.get("exact.displacement")
+
+    @property
+    def foundation(self) -> tuple | None:
+        """((x, y), (n_x, n_y)): a point of the foundation line and its normal towards the body;
+        None when the gap is given as an expression."""
+        line = self._data.get("contact", {}).get("foundation")
+        return None if line is None else (tuple(line["point"]), tuple(line["normal"]))
+
+    @property
+    def mesh_file(self) -> Path | None:
+        """discretization.mesh.file resolved against the scene file's folder (SPEC §8), or None."""
+        name = self._data["discretization"]["mesh"].get("file")
+        if name is None:
+            return None
+        folder = Path(self.source).parent if self.source and not self.source.startswith("<") else Path(".")
+        return folder / name
 
     normal_compliance = property(lambda self: self._contact_law("normal"),
                                  doc="PowerLaw p_nu(t) = k (t)_+^m; None without contact section")
@@ -423,7 +392,7 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
         _apply_override(data, override)
     _validate(data)
     normalized = _normalized(data, _validator().schema)
-    expressions = _semantic_checks(normalized)
+    expressions = _semantic_checks(normalized, data)
     return Scene(normalized, expressions, source)
 
 

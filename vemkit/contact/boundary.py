@@ -3,8 +3,9 @@
 ``nodal`` quadrature (SPEC §3): each Gamma_C vertex gets half the length of each adjacent contact
 edge as weight; the outward normal of a vertex is the length-weighted mean of the outward
 normals of its contact edges (exact on straight parts), the tangent is tau = (-nu_2, nu_1)
-(on the bottom edge nu = (0, -1), tau = (1, 0)). Clamped vertices are dropped: their
-displacement is zero and they carry no unknown.
+(on the bottom edge nu = (0, -1), tau = (1, 0)). Vertices with a Dirichlet condition (clamped,
+or a prescribed component) are dropped: they belong to the closure of Gamma_D, and their
+displacement is given.
 
 ``gauss`` quadrature (``contact_gauss_points`` N per edge): the normal-compliance term of (3.16),
 
@@ -13,7 +14,7 @@ displacement is zero and they carry no unknown.
 with t = u_h . nu_e - g interpolated linearly along each edge e between its two end values
 (phi_a the hat functions of the ends, nu_e the edge normal: the normal of a straight edge, which is
 also the vertex normal of the nodal rule on straight parts), and Gauss-Legendre points s_q,
-weights w_q on [0, 1]. A clamped end keeps u = 0 and its own gap. Its consistent linearization is
+weights w_q on [0, 1]. A dropped end keeps its prescribed displacement and its own gap. Its consistent linearization is
 sum_q |e| w_q p_nu'(t_eq) phi_a phi_b nu_e nu_e^T, coupling the two ends of an edge (no longer
 one block per vertex). On a constant penetration along an edge both rules give the same force.
 
@@ -77,6 +78,8 @@ class ContactBoundary:
     edge_coords: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))  # (n_e, end, xy)
     gauss_points: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) on [0, 1]
     gauss_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) summing to 1
+    # (n_e, 2) prescribed u . nu_e at dropped (Dirichlet) edge ends, 0 at contact vertices
+    edge_prescribed: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def __post_init__(self):
         if self.quadrature not in QUADRATURES:
@@ -108,9 +111,10 @@ class ContactBoundary:
         return out
 
     def with_gap(self, gap) -> "ContactBoundary":
-        """This boundary with another gap, gap(x, y) -> array (at the vertices and the clamped edge ends)."""
-        g = _gap_values(gap, self.coords)
-        return replace(self, gap=g, edge_gap=_edge_gaps(gap, self.edge_coords, self.edge_vertex, g))
+        """This boundary with another gap, gap(x, y) -> array or a FoundationLine (at the vertices and
+        the dropped edge ends)."""
+        g = _gap_values(gap, self.coords, self.normal)
+        return replace(self, gap=g, edge_gap=_edge_gaps(gap, self.edge_coords, self.edge_vertex, g, self.edge_normal))
 
     # -- the normal-compliance term and its linearization (nodal or gauss) ----------------------------
     def contact_force(self, u, law, multiplier):
@@ -170,7 +174,7 @@ class ContactBoundary:
         """(n_e, n_q) u_nu - g at the Gauss points, both linear along each edge."""
         u_padded = np.append(u, 0.0)
         end_u = u_padded[self._edge_dofs(u.size)]  # (n_e, 2, 2); u = 0 at clamped ends
-        ends = np.einsum("eai,ei->ea", end_u, self.edge_normal) - self.edge_gap
+        ends = np.einsum("eai,ei->ea", end_u, self.edge_normal) + self.edge_prescribed - self.edge_gap
         return ends @ self._shape().T
 
     def _edge_cap(self, cap):
@@ -184,20 +188,43 @@ class ContactBoundary:
 
 
 
-def _gap_values(gap, coords, check=True):
-    g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (coords.shape[0],)).copy()
+class FoundationLine:
+    """The foundation as a line (SPEC §7 ``contact.foundation``): the gap of a boundary point x with
+    outward normal nu is the distance from x along nu to the line, d / cos with d = (x - point) . n
+    (n the unit normal of the line towards the body) and cos = -nu . n; a surface turned away from
+    the line (cos below MIN_FACING) gets d / MIN_FACING, far enough never to touch."""
+
+    MIN_FACING = 1e-2
+
+    def __init__(self, point, normal):
+        self.point = np.asarray(point, dtype=float)
+        self.normal = np.asarray(normal, dtype=float) / np.hypot(*normal)
+
+    def along(self, coords: np.ndarray, normals: np.ndarray) -> np.ndarray:
+        distance = (coords - self.point) @ self.normal
+        facing = np.maximum(-(normals @ self.normal), self.MIN_FACING)
+        return distance / facing
+
+
+def _gap_values(gap, coords, normals, check=True):
+    if isinstance(gap, FoundationLine):
+        g = gap.along(coords, normals)
+    else:
+        g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (coords.shape[0],)).copy()
     if not np.all(np.isfinite(g)) or (check and np.any(g < 0)):
         raise SceneError("contact.gap must be finite and >= 0 at every contact vertex (2.11)", key="contact.gap")
     return g
 
 
-def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap):
-    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at clamped ends."""
+def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap, edge_normal):
+    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at dropped ends (with
+    the edge's normal)."""
     ends = np.zeros(edge_vertex.shape)
     free = edge_vertex >= 0
     ends[free] = vertex_gap[edge_vertex[free]]
     if np.any(~free):
-        ends[~free] = _gap_values(gap, edge_coords[~free], check=False)
+        normals = np.broadcast_to(edge_normal[:, None, :], edge_coords.shape)
+        ends[~free] = _gap_values(gap, edge_coords[~free], normals[~free], check=False)
     return ends
 
 
@@ -215,18 +242,20 @@ def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap, quadrature: str = "no
         np.add.at(weight, edges[:, end], 0.5 * length)
         np.add.at(nsum, edges[:, end], weighted_normal)
     verts = np.unique(edges)
-    verts = verts[dofs.free_index[verts] >= 0]
+    verts = verts[dofs.unconstrained_vertices()[verts]]
     normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
     free = dofs.free_index[verts]
     coords = mesh.vertices[verts]
-    g = _gap_values(gap, coords)
+    g = _gap_values(gap, coords, normal)
     contact_index = np.full(nv, -1, dtype=np.int64)
     contact_index[verts] = np.arange(verts.size)
     edge_vertex = contact_index[edges]
     edge_coords = mesh.vertices[edges]
-    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, g)
+    edge_normal = weighted_normal / length[:, None]
+    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, g, edge_normal)
+    prescribed = np.einsum("eai,ei->ea", dofs.prescribed_displacement()[edges], edge_normal)
     s, w = gauss_rule(gauss_points) if quadrature == "gauss" else (np.zeros(0), np.zeros(0))
     return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight[verts], normal, tangent, g, coords,
-                           quadrature, edge_vertex, weighted_normal / length[:, None], length, edge_gap, edge_coords,
-                           s, w)
+                           quadrature, edge_vertex, edge_normal, length, edge_gap, edge_coords,
+                           s, w, np.where(edge_vertex >= 0, 0.0, prescribed))

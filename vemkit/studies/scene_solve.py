@@ -8,12 +8,14 @@ residual check (:func:`vemkit.solvers.verification.verify_solution`) meets the s
 
 from __future__ import annotations
 
+from vemkit.config.expressions import vector_field
 from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import MeshError, ResultError, VerificationError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.mesh import Mesh
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.verification import CHECK_KEYS, verify_solution
+from vemkit.vem.norms import relative_exact_errors
 
 #: the independent check must meet min(max(CHECK_FACTOR * tol, CHECK_FLOOR), CHECK_CAP). Measured
 #: (paper scene, n = 2 ... 64, square/voronoi/triangle/hanging): ssn's check is <= 1e-13 at tol <=
@@ -61,6 +63,13 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
     attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
     if verify:
         attrs.update(_verified(problem, solution, scene.solver_options))
+    if scene.exact_displacement is not None and scene.order == 2:  # Pi_2 u_h (vemkit.vem.norms_k2)
+        from vemkit.vem.norms_k2 import relative_exact_errors_k2
+        attrs.update(relative_exact_errors_k2(problem.mesh, problem.projected(solution.u),
+                                              vector_field(scene.exact_displacement)))
+    elif scene.exact_displacement is not None:  # SPEC §7: relative errors against the exact field
+        attrs.update(relative_exact_errors(problem.mesh, problem.dofs.expand(solution.u),
+                                           vector_field(scene.exact_displacement)))
     try:
         with floating_point_errors_raise():
             ds = solution_dataset(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)

@@ -4,7 +4,8 @@
   triangulation of the cell) and int_K v_h dx computed as int_K Pi v_h dx = |K| (Pi v_h)(x_K),
   x_K the centroid: exact for linear v_h on any polygon, hence the patch test with body force.
 - Tractions: int_e f2 . v_h ds on every edge of a Neumann part by Gauss-Legendre quadrature;
-  v_h is linear on each edge, so this is exact for polynomial tractions of moderate degree.
+  v_h is linear on each edge, so this is exact for polynomial tractions of moderate degree. A
+  normal pressure p is the traction -p nu with nu the outward normal of each edge (SPEC §7).
 All vectors are over the vertices, shape (N, 2); restrict with ``DofMap.restrict``.
 """
 
@@ -64,6 +65,21 @@ def traction_load(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -> n
         out[:, comp] += np.bincount(edges[:, 0], to_a[:, comp], mesh.n_vertices)
         out[:, comp] += np.bincount(edges[:, 1], to_b[:, comp], mesh.n_vertices)
     return out
+
+
+def pressure_load(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> np.ndarray:
+    """(N, 2) nodal loads of a normal pressure p: the traction -p nu on every edge (a, b), nu its
+    outward normal (the body lies left of a -> b); pressure(x, y) -> p, or a number."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    tangent = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
+    normal = np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+
+    def traction(x, y):
+        p = np.broadcast_to(pressure(x, y) if callable(pressure) else float(pressure), x.shape)
+        return -p * normal[:, 0:1], -p * normal[:, 1:2]
+
+    return traction_load(mesh, edges, traction, points)
 
 
 def cell_averages(mesh: Mesh, field, triangles: np.ndarray, parent: np.ndarray) -> np.ndarray:

@@ -88,8 +88,14 @@ __all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "family_builder", "square
 
 
 def scene_mesh(scene) -> Mesh:
-    """The mesh a scene (``vemkit.config.Scene``) asks for."""
+    """The mesh a scene (``vemkit.config.Scene``) asks for: its family on its domain with one of
+    n / h / cells, or its mesh file (SPEC §8, read and validated)."""
+    if scene.mesh_file is not None:
+        from vemkit.mesh.files import read_mesh
+
+        return read_mesh(scene.mesh_file)
     opts = scene.mesh_options
-    family, n = opts.pop("family"), opts.pop("n")
+    family = opts.pop("family")
+    sizes = {key: opts.pop(key) for key in ("n", "h", "cells") if key in opts}
     # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7)
-    return build_mesh(family, n, domain=scene.domain, **opts)
+    return build_mesh(family, domain=scene.domain, **sizes, **opts)

@@ -1,0 +1,202 @@
+"""Boundary data and mesh size of a scene (SPEC §7), checked and compiled: Dirichlet sides with their
+components, Neumann tractions and pressures, the contact gap or foundation line, the exact solution.
+
+Each expression is compiled once (:mod:`vemkit.config.expressions`, never ``eval``) and
+test-evaluated where it will be used: on the points of its side, or inside the body, so that a
+NaN, an infinity or a negative gap is a one-line :class:`SceneError` before any mesh is built.
+A scene whose mesh comes from a file has its sides in the file: they are checked when it is read.
+
+Compiled keys (the Scene's ``_expressions``): ``boundary.dirichlet.SIDE`` -> (u1 | None, u2 | None),
+``boundary.neumann.SIDE.traction`` -> (f_x, f_y), ``boundary.neumann.SIDE.pressure`` -> p,
+``exact.displacement`` -> (u1, u2), ``contact.gap`` -> g.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vemkit.config.domain import Domain
+from vemkit.config.expressions import Expression, compile_expression
+from vemkit.exceptions import ExpressionError, SceneError
+
+__all__ = ["MAX_NORMAL_K_OVER_E", "PROBES", "boundary_expressions", "check_contact", "check_foundation",
+           "check_mesh_size", "check_sides", "side_points"]
+
+#: contact.normal.k / material.E above this is refused (README "Input rules and limits"): measured,
+#: ssn's independent check is 5e-9 at k/E = 5e8 and fails at 5e11 (paper scene, n = 8)
+MAX_NORMAL_K_OVER_E = 1e9
+PROBES = 16  # points per side (and per direction inside) where expressions are test-evaluated
+# points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
+_UNIT_SQUARE_SIDE_POINTS = {
+    "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
+    "bottom": lambda s: (s, 0.0 * s), "top": lambda s: (s, 0.0 * s + 1.0),
+}
+
+
+def side_points(domain: Domain, side: str, s: np.ndarray):
+    """Points (x, y) on a side at the parameters s of each of its edges (the unit square: as one
+    straight side)."""
+    if domain.is_unit_square:
+        return _UNIT_SQUARE_SIDE_POINTS[side](s)
+    x0, y0, x1, y1 = domain.bounds
+    polygonal = domain.discretize(max(x1 - x0, y1 - y0) / PROBES)
+    segments = polygonal.segments[polygonal.segment_sides == side]
+    a, b = polygonal.points[segments[:, 0]], polygonal.points[segments[:, 1]]
+    points = (a[:, None, :] + s[None, :, None] * (b - a)[:, None, :]).reshape(-1, 2)
+    return points[:, 0], points[:, 1]
+
+
+def inside_points(domain: Domain):
+    """A PROBES x PROBES grid over the bounding box of the body (the unit square by default)."""
+    s = (np.arange(PROBES) + 0.5) / PROBES
+    x, y = np.meshgrid(s, s)
+    if domain.is_unit_square:
+        return x, y
+    x0, y0, x1, y1 = domain.bounds
+    return x0 + (x1 - x0) * x, y0 + (y1 - y0) * y
+
+
+def compile_checked(key: str, value) -> Expression:
+    try:
+        return compile_expression(value, name=key)
+    except ExpressionError as error:
+        raise SceneError(str(error)) from None
+
+
+def evaluate_checked(expression: Expression, points) -> np.ndarray:
+    try:
+        return expression(*points)
+    except ExpressionError as error:
+        raise SceneError(str(error)) from None
+
+
+def _dirichlet(boundary: dict) -> dict:
+    """side -> [u1 | None, u2 | None] (the list form: u = 0 on every listed side)."""
+    entries = boundary["dirichlet"]
+    if isinstance(entries, list):
+        return {side: [0.0, 0.0] for side in entries}
+    return entries
+
+
+def _compiled_entries(data: dict, domain: Domain | None):
+    """(key, expression(s), points | None) of every boundary and exact expression of the scene."""
+    s = (np.arange(PROBES) + 0.5) / PROBES
+    at_side = (lambda side: side_points(domain, side, s)) if domain is not None else (lambda side: None)
+    inside = inside_points(domain) if domain is not None else None
+    for side, components in _dirichlet(data["boundary"]).items():
+        key = f"boundary.dirichlet.{side}"
+        pair = tuple(None if value is None else compile_checked(f"{key}[{i}]", value)
+                     for i, value in enumerate(components))
+        if pair == (None, None):
+            raise SceneError(f"{key} = [null, null]: prescribes nothing; give a value for at least one "
+                             "component or move the side to neumann", key=key)
+        yield key, pair, at_side(side)
+    for side, entry in data["boundary"]["neumann"].items():
+        if len(entry) != 1:
+            raise SceneError(f"boundary.neumann.{side}: give exactly one of traction: [f_x, f_y] or "
+                             "pressure: p; fix the scene", key=f"boundary.neumann.{side}")
+        kind, value = next(iter(entry.items()))
+        key = f"boundary.neumann.{side}.{kind}"
+        compiled = compile_checked(key, value) if kind == "pressure" else \
+            tuple(compile_checked(f"{key}[{i}]", value[i]) for i in (0, 1))
+        yield key, compiled, at_side(side)
+    if "exact" in data:
+        key = "exact.displacement"
+        yield key, tuple(compile_checked(f"{key}[{i}]", data["exact"]["displacement"][i]) for i in (0, 1)), inside
+
+
+def boundary_expressions(data: dict, domain: Domain | None) -> dict:
+    """The compiled boundary and exact expressions by key, each test-evaluated on its points
+    (``domain`` None: the mesh comes from a file, the points are unknown yet)."""
+    compiled = {}
+    for key, value, points in _compiled_entries(data, domain):
+        compiled[key] = value
+        for expression in (value if isinstance(value, tuple) else (value,)):
+            if expression is not None and points is not None:
+                evaluate_checked(expression, points)
+    return compiled
+
+
+def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
+    """The foundation line's normal is not zero and every contact side lies on its body side."""
+    normal = np.asarray(foundation["normal"], dtype=float)
+    if not np.hypot(*normal) > 0:
+        raise SceneError("contact.foundation.normal = [0, 0]: give the line's normal pointing towards "
+                         "the body, e.g. [0, 1] for a floor", key="contact.foundation.normal")
+    if domain is None:
+        return
+    point = np.asarray(foundation["point"], dtype=float)
+    for side in sides:
+        x, y = side_points(domain, side, np.linspace(0.0, 1.0, PROBES + 1))
+        distance = ((x - point[0]) * normal[0] + (y - point[1]) * normal[1]) / np.hypot(*normal)
+        if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
+            i = int(np.argmin(distance))
+            raise SceneError(f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation line "
+                             f"at x={x[i]:.6g}, y={y[i]:.6g} (the body starts out penetrating it); move "
+                             "contact.foundation.point or flip contact.foundation.normal",
+                             key="contact.foundation")
+
+
+def check_mesh_size(mesh: dict) -> None:
+    sizes = [key for key in ("n", "h", "cells") if key in mesh]
+    if "file" in mesh:
+        extra = sizes + [key for key in mesh if key not in ("file", *sizes)]
+        if extra:
+            raise SceneError(f"discretization.mesh: file = {mesh['file']!r} is the whole mesh; drop "
+                             f"{', '.join(extra)}", key="discretization.mesh")
+        return
+    if "family" not in mesh:
+        raise SceneError("discretization.mesh.family is missing (mesh family); add it to the scene or "
+                         "--set discretization.mesh.family=... (or give discretization.mesh.file)",
+                         key="discretization.mesh.family")
+    if len(sizes) != 1:
+        named = ", ".join(f"{k} = {mesh[k]}" for k in sizes) or "none given"
+        raise SceneError(f"discretization.mesh: give exactly one of n, h and cells ({named}); fix the "
+                         "scene or --set discretization.mesh.n=...", key="discretization.mesh")
+
+
+def check_sides(data: dict, sides) -> None:
+    """Every boundary side exists (``sides`` None: the mesh file names them) and has one condition."""
+    boundary, owner = data["boundary"], {}
+    for part in ("dirichlet", "neumann", "contact"):
+        for index, side in enumerate(boundary[part]):
+            if sides is not None and side not in sides:
+                where = f"boundary.{part}[{index}] = {side!r}" if isinstance(boundary[part], list) else \
+                    f"boundary.{part}.{side}"
+                raise SceneError(f"{where}: unknown boundary name {side!r}; the {_domain_name(data)} has "
+                                 f"sides {', '.join(sides)}; fix the scene", key=f"boundary.{part}")
+            if side in owner:
+                raise SceneError(f"boundary: side {side!r} is listed in both {owner[side]} and "
+                                 f"{part}; a side has one boundary condition")
+            owner[side] = part
+    if boundary["contact"] and "contact" not in data:
+        raise SceneError(f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
+                         "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}")
+
+
+def check_contact(data: dict, given_contact: dict, domain, compiled: dict) -> None:
+    contact, sides = data["contact"], data["boundary"]["contact"]
+    if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
+        raise SceneError(f"contact.normal.k = {contact['normal']['k']:g}: must be at most "
+                         f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "
+                         "(stiffer is rigid contact, beyond double precision); fix the scene or "
+                         "--set contact.normal.k=...", key="contact.normal.k")
+    if "foundation" in contact:
+        if "gap" in given_contact:
+            raise SceneError("contact: give either gap or foundation, not both (the foundation "
+                             "line defines the gap)", key="contact.foundation")
+        check_foundation(contact["foundation"], sides, domain)
+        return
+    gap = compiled["contact.gap"] = compile_checked("contact.gap", contact["gap"])
+    for side in sides if domain is not None else ():
+        x, y = side_points(domain, side, np.linspace(0.0, 1.0, PROBES + 1))
+        values = evaluate_checked(gap, (x, y))
+        if values.min() < 0:
+            i = int(np.argmin(values))
+            raise SceneError(f"contact.gap = {repr(contact['gap'])}: is {values[i]:.6g} "
+                             f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
+                             "g_a must be >= 0); fix the scene or --set contact.gap=...")
+
+
+def _domain_name(data) -> str:
+    return "unit_square" if data["domain"] == "unit_square" else "domain"
