@@ -2,12 +2,17 @@
 
 A :class:`Domain` is plain data: the outer polygon (counter-clockwise), one side name per outer
 edge (edge i runs from corner i to corner i + 1), and holes, each a polygon with one side name per
-edge or a circle ``(cx, cy, r)`` with one side name. ``domain_from_spec`` builds it from the scene
+edge or a circle ``(cx, cy, r)`` with one side name. An outer edge may be an arc (``arcs``, an
+extension of SPEC §7): ``arcs[i] = (cx, cy)`` makes edge i the shorter arc (less than a half circle)
+of the circle through its two corners centred at (cx, cy); ``None`` keeps it straight. The arc
+bulges away from its centre: outwards when the centre lies on the body's side of the chord.
+``domain_from_spec`` builds it from the scene
 mapping of SPEC §7 (or ``"unit_square"``) and refuses a broken domain with a one-line
 ``InputError`` whose ``key`` names the entry (``domain.polygon``, ``domain.holes[1]`` ...).
 
 Meshing needs polygons only: ``Domain.discretize(h)`` replaces every circle by the polygon whose
-``m = max(8, ceil(2 π r / h))`` vertices lie on the circle (edges of length about h) and returns a
+``m = max(8, ceil(2 π r / h))`` vertices lie on the circle (edges of length about h), and every arc
+of angle θ by ``max(ceil(8 θ / 2π), ceil(r θ / h))`` chords with their ends on the arc, and returns a
 :class:`PolygonalDomain`: the shapely polygon, the boundary segments with their side names, and a
 point inside every hole (for Triangle).
 
@@ -69,6 +74,43 @@ class CircleHole:
         return np.stack([self.cx + self.r * np.cos(t), self.cy + self.r * np.sin(t)], axis=1)
 
 
+def arc_angles(a, b, centre) -> tuple:
+    """(r, t0, dt) of the shorter arc from corner a to corner b around ``centre``: radius (the
+    distance to a), start angle and signed sweep, |dt| < π (dt > 0: counter-clockwise)."""
+    (ax, ay), (bx, by), (cx, cy) = a, b, centre
+    t0 = math.atan2(ay - cy, ax - cx)
+    dt = math.remainder(math.atan2(by - cy, bx - cx) - t0, 2.0 * math.pi)
+    return math.hypot(ax - cx, ay - cy), t0, dt
+
+
+def arc_chords(r: float, dt: float, h: float | None) -> int:
+    """Chords that stand for an arc of radius r and sweep dt at cell size h (``None``: half-degree
+    steps, the resolution at which a domain is validated)."""
+    step = abs(dt) * MIN_CIRCLE_VERTICES / (2.0 * math.pi)
+    fine = abs(dt) / (math.pi / 360.0) if h is None else r * abs(dt) / h
+    return max(1, math.ceil(step - 1e-12), math.ceil(fine - 1e-12))
+
+
+def arc_points(a, b, centre, h: float | None) -> np.ndarray:
+    """The points strictly between corners a and b on their arc, in order from a (chords of about h)."""
+    r, t0, dt = arc_angles(a, b, centre)
+    m = arc_chords(r, dt, h)
+    t = t0 + dt * np.arange(1, m) / m
+    return np.stack([centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)], axis=1)
+
+
+def _arc_box(a, b, centre) -> tuple:
+    """(x0, y0, x1, y1) of an arc: its corners and the circle's axis extremes it passes."""
+    r, t0, dt = arc_angles(a, b, centre)
+    xs, ys = [a[0], b[0]], [a[1], b[1]]
+    for k in range(-4, 5):  # the angles k π/2 within the sweep
+        s = (k * 0.5 * math.pi - t0) / dt if dt else -1.0
+        if 0.0 < s < 1.0:
+            xs.append(centre[0] + r * round(math.cos(k * 0.5 * math.pi)))
+            ys.append(centre[1] + r * round(math.sin(k * 0.5 * math.pi)))
+    return min(xs), min(ys), max(xs), max(ys)
+
+
 class PolygonalDomain(NamedTuple):
     """A domain with every circle replaced by a polygon: what the mesh families work on.
 
@@ -89,6 +131,7 @@ class Domain:
     polygon: tuple = UNIT_SQUARE_CORNERS
     sides: tuple = UNIT_SQUARE_EDGE_SIDES
     holes: tuple = ()
+    arcs: tuple = ()  # empty (every outer edge straight) or one centre (cx, cy) or None per edge
 
     @property
     def side_names(self) -> tuple:
@@ -104,13 +147,31 @@ class Domain:
 
     @property
     def bounds(self) -> tuple:
-        """(x0, y0, x1, y1) of the outer polygon."""
+        """(x0, y0, x1, y1) of the outer boundary, arcs included."""
         p = np.asarray(self.polygon)
-        return (*p.min(axis=0).tolist(), *p.max(axis=0).tolist())
+        boxes = [(*p.min(axis=0).tolist(), *p.max(axis=0).tolist())]
+        k = len(self.polygon)
+        boxes += [_arc_box(self.polygon[i], self.polygon[(i + 1) % k], c) for i, c in enumerate(self.arcs) if c]
+        lo, hi = np.min([b[:2] for b in boxes], axis=0), np.max([b[2:] for b in boxes], axis=0)
+        return (*lo.tolist(), *hi.tolist())
+
+    def outer_ring(self, h: float | None) -> tuple:
+        """(points (P, 2), side of each edge point i -> i+1): the outer boundary counter-clockwise,
+        every arc replaced by chords of about h (``None``: half-degree steps, see ``arc_chords``)."""
+        corners = np.asarray(self.polygon, dtype=float)
+        if not self.arcs:
+            return corners, list(self.sides)
+        k = corners.shape[0]
+        points, sides = [], []
+        for i, centre in enumerate(self.arcs):
+            inner = np.zeros((0, 2)) if centre is None else arc_points(self.polygon[i], self.polygon[(i + 1) % k], centre, h)
+            points += [corners[i:i + 1], inner]
+            sides += [self.sides[i]] * (inner.shape[0] + 1)
+        return np.concatenate(points), sides
 
     def discretize(self, h: float) -> PolygonalDomain:
-        """The polygonal domain for cells of size h (circles become polygons, see the module doc)."""
-        rings = [(np.asarray(self.polygon, dtype=float), list(self.sides))]
+        """The polygonal domain for cells of size h (circles and arcs become chords, see the module doc)."""
+        rings = [self.outer_ring(h)]
         inside = []
         for hole in self.holes:
             if isinstance(hole, CircleHole):
@@ -139,8 +200,16 @@ class Domain:
 
     @property
     def exact_area(self) -> float:
-        """Area of the body with circles as circles."""
+        """Area of the body with circles as circles and arcs as arcs: each arc adds (bulging out) or
+        removes (bulging in) its circular segment r²/2 (θ - sin θ)."""
         area = shapely.Polygon(self.polygon).area
+        k = len(self.polygon)
+        for i, centre in enumerate(self.arcs):
+            if centre is not None:
+                a, b = self.polygon[i], self.polygon[(i + 1) % k]
+                r, _, dt = arc_angles(a, b, centre)
+                out = (b[0] - a[0]) * (centre[1] - a[1]) - (b[1] - a[1]) * (centre[0] - a[0]) > 0  # centre on the body's side
+                area += (1.0 if out else -1.0) * 0.5 * r * r * (abs(dt) - math.sin(abs(dt)))
         for hole in self.holes:
             area -= math.pi * hole.r**2 if isinstance(hole, CircleHole) else shapely.Polygon(hole.polygon).area
         return float(area)
@@ -152,6 +221,8 @@ class Domain:
         holes = [{"circle": [h.cx, h.cy, h.r], "side": h.side} if isinstance(h, CircleHole)
                  else {"polygon": [list(p) for p in h.polygon], "sides": list(h.sides)} for h in self.holes]
         spec = {"polygon": [list(p) for p in self.polygon], "sides": list(self.sides)}
+        if self.arcs:
+            spec["arcs"] = [None if c is None else list(c) for c in self.arcs]
         if holes:
             spec["holes"] = holes
         return spec
@@ -194,9 +265,10 @@ def domain_from_spec(spec=None) -> Domain:
         return UNIT_SQUARE
     if not isinstance(spec, dict):
         raise InputError("domain: give unit_square or a mapping {polygon: [[x, y], ...], sides: [...]}", key="domain")
-    unknown = sorted(set(spec) - {"polygon", "sides", "holes"})
+    unknown = sorted(set(spec) - {"polygon", "sides", "holes", "arcs"})
     if unknown:
-        raise InputError(f"domain.{unknown[0]}: unknown key; valid keys: polygon, sides, holes", key=f"domain.{unknown[0]}")
+        raise InputError(f"domain.{unknown[0]}: unknown key; valid keys: polygon, sides, arcs, holes",
+                         key=f"domain.{unknown[0]}")
     for required in ("polygon", "sides"):
         if required not in spec:
             raise InputError(f"domain.{required} is missing; give the outer polygon and one side name per edge",
@@ -208,13 +280,54 @@ def domain_from_spec(spec=None) -> Domain:
     if not ring.is_ccw:
         raise InputError("domain.polygon is clockwise; list its corners counter-clockwise (reverse the "
                          "list, and its sides)", key="domain.polygon")
+    arcs = _arcs(spec.get("arcs"), outer)
+    body = Domain(tuple(outer), tuple(sides), (), arcs)
+    if arcs:
+        curved = shapely.LinearRing(body.outer_ring(None)[0])
+        _check_simple(curved, "domain.arcs", "the outer boundary with its arcs",
+                      "move an arc's centre farther from its edge (flatter arc) or to its other side")
+        if not curved.is_ccw:
+            raise InputError("domain.arcs: the outer boundary with its arcs is clockwise; move the arc centres "
+                             "to the other side of their edges", key="domain.arcs")
     holes = spec.get("holes") or []
     if not isinstance(holes, list):
         raise InputError("domain.holes: give a list of {circle: [cx, cy, r], side: NAME} or "
                          "{polygon: [...], sides: [...]}", key="domain.holes")
     parsed = tuple(_hole(entry, f"domain.holes[{i}]") for i, entry in enumerate(holes))
-    _check_placement(shapely.Polygon(outer), parsed)
-    return Domain(tuple(outer), tuple(sides), parsed)
+    _check_placement(shapely.Polygon(body.outer_ring(None)[0]), parsed)
+    return Domain(tuple(outer), tuple(sides), parsed, arcs)
+
+
+def _arcs(value, corners: list) -> tuple:
+    """The validated ``domain.arcs``: () when absent or all null, else one centre or None per edge."""
+    if value is None:
+        return ()
+    k = len(corners)
+    if not isinstance(value, (list, tuple)) or len(value) != k:
+        count = len(value) if isinstance(value, (list, tuple)) else "no list of"
+        raise InputError(f"domain.arcs has {count} entries but the polygon has {k} edges; give one per edge i -> "
+                         "i+1: null (straight) or the centre [cx, cy] of its arc", key="domain.arcs")
+    centres = [None if entry is None else _arc_centre(entry, corners[i], corners[(i + 1) % k], f"domain.arcs[{i}]")
+               for i, entry in enumerate(value)]
+    return tuple(centres) if any(c is not None for c in centres) else ()
+
+
+def _arc_centre(entry, a, b, key: str) -> tuple:
+    try:
+        cx, cy = (float(v) for v in entry)
+    except (TypeError, ValueError):
+        cx = cy = float("nan")
+    if not (math.isfinite(cx) and math.isfinite(cy)):
+        raise InputError(f"{key}: give null or the centre [cx, cy] (two finite numbers) of the edge's arc", key=key)
+    ra, rb = math.hypot(a[0] - cx, a[1] - cy), math.hypot(b[0] - cx, b[1] - cy)
+    if abs(ra - rb) > 1e-9 * max(ra, rb):
+        raise InputError(f"{key}: the corners {_pt(a)} and {_pt(b)} are at distances {ra:.12g} and {rb:.12g} from "
+                         f"the centre {_pt((cx, cy))}; give a centre equally far from both", key=key)
+    mid = math.hypot(0.5 * (a[0] + b[0]) - cx, 0.5 * (a[1] + b[1]) - cy)
+    if mid <= 1e-9 * ra:
+        raise InputError(f"{key}: the centre {_pt((cx, cy))} is the middle of the edge, so the arc would be a half "
+                         "circle; split the edge at a corner on the circle (each arc less than a half circle)", key=key)
+    return (cx, cy)
 
 
 def _corners(value, key: str) -> list:
@@ -253,12 +366,11 @@ def _check_name(name, key: str) -> None:
                          key=key)
 
 
-def _check_simple(ring, key: str, what: str) -> None:
+def _check_simple(ring, key: str, what: str, fix: str = "list the corners in order along the boundary") -> None:
     if not ring.is_simple:
         reason = shapely.is_valid_reason(shapely.Polygon(ring))
         where = reason.split("[", 1)[1].rstrip("]") if "[" in reason else "somewhere"
-        raise InputError(f"{key}: {what} crosses itself (near {where}); list the corners in order along the "
-                         "boundary", key=key)
+        raise InputError(f"{key}: {what} crosses itself (near {where}); {fix}", key=key)
 
 
 def _hole(entry, key: str):
