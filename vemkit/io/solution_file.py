@@ -29,18 +29,20 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
     from vemkit.solvers.solution import contact_state
 
     mesh = problem.mesh
-    u = problem.dofs.expand(solution.u)
-    proj = projected_solution(mesh, u)
-    sig = stress(proj.strain, problem.lam, problem.mu)
+    element_order = getattr(problem, "order", 1)  # k of Section 3 (vemkit.contact.problem_k2 for k = 2)
+    u = problem.dofs.expand(solution.u)  # the displacement at the mesh vertices
+    strain = projected_solution(mesh, u).strain if element_order == 1 else problem.cell_mean_strain(solution.u)
+    sig = stress(strain, problem.lam, problem.mu)
     ds = mesh_to_ugrid_dataset(mesh)
     node, face = "mesh2d_nNodes", "mesh2d_nFaces"
     ds["u1"] = (node, u[:, 0], {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
     ds["u2"] = (node, u[:, 1], {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
-    face_attrs = {"mesh": "mesh2d", "location": "face", "comment": "constant per cell: from the projection Pi_1 (3.8)"}
+    face_attrs = {"mesh": "mesh2d", "location": "face", "comment": "constant per cell: from the projection Pi_1 (3.8)"
+                  if element_order == 1 else "cell mean of the linear strain of the projection Pi_2 (3.8)"}
     for name, values, long_name, units in (
-        ("strain_11", proj.strain[:, 0], "strain eps11 of Pi u", "1"),
-        ("strain_22", proj.strain[:, 1], "strain eps22 of Pi u", "1"),
-        ("strain_12", proj.strain[:, 2], "strain eps12 of Pi u", "1"),
+        ("strain_11", strain[:, 0], "strain eps11 of Pi u", "1"),
+        ("strain_22", strain[:, 1], "strain eps22 of Pi u", "1"),
+        ("strain_12", strain[:, 2], "strain eps12 of Pi u", "1"),
         ("stress_11", sig[:, 0], "stress sigma11 = C eps(Pi u)", "daN/mm2"),
         ("stress_22", sig[:, 1], "stress sigma22", "daN/mm2"),
         ("stress_12", sig[:, 2], "stress sigma12", "daN/mm2"),
@@ -72,6 +74,8 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             c, np.asarray(st.state, dtype=np.int8)[order],
             {"long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
         )
+    if element_order == 2:
+        _add_order2_fields(ds, problem, solution)
     for key, values in solution.history.items():
         ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
     ds.attrs.update(
@@ -85,11 +89,36 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             "wall_time": float(solution.wall_time),
             "n_dofs": int(problem.n_dofs),
             "stabilization": problem.stabilization,
+            "order": int(element_order),
             "vemkit_version": vemkit.__version__,
         }
     )
     ds.attrs.update(extra_attrs or {})
     return ds
+
+
+def _add_order2_fields(ds: xr.Dataset, problem, solution) -> None:
+    """k = 2: the edge and cell means (the other degrees of freedom of Section 3.1) as edge and face
+    variables; contact points are vertices or edge midpoints (``contact_vertex`` / ``contact_edge``, -1
+    where the other applies)."""
+    values = problem.node_values(solution.u)
+    nv, ne = problem.mesh.n_vertices, problem.mesh.edges.shape[0]
+    ds.attrs["n_space_dofs"] = int(problem.n_space_dofs)  # n_dofs: the unknowns after condensing the cell means
+    for c in (1, 2):
+        ds[f"u{c}_edge_mean"] = ("mesh2d_nEdges", values[nv:nv + ne, c - 1], {
+            "long_name": f"mean of u{c} over the edge (k = 2 degree of freedom)", "units": "mm", "mesh": "mesh2d",
+            "location": "edge"})
+        ds[f"u{c}_face_mean"] = ("mesh2d_nFaces", values[nv + ne:, c - 1], {
+            "long_name": f"mean of u{c} over the cell (k = 2 degree of freedom)", "units": "mm", "mesh": "mesh2d",
+            "location": "face"})
+    cb = problem.contact
+    if cb.size:
+        node = cb.vertices[np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))]
+        ds["contact_vertex"] = ("contact_node", np.where(node < nv, node, -1), {
+            "long_name": "mesh2d node index of the contact vertex (-1: an edge midpoint)"})
+        ds["contact_edge"] = ("contact_node", np.where(node < nv, -1, node - nv), {
+            "long_name": "mesh2d edge index of the contact edge midpoint (-1: a vertex)"})
+        ds["contact_weight"].attrs["long_name"] = "Simpson quadrature weight on Gamma_C (|e|/6 at vertices, 4|e|/6 at midpoints)"
 
 
 def check_finite(ds: xr.Dataset, what: str = "result") -> None:

@@ -116,6 +116,7 @@ class NodeMapK2:
     n_cells: int
     free_nodes: np.ndarray
     free_index: np.ndarray
+    condensed: bool = False  # cell nodes eliminated by static condensation (``condense_load``, ``recover_cell_means``)
 
     @property
     def n_nodes(self) -> int:
@@ -133,10 +134,22 @@ class NodeMapK2:
         ``first_appearance``): always go through ``restrict`` / ``expand``."""
         nv, ne, nc = mesh.n_vertices, mesh.edges.shape[0], mesh.n_cells
         pairs = np.asarray(clamped_edges, dtype=np.int64).reshape(-1, 2)
-        free = np.ones(nv + ne + nc, dtype=bool)
+        clamped = np.zeros(nv + ne + nc, dtype=bool)
         if pairs.size:
-            free[pairs.ravel()] = False
-            free[nv + edge_indices(mesh, pairs)] = False
+            clamped[pairs.ravel()] = True
+            clamped[nv + edge_indices(mesh, pairs)] = True
+        return cls.from_clamped_nodes(mesh, clamped)
+
+    @classmethod
+    def from_clamped_nodes(cls, mesh: Mesh, clamped: np.ndarray, condensed: bool = False) -> "NodeMapK2":
+        """Clamp the nodes where the (n_nodes,) mask ``clamped`` is True (numbering as above).
+
+        ``condensed``: the cell nodes carry no unknowns either; they are eliminated cell by cell
+        (static condensation, exact: a cell node couples only with the nodes of its own cell)."""
+        nv, ne, nc = mesh.n_vertices, mesh.edges.shape[0], mesh.n_cells
+        free = ~np.asarray(clamped, dtype=bool)
+        if condensed:
+            free[nv + ne:] = False
         offsets, nodes = cell_nodes(mesh)
         cells = morton_order(mesh)
         sizes = offsets[cells + 1] - offsets[cells]
@@ -145,7 +158,7 @@ class NodeMapK2:
         free_nodes = order[free[order]]
         free_index = np.full(free.size, -1, dtype=np.int64)
         free_index[free_nodes] = np.arange(free_nodes.size)
-        return cls(nv, ne, nc, free_nodes, free_index)
+        return cls(nv, ne, nc, free_nodes, free_index, condensed)
 
     @classmethod
     def natural(cls, mesh: Mesh) -> "NodeMapK2":
@@ -190,6 +203,20 @@ def _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
 
 
 @numba.njit(cache=True)
+def condense_cell(K, n):
+    """Static condensation of the cell node (local node 2n, scalars 4n, 4n + 1) in the element matrix
+    K: K_bb -= K_bc K_cc^-1 K_cb on the 4n boundary scalars (vertices and edges)."""
+    c = 4 * n
+    a, b, d, e = K[c, c], K[c, c + 1], K[c + 1, c], K[c + 1, c + 1]
+    det = a * e - b * d
+    for i in range(c):
+        w0 = (K[i, c] * e - K[i, c + 1] * d) / det  # (K_bc K_cc^-1)[i, :]
+        w1 = (K[i, c + 1] * a - K[i, c] * b) / det
+        for j in range(c):
+            K[i, j] -= w0 * K[c, j] + w1 * K[c + 1, j]
+
+
+@numba.njit(cache=True)
 def _element_workspace(nmax):
     """(K, work, px, py): the work arrays of one k = 2 element stiffness for up to nmax vertices."""
     mmax = 4 * nmax + 2
@@ -199,7 +226,7 @@ def _element_workspace(nmax):
 
 
 @numba.njit(cache=True)
-def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, nmax, data):
+def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, condense, nmax, data):
     """Zero, then add, the rows row_lo <= r < row_hi of every element stiffness touching them (as for k = 1)."""
     K, work, px, py = _element_workspace(nmax)
     rows = np.empty(2 * nmax + 1, dtype=np.int64)
@@ -210,7 +237,9 @@ def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_
         size = offsets[c + 1] - start
         for i in range(size):
             rows[i] = free_index[nodes[start + i]]
-        _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
+        n = _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
+        if condense:
+            condense_cell(K, n)
         _add_rows(row_lo, row_hi, rows, size, order, K, pindptr, pindices, data)
 
 
@@ -244,7 +273,7 @@ def _add_rows(row_lo, row_hi, rows, size, order, K, pindptr, pindices, data):
 
 
 @numba.njit(cache=True, parallel=True)
-def scatter_stiffness_k2(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, data):
+def scatter_stiffness_k2(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, condense, data):
     """Every k = 2 element stiffness (3.9) summed into the CSR ``data`` (overwritten): contiguous row
     chunks, one thread each, a thread writing only its own rows (cells straddling two chunks are
     computed twice)."""
@@ -252,13 +281,14 @@ def scatter_stiffness_k2(vertices, offsets, nodes, free_index, free_nodes, nc_pt
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, free_nodes.shape[0])
         _scatter_rows_k2(lo, hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices,
-                         lam, mu, stab, nmax, data)
+                         lam, mu, stab, condense, nmax, data)
 
 
 def stiffness_matrix_k2(mesh: Mesh, lam: float, mu: float, stabilization: str, nodes: NodeMapK2 | None = None):
     """The global k = 2 VEM stiffness matrix on the free dofs of ``nodes`` (CSR), in their order.
 
-    ``nodes`` None: every node free in the natural order (``NodeMapK2.natural``)."""
+    ``nodes`` None: every node free in the natural order (``NodeMapK2.natural``). With
+    ``nodes.condensed`` it is the Schur complement on the vertex and edge dofs (``condense_cell``)."""
     if nodes is None:
         nodes = NodeMapK2.natural(mesh)
     stab = stabilization_code(stabilization)
@@ -268,12 +298,12 @@ def stiffness_matrix_k2(mesh: Mesh, lam: float, mu: float, stabilization: str, n
     indptr, indices = dof_pattern(pindptr, pindices)
     data = np.empty(indices.shape[0])  # zeroed by the threads, each its own rows
     scatter_stiffness_k2(mesh.vertices, offsets, cn, nodes.free_index, nodes.free_nodes, nc_ptr, nc,
-                         pindptr, pindices, float(lam), float(mu), stab, data)
+                         pindptr, pindices, float(lam), float(mu), stab, nodes.condensed, data)
     return sorted_csr(data, indices, indptr, nodes.n_free)
 
 
 @numba.njit(cache=True)
-def _lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, out):
+def _lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, condense, out):
     """out[free] -= K_fc u_c over the cells that touch a clamped node with a non-zero value."""
     nmax = largest_cell(offsets)
     K, work, px, py = _element_workspace(nmax)
@@ -287,7 +317,9 @@ def _lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, out):
                 touched = True
         if not touched:
             continue
-        _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
+        n = _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
+        if condense:
+            condense_cell(K, n)
         for i in range(size):
             r = free_index[nodes[start + i]]
             if r < 0:
@@ -307,7 +339,8 @@ def dirichlet_lift(mesh: Mesh, lam: float, mu: float, stabilization: str, nodes:
     offsets, cn = cell_nodes(mesh)
     out = np.zeros(nodes.n_free)
     vals = np.ascontiguousarray(values, dtype=float).reshape(nodes.n_nodes, 2)
-    _lift(mesh.vertices, offsets, cn, nodes.free_index, vals, float(lam), float(mu), stabilization_code(stabilization), out)
+    _lift(mesh.vertices, offsets, cn, nodes.free_index, vals, float(lam), float(mu), stabilization_code(stabilization),
+          nodes.condensed, out)
     return out
 
 

@@ -46,6 +46,21 @@ def traction_load_k2(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -
     return out
 
 
+def pressure_load_k2(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> np.ndarray:
+    """(n_nodes, 2) loads of a normal pressure p: the traction -p nu on every edge (a, b), nu its
+    outward normal (the body lies left of a -> b); pressure(x, y) -> p, or a number."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    tangent = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
+    normal = np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+
+    def traction(x, y):  # x, y: (edges, points)
+        p = np.broadcast_to(pressure(x, y) if callable(pressure) else float(pressure), x.shape)
+        return -p * normal[:, 0:1], -p * normal[:, 1:2]
+
+    return traction_load_k2(mesh, edges, traction, points)
+
+
 def body_force_load_k2(mesh: Mesh, cell_force: np.ndarray) -> np.ndarray:
     """(n_nodes, 2) loads of int_K P_0 f1 . v_h dx = |K| P_0 f1 . (cell mean of v_h), given P_0 f1 (M, 2)."""
     out = np.zeros((n_nodes(mesh), 2))
@@ -89,6 +104,14 @@ def _scatter_projected(vertices, offsets, nodes, lam, mu, moments, out):
             out[nodes[start + j // 2], j % 2] += acc
 
 
+def cell_frames(mesh: Mesh) -> np.ndarray:
+    """(M, 3): centroid (x_K, y_K) and scale h_K of every cell, as the element kernel uses them."""
+    offsets, nodes = cell_nodes(mesh)
+    frame = np.empty((mesh.n_cells, 3))
+    _frames(mesh.vertices, offsets, nodes, frame)
+    return frame
+
+
 def _basis_at(xi, eta):
     """(P, 12, 2): the kernel's basis fields at scaled points."""
     z, one = np.zeros_like(xi), np.ones_like(xi)
@@ -108,8 +131,7 @@ def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarra
     from vemkit.vem.norms import reference_quadrature
 
     offsets, nodes = cell_nodes(mesh)
-    frame = np.empty((mesh.n_cells, 3))
-    _frames(mesh.vertices, offsets, nodes, frame)
+    frame = cell_frames(mesh)
     points, weights, cells = reference_quadrature(mesh, degree=5)
     f = np.stack(np.broadcast_arrays(*body_force(points[:, 0], points[:, 1])), axis=1)
     xi = (points[:, 0] - frame[cells, 0]) / frame[cells, 2]

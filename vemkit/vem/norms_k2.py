@@ -93,3 +93,98 @@ def exact_errors_k2(mesh: Mesh, proj: ProjectedSolutionK2, u_exact, grad_exact, 
         "l2": float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)))),
         "h1_semi": float(np.sqrt(np.sum(weights * np.sum(grad**2, axis=(1, 2))))),
     }
+
+
+def relative_exact_errors_k2(mesh: Mesh, proj: ProjectedSolutionK2, u_exact) -> dict:
+    """SPEC §7 for k = 2: ``error_l2``, ``error_h1_semi``, ``error_h1`` of Pi_2 u_h against u_exact(x, y)
+    -> (u1, u2), relative to the norms of u_exact (as ``vemkit.vem.norms.relative_exact_errors``)."""
+    from vemkit.vem.norms import difference_gradient, reference_quadrature
+
+    quadrature = reference_quadrature(mesh, degree=5)
+    grad = difference_gradient(u_exact, 1e-3 * float(np.ptp(mesh.vertices, axis=0).max()))
+    absolute = exact_errors_k2(mesh, proj, u_exact, grad, quadrature)
+    zero = exact_errors_k2(mesh, ProjectedSolutionK2(np.zeros_like(proj.coef), proj.frame), u_exact, grad, quadrature)
+    tiny = np.finfo(float).tiny
+    return {"error_l2": absolute["l2"] / max(zero["l2"], tiny),
+            "error_h1_semi": absolute["h1_semi"] / max(zero["h1_semi"], tiny),
+            "error_h1": float(np.hypot(absolute["l2"], absolute["h1_semi"]) / max(np.hypot(zero["l2"], zero["h1_semi"]), tiny))}
+
+
+def _values_and_gradients(proj, cells, points):
+    """(values (P, 2), gradients (P, 2, 2)) of a k = 1 ``ProjectedSolution`` or a ``ProjectedSolutionK2``."""
+    if isinstance(proj, ProjectedSolutionK2):
+        return proj.evaluate(cells, points), proj.gradient(cells, points)
+    return proj.evaluate(cells, points), proj.gradient[cells]
+
+
+def projection_error_k2(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=None, regions=None) -> dict:
+    """SPEC §5's first measure for either order: ||Pi u_h - Pi u_ref|| / ||Pi u_ref|| broken over the
+    reference cells, Pi = Pi_1 or Pi_2 of each solution on its own mesh (``coarse`` and ``ref`` are
+    k = 1 ``ProjectedSolution`` or ``ProjectedSolutionK2``). A degree-5 rule on a triangulation of
+    every reference cell: exact for two quadratic projections when each reference cell lies in one
+    coarse cell (nested meshes). Returns {"h1", "h1_semi", "l2"} (full H1 norm, seminorm, L2) and,
+    for every ``regions`` entry name -> mask(points) -> bool array, "share_<name>": the part of the
+    squared H1-seminorm error inside it (where the error sits)."""
+    from vemkit.vem.norms import locate_points, reference_quadrature
+
+    points, weights, ref_cells = quadrature if quadrature is not None else reference_quadrature(ref_mesh, degree=5)
+    coarse_cells = locate_points(coarse_mesh, points)
+    if np.any(coarse_cells < 0):
+        raise ValueError("the reference mesh is not covered by the coarse mesh (different domains?)")
+    value_h, grad_h = _values_and_gradients(coarse, coarse_cells, points)
+    value_ref, grad_ref = _values_and_gradients(ref, ref_cells, points)
+    l2 = np.sum(weights * np.sum((value_h - value_ref) ** 2, axis=1))
+    density = weights * np.sum((grad_h - grad_ref) ** 2, axis=(1, 2))
+    semi = np.sum(density)
+    ref_l2 = np.sum(weights * np.sum(value_ref**2, axis=1))
+    ref_semi = np.sum(weights * np.sum(grad_ref**2, axis=(1, 2)))
+    out = {"h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))), "h1_semi": float(np.sqrt(semi / ref_semi)),
+           "l2": float(np.sqrt(l2 / ref_l2))}
+    for name, mask in (regions or {}).items():
+        out[f"share_{name}"] = float(np.sum(density[mask(points)]) / semi) if semi > 0 else 0.0
+    return out
+
+
+def _part_edges(mesh: Mesh, parts) -> np.ndarray:
+    parts = [parts] if isinstance(parts, str) else list(parts)
+    return np.concatenate([np.asarray(mesh.boundary[p], dtype=np.int64).reshape(-1, 2) for p in parts])
+
+
+def boundary_trace(mesh: Mesh, parts, node_values: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(P, 2) the trace of a discrete displacement on the boundary ``parts`` (a name or names) at
+    ``points`` (P, 2) lying on them: linear between the vertex values (k = 1, ``node_values``
+    (n_vertices, 2)) or the quadratic of Section 3.1 from the vertex values and the edge mean (k = 2,
+    (n_nodes, 2)). Each point is placed on the nearest edge (O(points x edges) work)."""
+    from vemkit.vem.assembly_k2 import edge_indices
+    from vemkit.vem.load_k2 import trace_weights
+
+    edges = _part_edges(mesh, parts)
+    a, b = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
+    d = b - a
+    t = np.einsum("pek,ek->pe", points[:, None, :] - a[None], d) / np.sum(d * d, axis=1)[None]
+    t = np.clip(t, 0.0, 1.0)
+    gap = np.linalg.norm(a[None] + t[..., None] * d[None] - points[:, None, :], axis=2)
+    e = np.argmin(gap, axis=1)
+    s = t[np.arange(points.shape[0]), e]
+    values = np.asarray(node_values, dtype=float).reshape(-1, 2)
+    ua, ub = values[edges[e, 0]], values[edges[e, 1]]
+    if values.shape[0] == mesh.n_vertices:  # k = 1: linear trace
+        return (1 - s)[:, None] * ua + s[:, None] * ub
+    mean = values[mesh.n_vertices + edge_indices(mesh, edges[e])]
+    w = trace_weights(s)
+    return w[:, 0:1] * ua + w[:, 1:2] * ub + w[:, 2:3] * mean
+
+
+def trace_error(coarse_mesh: Mesh, coarse_values, ref_mesh: Mesh, ref_values, parts, points: int = 5) -> float:
+    """||u_h - u_ref||_{L2(parts)} / ||u_ref||_{L2(parts)}: the traces (``boundary_trace``) compared at
+    ``points`` Gauss points on every edge of the reference mesh's ``parts`` (exact for nested meshes)."""
+    from vemkit.vem.load import edge_quadrature
+
+    edges = _part_edges(ref_mesh, parts)
+    s, w = edge_quadrature(points)
+    a, b = ref_mesh.vertices[edges[:, 0]], ref_mesh.vertices[edges[:, 1]]
+    x = (a[:, None, :] * (1 - s)[None, :, None] + b[:, None, :] * s[None, :, None]).reshape(-1, 2)
+    weights = (np.linalg.norm(b - a, axis=1)[:, None] * w[None, :]).ravel()
+    ref = boundary_trace(ref_mesh, parts, ref_values, x)
+    diff = boundary_trace(coarse_mesh, parts, coarse_values, x) - ref
+    return float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)) / np.sum(weights * np.sum(ref**2, axis=1))))

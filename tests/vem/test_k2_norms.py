@@ -1,0 +1,60 @@
+"""The Section 4 study's error measures (vemkit.vem.norms_k2) on fields with known errors:
+projections of either order against a k = 2 reference on a nested finer mesh, and traces on Gamma_C."""
+
+import numpy as np
+import pytest
+
+from vemkit.mesh.families import build_mesh
+from vemkit.vem.assembly_k2 import interpolate_k2
+from vemkit.vem.elasticity import lame_parameters
+from vemkit.vem.norms_k2 import projected_solution_k2, projection_error_k2, trace_error
+from vemkit.vem.projection import projected_solution
+
+LAM, MU = lame_parameters(2000.0, 0.4)
+
+
+def _quadratic(x, y):
+    return 0.3 * x * x - 0.2 * x * y + 0.1, 0.5 * y * y + 0.4 * x
+
+
+def _k2(mesh, field):
+    values = interpolate_k2(mesh, field)
+    return values, projected_solution_k2(mesh, values, LAM, MU)
+
+
+def test_a_quadratic_has_no_error_at_k2_and_a_linear_field_none_at_k1():
+    fine = build_mesh("square", 16)
+    coarse = build_mesh("hanging", 4, levels=1, rule="contact")
+    ref_values, ref = _k2(fine, _quadratic)
+    coarse_values, coarse_proj = _k2(coarse, _quadratic)
+    err = projection_error_k2(coarse, coarse_proj, fine, ref, regions={"everywhere": lambda p: np.ones(len(p), bool)})
+    assert max(err["h1"], err["h1_semi"], err["l2"]) < 1e-12
+    assert trace_error(coarse, coarse_values, fine, ref_values, "bottom") < 1e-12
+
+    def linear(x, y):
+        return 0.3 * x - 0.2 * y + 0.1, 0.5 * y + 0.4 * x
+
+    _, ref_linear = _k2(fine, linear)
+    k1 = projected_solution(coarse, np.stack(linear(*coarse.vertices.T), axis=1))
+    assert projection_error_k2(coarse, k1, fine, ref_linear)["h1"] < 1e-12
+
+
+@pytest.mark.parametrize("n", [4, 8])
+def test_known_errors_of_the_k1_interpolant_of_x_squared(n):
+    """u = (x^2, 0) on n x n squares: the k = 1 projection of the vertex interpolant has the gradient
+    2 x_mid per cell, so |Pi_1 u_I - u|_1 / |u|_1 = h / 2; on the bottom side the linear interpolant
+    misses by (x - a)(b - x), so ||u_I - u||_L2 / ||u||_L2 = h^2 / sqrt(6)."""
+    h = 1.0 / n
+
+    def field(x, y):
+        return x * x, 0 * x
+
+    fine = build_mesh("square", 4 * n)
+    ref_values, ref = _k2(fine, field)
+    coarse = build_mesh("square", n)
+    vertex_values = np.stack(field(*coarse.vertices.T), axis=1)
+    err = projection_error_k2(coarse, projected_solution(coarse, vertex_values), fine, ref,
+                              regions={"left half": lambda p: p[:, 0] < 0.5})
+    assert err["h1_semi"] == pytest.approx(h / 2, rel=1e-12)
+    assert err["share_left half"] == pytest.approx(0.5, rel=1e-12)  # the error density is uniform
+    assert trace_error(coarse, vertex_values, fine, ref_values, ["bottom"]) == pytest.approx(h * h / np.sqrt(6), rel=1e-12)

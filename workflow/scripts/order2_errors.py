@@ -1,0 +1,96 @@
+"""Rule order2_errors: the errors of one case of the Section 4 study at every level.
+
+Against the k = 2 reference: Pi_k u_h - Pi_2 u_ref in H1 (full and seminorm) and L2 over the reference
+cells (``vemkit.vem.norms_k2.projection_error_k2``), the trace error on Gamma_C
+(``trace_error``), and where the squared H1-seminorm error sits: within ``region_radius`` of each
+corner of the body and of the contact-zone boundary (the points of Gamma_C where the reference's
+contact state changes between separated and in contact). For k = 1 also the paper's measure (SPEC §5)
+against the main workflow's k = 1 reference.
+"""
+
+import json
+
+from _helpers import logged
+
+smk = snakemake  # noqa: F821 - the snakemake object of the job
+
+
+def node_values(mesh, ds):
+    """k = 1: (n_vertices, 2) vertex values; k = 2: (n_nodes, 2) vertex values, edge and cell means."""
+    import numpy as np
+
+    u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
+    if int(ds.attrs.get("order", 1)) == 1:
+        return u
+    if not np.array_equal(ds["mesh2d_edge_nodes"].values.astype(np.int64), mesh.edges):
+        raise ValueError("the file's edges are not the mesh's edge order: the edge means cannot be placed")
+    edge = np.stack([ds["u1_edge_mean"].values, ds["u2_edge_mean"].values], axis=1)
+    face = np.stack([ds["u1_face_mean"].values, ds["u2_face_mean"].values], axis=1)
+    return np.concatenate([u, edge, face])
+
+
+def projected(mesh, ds, values):
+    from vemkit.config.scene import scene_from_yaml
+    from vemkit.vem.norms_k2 import projected_solution_k2
+    from vemkit.vem.projection import projected_solution
+
+    if int(ds.attrs.get("order", 1)) == 1:
+        return projected_solution(mesh, values)
+    lam, mu = scene_from_yaml(ds.attrs["scene"]).lame()
+    return projected_solution_k2(mesh, values, lam, mu)
+
+
+def regions(mesh, ds, radius):
+    """name -> mask(points): each corner of the body's bounding box, and the contact-zone boundary."""
+    import numpy as np
+
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    corners = {f"corner_{xn}_{yn}": (x, y) for xn, x in (("xmin", lo[0]), ("xmax", hi[0]))
+               for yn, y in (("ymin", lo[1]), ("ymax", hi[1]))}
+    state, cx, cy = ds["contact_state"].values, ds["contact_x"].values, ds["contact_y"].values
+    change = np.flatnonzero((state[1:] == 0) != (state[:-1] == 0))  # sorted along x (solution file order)
+    boundary = np.stack([0.5 * (cx[change] + cx[change + 1]), 0.5 * (cy[change] + cy[change + 1])], axis=1)
+    out = {name: (lambda p, c=c: np.hypot(p[:, 0] - c[0], p[:, 1] - c[1]) < radius) for name, c in corners.items()}
+    out["contact_zone_boundary"] = lambda p: np.min(np.hypot(p[:, None, 0] - boundary[None, :, 0],
+                                                             p[:, None, 1] - boundary[None, :, 1]), axis=1,
+                                                    initial=np.inf) < radius
+    return out, boundary
+
+
+with logged(smk):
+    import numpy as np
+
+    from vemkit.config.scene import scene_from_yaml
+    from vemkit.io.solution_file import read_solution
+    from vemkit.vem.norms import paper_error, reference_quadrature
+    from vemkit.vem.norms_k2 import projection_error_k2, trace_error
+
+    s = smk.params.settings
+    case = s["cases"][smk.wildcards.case]
+    ref_mesh, ref_ds = read_solution(smk.input.reference)
+    ref_values = node_values(ref_mesh, ref_ds)
+    ref_proj = projected(ref_mesh, ref_ds, ref_values)
+    quadrature = reference_quadrature(ref_mesh, degree=5)
+    masks, zone_boundary = regions(ref_mesh, ref_ds, s["region_radius"])
+    contact_sides = scene_from_yaml(ref_ds.attrs["scene"]).contact_sides
+    print(f"contact-zone boundary of the reference at {zone_boundary.tolist()}; Gamma_C: {contact_sides}", flush=True)
+    paper_mesh = paper_values = None
+    if case["order"] == 1:
+        paper_mesh, paper_ds = read_solution(smk.input.paper_reference)
+        paper_values = node_values(paper_mesh, paper_ds)
+    records = []
+    for n, path in zip(case["levels"], smk.input.solutions, strict=True):
+        mesh, ds = read_solution(path)
+        values = node_values(mesh, ds)
+        err = projection_error_k2(mesh, projected(mesh, ds, values), ref_mesh, ref_proj, quadrature, masks)
+        record = {"case": smk.wildcards.case, "family": case["family"], "order": case["order"], "n": n,
+                  "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])), "n_unknowns": int(ds.attrs["n_dofs"]),
+                  "n_cells": int(mesh.n_cells), "error_h1": err["h1"], "error_h1_semi": err["h1_semi"],
+                  "error_l2": err["l2"], "error_contact_l2": trace_error(mesh, values, ref_mesh, ref_values, contact_sides),
+                  "error_paper": float(paper_error(mesh, values, paper_mesh, paper_values)) if paper_mesh else float("nan"),
+                  "iterations": int(ds.attrs["iterations"]), "wall_time": float(ds.attrs["wall_time"]),
+                  **{k: v for k, v in err.items() if k.startswith("share_")}}
+        records.append(record)
+        print(json.dumps(record), flush=True)
+    with open(smk.output[0], "w", encoding="utf-8") as out:
+        json.dump({"records": records, "contact_zone_boundary": zone_boundary.tolist()}, out, indent=1)
