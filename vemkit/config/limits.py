@@ -156,7 +156,11 @@ def scene_resources(scene) -> Resources | None:
     (None for a mesh read from a file: its size is known once it is read)."""
     if "family" not in scene.mesh_options:
         return None
-    return estimate_resources(*estimate_mesh(scene.mesh_options, domain_area(scene.domain)))
+    cells, vertices = estimate_mesh(scene.mesh_options, domain_area(scene.domain))
+    # k = 2 (discretization.order): 2 DOFs per vertex, edge (Euler: about V + C) and cell; measured peak
+    # memory per DOF as for k = 1 (benchmarks/order2.py: 0.80 GiB at 525 312 DOFs, k = 1 0.74 GiB)
+    nodes = vertices if scene.order == 1 else 2 * (vertices + cells)
+    return estimate_resources(cells, nodes)._replace(vertices=vertices)
 
 
 def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS) -> Resources | None:

@@ -8,7 +8,7 @@ triplets are ever formed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -20,14 +20,34 @@ from vemkit.vem.element import element_stiffness, stabilization_code
 
 @dataclass(frozen=True)
 class DofMap:
-    """Which vertices carry unknowns. ``free_index[v]`` is -1 for a clamped vertex."""
+    """Which vertices carry unknowns. ``free_index[v]`` is -1 for a clamped vertex (u = 0, eliminated).
+
+    ``fixed_dofs``: dofs of kept vertices whose value is prescribed (a roller's component, a
+    nonzero prescribed displacement), held at ``fixed_values`` by identity rows
+    (:mod:`vemkit.vem.constraints`); the unknown vector carries these values.
+    """
 
     free_vertices: np.ndarray
     free_index: np.ndarray
+    fixed_dofs: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    fixed_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_free(self) -> int:
         return 2 * self.free_vertices.size
+
+    def unconstrained_vertices(self) -> np.ndarray:
+        """(n_vertices,) bool: both components of the vertex are unknowns (no Dirichlet data)."""
+        free = self.free_index >= 0
+        held = np.unique(self.fixed_dofs // 2)
+        free[self.free_vertices[held]] = False
+        return free
+
+    def prescribed_displacement(self) -> np.ndarray:
+        """(n_vertices, 2) the Dirichlet displacement: the fixed values, zero elsewhere."""
+        u = np.zeros((self.free_index.size, 2))
+        u.reshape(-1)[2 * self.free_vertices[self.fixed_dofs // 2] + self.fixed_dofs % 2] = self.fixed_values
+        return u
 
     @classmethod
     def from_clamped(cls, n_vertices: int, clamped_vertices) -> "DofMap":
