@@ -3,8 +3,11 @@
     vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
     vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu] [--max-dofs N] [-q]
     vemkit mesh --scene SCENE.yaml -o MESH.nc [--set key.path=value ...] [--vtu MESH.vtu] [-q]
+    vemkit adapt SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
 
-Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy).
+Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy;
+for ``adapt`` (SPEC §9): every step's solution met it, also when the loop stopped at its limits
+before the target, which a note on stderr says).
 Any failure is one line ``vemkit: error: ...`` naming the input and the fix, exit status 2: a bad
 scene, ``--set``, option, argument, output path, a request beyond the limits, a solve that did
 not converge. A bug is one line ``vemkit: error: internal error (...); please report``, exit
@@ -107,6 +110,59 @@ def cmd_solve(args) -> int:
     return 0
 
 
+def _adapt_inputs(args):
+    """The scene, the adaptivity settings, the true-error measure and the output targets of ``adapt``."""
+    from vemkit.config.limits import check_scene_resources
+    from vemkit.config.scene import load_scene
+    from vemkit.studies.adaptivity import AdaptivitySettings
+    from vemkit.studies.adaptivity_errors import reference_path, scene_true_error
+
+    _outputs(args, [args.scene])
+    scene = load_scene(args.scene, args.set or ())
+    mesh_file = scene.mesh_options.get("file")
+    inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
+    targets = _outputs(args, inputs)
+    check_scene_resources(scene, args.max_dofs)  # the first mesh; the loop keeps below max_dofs
+    return scene, AdaptivitySettings.from_scene(scene, args.max_dofs), scene_true_error(scene), targets
+
+
+def _step_line(step: int, record: dict) -> str:
+    true = f", true error {record['true_error']:.3e}" if "true_error" in record else ""
+    return (f"vemkit adapt: step {step + 1}: {record['n_dofs']} dofs, {record['n_cells']} cells, estimate "
+            f"{record['estimate']:.3e}{true}, {record['iterations']} iterations, {record['wall_time']:.2f} s")
+
+
+def cmd_adapt(args) -> int:
+    scene, settings, true_error, (output, vtu) = _adapt_inputs(args)
+
+    from vemkit.io.output_files import atomic_outputs
+    from vemkit.io.solution_file import check_finite
+    from vemkit.mesh.files import write_vtu
+    from vemkit.studies.adaptivity import STOP_REASONS, adapt, adaptive_dataset
+
+    def progress(step, record):
+        print(_step_line(step, record), file=sys.stderr, flush=True)
+
+    run = adapt(scene, settings, true_error=true_error, progress=None if args.quiet else progress)
+    ds = adaptive_dataset(scene, run)
+    check_finite(ds, args.output)
+    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+        ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
+        if vtu_part is not None:
+            write_vtu(run.problem.mesh, vtu_part, point_data={"displacement": run.problem.dofs.expand(run.solution.u)},
+                      cell_data={"error_indicator": ds["error_indicator"].values})
+    last = run.history[-1]
+    if run.reason != "target":
+        print(f"vemkit: note: adaptivity.target = {settings.target:g} not reached: {STOP_REASONS[run.reason]} "
+              f"(estimate {last['estimate']:.3e} after {len(run.history)} steps, {last['n_dofs']} dofs); "
+              f"{args.output} holds the last solution", file=sys.stderr)
+    if not args.quiet:
+        print(f"{args.output}: {len(run.history)} adaptive steps ({run.reason}), {last['n_dofs']} dofs, "
+              f"{last['n_cells']} cells, estimate {last['estimate']:.3e}, {ds.attrs['adapt_wall_time']:.2f} s "
+              f"(check {ds.attrs['check_worst']:.1e})")
+    return 0
+
+
 def _family_mesh(args):
     """The mesh of ``vemkit mesh FAMILY N [--option ...]`` (unit square), resources checked first."""
     from vemkit.config.limits import check_resources, estimate_mesh, estimate_resources
@@ -135,7 +191,7 @@ def _scene_mesh(args):
                          "(use --set discretization.mesh.KEY=VALUE)", key="arguments")
     scene = load_scene(args.scene, args.set or ())
     check_scene_resources(scene, args.max_dofs)
-    return scene_mesh(scene), scene.mesh_options["family"]
+    return scene_mesh(scene), scene.mesh_options.get("family", "file")
 
 
 def cmd_mesh(args) -> int:
@@ -201,6 +257,17 @@ def build_parser() -> argparse.ArgumentParser:
     mesh.add_argument("--max-dofs", **limit)
     mesh.add_argument("-q", "--quiet", action="store_true")
     mesh.set_defaults(func=cmd_mesh)
+    adapt = sub.add_parser("adapt", help="solve, estimate, mark and refine until the scene's adaptivity target "
+                                         "(SPEC §9); write the final solution with the indicator and the history")
+    adapt.add_argument("scene", help="scene YAML file; its adaptivity: block sets the loop (defaults filled in)")
+    adapt.add_argument("-o", "--output", required=True, help="final solution file (netCDF4, UGRID) with "
+                                                            "error_indicator and the adapt_* history")
+    adapt.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. "
+                                                                          "adaptivity.target=0.05")
+    adapt.add_argument("--vtu", help="also write the final mesh with the displacement and the indicator (VTU)")
+    adapt.add_argument("--max-dofs", **limit)
+    adapt.add_argument("-q", "--quiet", action="store_true", help="no progress lines and no summary line")
+    adapt.set_defaults(func=cmd_adapt)
     return parser
 
 

@@ -27,11 +27,11 @@ def _manufactured_scene():
 def test_the_estimator_tracks_the_exact_error_within_a_factor_3_over_the_steps():
     scene, exact = _manufactured_scene()
 
-    def true_error(problem, solution):
-        u = problem.dofs.expand(solution.u)
-        absolute = exact_errors(problem.mesh, projected_solution(problem.mesh, u), exact["u"], exact["grad"])
-        norm = exact_errors(problem.mesh, projected_solution(problem.mesh, 0 * u), exact["u"], exact["grad"])
-        return absolute["h1_semi"] / norm["h1_semi"]
+    def true_error(mesh, u):
+        absolute = exact_errors(mesh, projected_solution(mesh, u), exact["u"], exact["grad"])
+        norm = exact_errors(mesh, projected_solution(mesh, 0 * u), exact["u"], exact["grad"])
+        semi = absolute["h1_semi"] / norm["h1_semi"]
+        return {"error_h1_semi": semi, "error_h1": np.hypot(absolute["h1_semi"], absolute["l2"]) / np.hypot(norm["h1_semi"], norm["l2"])}
 
     run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-3, max_steps=9), true_error=true_error)
     errors = np.array([r["true_error"] for r in run.history])
@@ -89,3 +89,75 @@ def test_the_adaptive_solution_file_holds_the_indicator_and_the_history(tmp_path
         assert np.allclose(ds["error_indicator"], run.indicators["indicator"])
         assert list(ds["adapt_n_dofs"].values) == [r["n_dofs"] for r in run.history]
         assert "adapt_true_error" not in ds and ds.attrs["adapt_stop_reason"] == "max_steps"
+
+
+def test_theta_1_refines_every_cell_uniform_refinement():
+    scene = load_scene(PAPER, ["discretization.mesh.n=4"])
+    run = adapt(scene, AdaptivitySettings(theta=1.0, target=1e-6, max_steps=3))
+    assert [r["n_cells"] for r in run.history] == [16, 64, 256]
+    assert np.allclose(run.problem.mesh.cell_areas, 1 / 256)  # the square mesh n = 16
+
+
+def test_the_warm_start_finds_the_same_solutions_with_far_fewer_uzawa_iterations():
+    """Each solve starts from the previous step's solution prolongated to the refined mesh: on the paper
+    scene the friction multiplier is then already right, and Uzawa stops after a few iterations."""
+    scene = load_scene(PAPER, ["discretization.mesh.n=4", "solver.method=uzawa"])
+    settings = AdaptivitySettings(theta=0.5, target=1e-6, max_steps=5)
+    cold = adapt(scene, settings, warm_start=False)
+    warm = adapt(scene, settings)
+    assert [r["n_cells"] for r in warm.history] == [r["n_cells"] for r in cold.history]
+    assert np.abs(warm.solution.u - cold.solution.u).max() < 1e-7 * np.abs(cold.solution.u).max()
+    assert [r["warm_start"] for r in warm.history] == [0, 1, 1, 1, 1]
+    warm_its, cold_its = (sum(r["iterations"] for r in run.history[1:]) for run in (warm, cold))
+    assert 5 * warm_its < cold_its
+
+
+def test_a_circular_hole_is_refined_on_the_circle_and_every_mesh_is_valid():
+    from vemkit.mesh.families import scene_mesh
+
+    scene = scene_from_dict({
+        "name": "plate", "material": {"E": 1.0, "nu": 0.3},
+        "domain": {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
+                   "holes": [{"circle": [1.0, 0.5, 0.25], "side": "hole"}]},
+        "boundary": {"dirichlet": ["left"], "neumann": {"right": {"traction": [1.0, 0.0]}}},
+        "discretization": {"mesh": {"family": "triangle", "n": 4}}})
+    meshes = []
+    run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-6, max_steps=5),
+                observe=lambda step, so_far: meshes.append(so_far.problem.mesh))
+    for mesh in meshes:
+        validate_mesh(mesh)
+    estimates = [r["estimate"] for r in run.history]
+    assert np.all(np.diff(estimates) < 0) and estimates[-1] < 0.5 * estimates[0]
+    mesh, first = run.problem.mesh, scene_mesh(scene)
+    on_hole = np.unique(mesh.boundary["hole"])
+    assert on_hole.size > 2 * np.unique(first.boundary["hole"]).size  # refined at the hole ...
+    assert np.allclose(np.linalg.norm(mesh.vertices[on_hole] - [1.0, 0.5], axis=1), 0.25, atol=1e-13)  # ... on it
+    assert sorted(mesh.boundary) == sorted(first.boundary)
+
+
+def test_the_reference_error_is_exact_on_meshes_finer_than_the_reference_in_places():
+    """Two adapted meshes, each finer than the other somewhere: ‖Π(u_A − u_B)‖ is the same whichever
+    is the reference (the common-refinement quadrature is exact on nested meshes), and on a uniform
+    mesh coarser than the reference it is projection_error (SPEC §5)."""
+    from vemkit.io.solution_file import solution_dataset
+    from vemkit.mesh.families import build_mesh
+    from vemkit.studies.adaptivity_errors import reference_errors
+    from vemkit.studies.convergence import ReferenceSolution
+    from vemkit.vem.norms import projection_error, seminorm_squared
+
+    scene = load_scene(PAPER, ["discretization.mesh.n=4"])
+    runs = [adapt(scene, AdaptivitySettings(theta=theta, target=1e-6, max_steps=steps)) for theta, steps in ((0.3, 6), (1.0, 3))]
+    meshes = [run.problem.mesh for run in runs]
+    fields = [run.problem.dofs.expand(run.solution.u) for run in runs]
+    refs = [ReferenceSolution("<memory>", solution=(m, solution_dataset(r.problem, r.solution))) for m, r in zip(meshes, runs)]
+    norms = [np.sqrt(seminorm_squared(m.cell_areas, projected_solution(m, u).gradient)) for m, u in zip(meshes, fields)]
+    assert meshes[0].cell_areas.min() < meshes[1].cell_areas.min() and meshes[0].cell_areas.max() > meshes[1].cell_areas.max()
+    a_vs_b = reference_errors(meshes[0], fields[0], refs[1])["error_h1_semi"] * norms[1]
+    b_vs_a = reference_errors(meshes[1], fields[1], refs[0])["error_h1_semi"] * norms[0]
+    assert 1e-3 < a_vs_b / norms[1] < 0.2 and np.isclose(a_vs_b, b_vs_a, rtol=1e-10)
+    coarse = load_scene(PAPER, ["discretization.mesh.n=8"])
+    coarse_run = adapt(coarse, AdaptivitySettings(target=1e-6, max_steps=1))
+    u = coarse_run.problem.dofs.expand(coarse_run.solution.u)
+    mine = reference_errors(coarse_run.problem.mesh, u, refs[1])
+    spec5 = projection_error(build_mesh("square", 8), projected_solution(coarse_run.problem.mesh, u), meshes[1], refs[1].projected)
+    assert np.isclose(mine["error_h1"], spec5["h1"], rtol=1e-12) and np.isclose(mine["error_l2"], spec5["l2"], rtol=1e-12)

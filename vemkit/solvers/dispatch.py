@@ -62,8 +62,11 @@ def floating_point_errors_raise():
         yield
 
 
-def solve(problem, solver_options: dict, progress=None):
+def solve(problem, solver_options: dict, progress=None, initial=None):
     """Run the configured contact solver; raises ConvergenceError on failure.
+
+    ``initial``: None (each solver's own start) or (u0 free-dof vector, multiplier per contact
+    vertex), a warm start (e.g. a coarser solution prolongated to this mesh).
 
     ``solver_options["time_budget"]`` (seconds, optional): TimeBudgetExceeded once the solve has
     run longer (checked after every iteration). A floating-point overflow, invalid operation or
@@ -82,6 +85,8 @@ def solve(problem, solver_options: dict, progress=None):
         run = solve_ssn
     else:
         raise SceneError(f"solver.method = {method!r} is unknown; use ssn or uzawa", key="solver.method")
+    if initial is not None:
+        kwargs["initial"] = initial
     try:
         with single_threaded_blas(), floating_point_errors_raise():
             return run(problem, **common, **kwargs)

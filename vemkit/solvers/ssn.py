@@ -11,7 +11,11 @@ direction, |Gamma_C| = sum_c w_c, b_ref = k_tau for the reduced law (the largest
 the starting point for m_tau > 0). It does not grow under refinement (the local choice
 kd / (w b) ~ 1/h made the sets of mixed stick/slip cases flip-flop: 8 -> 19 iterations from 2^-4
 to 2^-8, against 5-7 -> 7-9 with this one). Start: u = the plain linear solution,
-lambda = P(kd u_tau / (w b_ref)) (the local trial multiplier, which finds the slip zone at once).
+lambda = P(kd u_tau / (w b_ref)) (the local trial multiplier, which finds the slip zone at once);
+or, given ``initial = (u0, lambda0)`` (a warm start, e.g. the previous adaptive step's solution
+prolongated to the refined mesh), (u0, P(lambda0)) when its residual merit theta is below that of
+the cold start (the plain solution is computed either way: it decides the cheap path below and the
+scalings gamma, b_ref).
 
 Newton step at (u, lambda), q = lambda + gamma u_tau: slip S = {|q| > 1}: lambda_new = sign(q);
 stick A = {|q| <= 1}: u_tau,new = 0; normal compliance linearized, J = sum_c w_c p_nu' nu_c nu_c^T
@@ -131,13 +135,14 @@ class _Point:
     floor: float = 0.0
 
 
-def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None) -> ContactSolution:
+def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None, initial=None) -> ContactSolution:
     """Semismooth Newton for (5.2)-(5.3); see the module docstring. ``tol``: relative residual.
 
     progress(k, record) is called after every Newton iteration with that iteration's history entries.
+    ``initial``: None, or (u0 free-dof vector, lambda0 per contact vertex), a warm start (module docstring).
     Raises ConvergenceError (never returns NaN).
     """
-    newton, u = _plain_start(problem, linear, tol)
+    newton, u = _plain_start(problem, linear, tol, None if initial is None else initial[0])
     cb, law = problem.contact, problem.law
     t = cb.normal_displacement(u) - cb.gap
     if cb.size == 0 or (not np.any(law.normal_pressure(t)) and not np.any(law.friction_bound(t))):
@@ -146,6 +151,10 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
     trial = newton.kd_tau * cb.tangential_displacement(u) / (cb.weight * newton.b_ref)
     point = _evaluate(newton, u, np.clip(trial, -1.0, 1.0))
+    if initial is not None:
+        warm = _evaluate(newton, np.asarray(initial[0], float), np.clip(np.asarray(initial[1], float), -1.0, 1.0))
+        newton.info["warm_start"] = bool(warm.theta < point.theta)
+        point = warm if warm.theta < point.theta else point
     newton.theta_previous = point.theta
     for k in range(1, max_iterations + 1):
         if _converged(newton, point):
@@ -159,12 +168,13 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
           newton.records, newton.contrast, reason="max_iterations")
 
 
-def _plain_start(problem, linear, tol):
-    """The linear solver of K and the plain linear solution (a starting guess: AMG to INITIAL_TOL)."""
+def _plain_start(problem, linear, tol, x0=None):
+    """The linear solver of K and the plain linear solution (a starting guess: AMG to INITIAL_TOL,
+    CG from ``x0`` when given)."""
     start = time.perf_counter()
     try:
         base = linear_solver(problem.stiffness, linear, near_nullspace=problem.near_nullspace, tol=tol)
-        u = base.solve(problem.load, tol=max(INITIAL_TOL, tol))
+        u = base.solve(problem.load, x0=None if x0 is None else np.asarray(x0, float), tol=max(INITIAL_TOL, tol))
     except LinearSolveError as exc:
         raise ConvergenceError(f"ssn: {exc}", solver="ssn", reason="linear_solver_failed", iterations=0) from exc
     baseline = max(base.iterations, 1) / max(np.log10(1.0 / max(INITIAL_TOL, tol)), 1.0)

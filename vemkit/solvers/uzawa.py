@@ -1,6 +1,10 @@
 """The paper's Uzawa iteration (Section 5, Steps 1-3, (5.4)-(5.6)) for the discrete contact problem.
 
-Step 1  lambda^0 = 0, u^0 = 0.
+Step 1  lambda^0 = 0, u^0 = 0 (or a warm start ``initial = (u^0, lambda^0)``, e.g. the previous
+        adaptive step's solution prolongated to the refined mesh; lambda^0 projected onto [-1, 1]).
+        A warm start's first |u^n - u^{n-1}| can dip below its later values (measured on an adapted
+        paper-scene mesh: 5.4e-9 at n = 3, then 6.0e-9 falling by 4e-4 per iteration), so there a
+        new smallest residual also counts as progress for the stagnation test below.
 Step 2  K u^n = f - sum_c w_c [p_nu(t_c^{n-1}) nu_c + p_tau(t_c^{n-1}) lambda_c^{n-1} tau_c],
         t^{n-1} = u_nu^{n-1} - g   (normal compliance and friction bound lagged: explicit in u^{n-1});
         lambda^n = P(lambda^{n-1} + rho k_tau u_tau^n),  P = projection onto [-1, 1].
@@ -140,6 +144,8 @@ class _Uzawa:
     records: list = field(default_factory=list)
     smallest_du: float = np.inf  # smallest |u^n - u^{n-1}| so far, at iteration smallest_at
     smallest_at: int = 0
+    warm: bool = False  # started from ``initial``: a new smallest residual also counts as progress
+    smallest_residual: float = np.inf
     growing: int = 0  # iterations in a row with a growing |u^n - u^{n-1}|
     du_abs: float = 0.0  # |u^n - u^{n-1}|
     du_abs_previous: float = np.inf
@@ -162,6 +168,7 @@ def solve_uzawa(
     max_iterations=10000,
     tol=1e-10,
     progress=None,
+    initial=None,
 ) -> ContactSolution:
     """Steps 1-3 of the paper; see the module docstring. ``tol``: relative tolerance of each linear
     solve and of the residual a stop must reach (acceptable_residual).
@@ -169,7 +176,8 @@ def solve_uzawa(
     progress(n, record) is called after every iteration with that iteration's history entries:
     du = |u^n - u^{n-1}| / |u^n|, dlambda = max |lambda^n - lambda^{n-1}|, residual = the relative
     equilibrium residual of (u^n, lambda^n) (exact up to the linear-solve tolerance), rho, and
-    linear_iterations. Raises ConvergenceError (never returns NaN).
+    linear_iterations. ``initial``: None (Step 1) or (u^0 free-dof vector, lambda^0 per contact
+    vertex). Raises ConvergenceError (never returns NaN).
     """
     if stop not in ("either", "both"):
         raise SceneError(f"solver.stop = {stop!r}: use either or both", key="solver.stop")
@@ -178,7 +186,7 @@ def solve_uzawa(
     options = dict(rho=rho, eps_u=eps_u, eps_lambda=eps_lambda, stop=stop, max_iterations=max_iterations, tol=tol)
     state = None
     try:
-        state = _start(problem, linear, options)
+        state = _start(problem, linear, options, initial)
         if state.n == 0:  # no contact force: the plain linear solution
             return _finish(state, 0)
         return _iterate(state, progress)
@@ -187,15 +195,17 @@ def solve_uzawa(
                                iterations=state.n if state is not None else 0) from exc
 
 
-def _start(problem, linear, options) -> _Uzawa:
+def _start(problem, linear, options, initial=None) -> _Uzawa:
     """Step 1 and the first solve of Step 2 (u^1 is the solution if no contact force acts at u^0 or u^1)."""
     start = time.perf_counter()
     cb, law = problem.contact, problem.law
     solver = linear_solver(problem.stiffness, linear, near_nullspace=problem.near_nullspace, tol=options["tol"])
-    state = _Uzawa(problem, solver, options, start, np.zeros(problem.n_dofs), np.zeros(cb.size),
-                   {"linear": solver.method, "stop": options["stop"]})
+    u0, lam0 = (np.zeros(problem.n_dofs), np.zeros(cb.size)) if initial is None else \
+        (np.asarray(initial[0], float), np.clip(np.asarray(initial[1], float), -1.0, 1.0))
+    state = _Uzawa(problem, solver, options, start, u0, lam0, {"linear": solver.method, "stop": options["stop"]},
+                   warm=initial is not None)
     rhs = problem.load - contact_force_vector(problem, state.u, state.lam)
-    u_first = solver.solve(rhs)
+    u_first = solver.solve(rhs, x0=None if initial is None else u0)
     state.linear_total += max(solver.iterations, 1)
     t_first = cb.normal_displacement(u_first) - cb.gap
     if cb.size == 0 or (
@@ -211,7 +221,8 @@ def _start(problem, linear, options) -> _Uzawa:
         state.linear_total += solves
     state.info["mu_tau"] = state.mu_tau
     state.forces = problem.load - rhs  # contact forces of (u^0, lambda^0)
-    state.previous_rhs = state.previous_rhs_change = np.zeros_like(problem.load)  # K u^0 = 0
+    state.previous_rhs_change = np.zeros_like(problem.load)
+    state.previous_rhs = np.zeros_like(problem.load) if initial is None else problem.stiffness @ u0  # K u^0
     state.u_first = u_first
     state.n = 1
     return state
@@ -314,6 +325,8 @@ def _watch_progress(state):
     state.du_abs_previous = du_abs
     if du_abs < state.smallest_du:
         state.smallest_du, state.smallest_at = du_abs, state.n
+    if state.warm and state.records[-1]["residual"] < state.smallest_residual:
+        state.smallest_residual, state.smallest_at = state.records[-1]["residual"], state.n
     if state.growing >= 5 and du_abs > DIVERGENCE_GROWTH * state.smallest_du:
         fail(state, f"|Δu| grew {du_abs / state.smallest_du:.0e}×", "diverged")
     if state.refused is not None and (du_abs == 0.0 or state.n - state.smallest_at >= STAGNATION_WINDOW):

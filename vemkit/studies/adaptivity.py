@@ -1,10 +1,21 @@
 """The adaptive loop of SPEC §9: solve → estimate → mark → refine, until the estimate is small enough.
 
-Each step solves the scene's contact problem on the current mesh, computes the indicators η_K of
-``vemkit.vem.estimator`` (with the contact traction of the solution as the Γ_C datum), stops when
-the relative estimate η ≤ ``target`` or the next mesh would exceed ``max_dofs`` or ``max_steps`` is
-reached, and otherwise refines the Dörfler-marked cells (``vemkit.mesh.refine``). The history
-records, per step, the DOFs, cells, η, wall time and, when the caller gives one, the true error.
+Each step solves the scene's contact problem on the current mesh, checks the solution
+independently (as ``vemkit solve`` does), computes the indicators η_K of ``vemkit.vem.estimator``
+(with the contact traction of the solution as the Γ_C datum), stops when the relative estimate
+η ≤ ``target``, when the next mesh would have more than ``max_dofs`` unknowns (counted as 2 × its
+vertices, an upper bound: no mesh beyond the limit is ever assembled) or after
+``max_steps`` solves, and otherwise refines the Dörfler-marked cells (``vemkit.mesh.refine``;
+new vertices on a circular hole or an arc of the scene's domain are placed on the curve).
+
+Warm start: the solve of step k + 1 starts from the solution of step k prolongated to the refined
+mesh (``RefinedMesh.prolongation``: linear along split edges, the vertex mean at new cell centres;
+the friction multiplier the same way along Γ_C), see the ``initial`` argument of
+``vemkit.solvers.dispatch.solve``.
+
+The history records, per step, the DOFs, cells, η, the solver's iterations and times and, when the
+scene has an exact solution (``exact:``) or names a reference solution file
+(``adaptivity.reference``), the true error (:mod:`vemkit.studies.adaptivity_errors`).
 """
 
 from __future__ import annotations
@@ -15,18 +26,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from vemkit.config.domain import CircleHole, domain_from_spec
 from vemkit.contact.problem import scene_problem
-from vemkit.exceptions import InputError
+from vemkit.exceptions import InputError, ResultError, VerificationError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
-from vemkit.solvers.dispatch import solve
+from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.solution import contact_state
+from vemkit.solvers.verification import CHECK_KEYS, verify_solution
 from vemkit.studies.convergence import RECORD_KEYS
+from vemkit.studies.scene_solve import check_tolerance
 from vemkit.vem.estimator import dorfler_marking, error_indicators
 from vemkit.vem.load import cell_averages
-
 
 
 @dataclass(frozen=True)
@@ -47,6 +60,15 @@ class AdaptivitySettings:
         if self.max_steps < 1 or self.max_dofs < 1:
             raise InputError("adaptivity.max_steps and adaptivity.max_dofs must be >= 1", key="adaptivity")
 
+    @classmethod
+    def from_scene(cls, scene, max_dofs: int | None = None) -> AdaptivitySettings:
+        """The settings of ``scene.adaptivity_options`` (validated by the scene schema); ``max_dofs``
+        (e.g. ``vemkit adapt --max-dofs``) caps ``adaptivity.max_dofs``."""
+        options = scene.adaptivity_options
+        cap = options["max_dofs"] if max_dofs is None else min(options["max_dofs"], int(max_dofs))
+        return cls(theta=options["marking"]["dorfler"], target=options["target"], max_dofs=cap,
+                   max_steps=options["max_steps"], max_hanging=options["max_hanging"])
+
 
 @dataclass
 class AdaptiveRun:
@@ -54,7 +76,8 @@ class AdaptiveRun:
     solution: object  # its ContactSolution
     indicators: dict  # error_indicators of the last solution
     history: list = field(default_factory=list)  # one dict per step (the keys of HISTORY_ATTRS)
-    reason: str = ""  # why the loop stopped: target, max_dofs, max_steps
+    reason: str = ""  # why the loop stopped: target, max_dofs, max_steps, unrefinable
+    checks: dict = field(default_factory=dict)  # the independent check of the last solution
 
 
 def contact_tractions(problem, solution) -> dict:
@@ -86,34 +109,111 @@ def scene_indicators(scene, problem, solution) -> dict:
                             body_force=body, neumann=neumann, contact=contact)
 
 
-def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None) -> AdaptiveRun:
-    """Run the loop from the scene's own mesh; ``true_error(problem, solution) -> float`` is optional."""
+def curved_sides(domain_spec) -> dict:
+    """{side: [cx, cy, r]} of the sides that lie on one circle: circular holes, and outer sides all of
+    whose edges are arcs of one circle (SPEC §7); refinement puts new boundary vertices on it."""
+    domain = domain_from_spec(domain_spec)
+    out = {hole.side: [hole.cx, hole.cy, hole.r] for hole in domain.holes if isinstance(hole, CircleHole)}
+    arcs = {}
+    for i, side in enumerate(domain.sides):
+        centre = domain.arcs[i] if domain.arcs else None
+        r = None if centre is None else round(float(np.hypot(*np.subtract(domain.polygon[i], centre))), 12)
+        arcs.setdefault(side, set()).add(None if centre is None else (float(centre[0]), float(centre[1]), r))
+    for side, circles in arcs.items():
+        if len(circles) == 1 and None not in circles and side not in out:
+            out[side] = list(next(iter(circles)))
+    return out
+
+
+def prolongated_start(refined, problem, solution, new_problem):
+    """(u0, λ0) on ``new_problem``: ``solution`` on ``problem`` prolongated by ``refined`` (a RefinedMesh)."""
+    P, dofs = refined.prolongation, new_problem.dofs
+    u0 = dofs.restrict(P @ problem.dofs.expand(solution.u))
+    u0[dofs.fixed_dofs] = dofs.fixed_values  # prescribed displacements at their exact values
+    multiplier, on_contact = np.zeros(problem.mesh.n_vertices), np.zeros(problem.mesh.n_vertices)
+    multiplier[problem.contact.vertices], on_contact[problem.contact.vertices] = solution.multiplier, 1.0
+    # a new Γ_C vertex next to a clamped end takes its contact neighbour's value, not half of it
+    weight = (P @ on_contact)[new_problem.contact.vertices]
+    lam0 = (P @ multiplier)[new_problem.contact.vertices] / np.where(weight > 0, weight, 1.0)
+    return u0, lam0
+
+
+def _checked(problem, solution, solver_options) -> dict:
+    """The independent check of ``vemkit solve`` (vemkit.studies.scene_solve); VerificationError if it fails."""
+    tol = check_tolerance(solver_options)
+    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
+    if not checks["passed"]:
+        worst = max(CHECK_KEYS, key=lambda k: checks[k])
+        raise VerificationError(
+            f"{solution.method} stopped after {solution.iterations} iterations on the {problem.mesh.n_cells}-cell "
+            f"adapted mesh but the independent check fails: {worst} = {checks[worst]:.1e} > {tol:.1e}; try "
+            "solver.method=ssn or a smaller solver.tol", solver=solution.method, iterations=solution.iterations)
+    return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
+
+
+def _solve_step(scene, mesh, previous, warm_start: bool, verify: bool, max_dofs: int):
+    """(problem, solution, record, checks) of one step; ``previous`` = (refined, problem, solution) or None."""
+    start = time.perf_counter()
+    problem = scene_problem(scene, mesh)
+    if problem.n_dofs > max_dofs:  # only the scene's own mesh can be too fine: refined meshes are checked
+        raise InputError(f"the scene's mesh has {problem.n_dofs} unknowns, more than adaptivity.max_dofs = {max_dofs}"
+                         " (or --max-dofs); use a coarser discretization.mesh or raise adaptivity.max_dofs",
+                         key="adaptivity.max_dofs")
+    problem.info["contact_sides"] = tuple(scene.contact_sides)
+    initial = prolongated_start(*previous, problem) if warm_start and previous is not None else None
+    solution = solve(problem, scene.solver_options, initial=initial)
+    checks = _checked(problem, solution, scene.solver_options) if verify else {}
+    record = {"n_dofs": problem.n_dofs, "n_cells": mesh.n_cells, "iterations": int(solution.iterations),
+              "linear_iterations": int(solution.linear_iterations), "solve_time": time.perf_counter() - start,
+              "warm_start": int(bool(solution.info.get("warm_start", initial is not None)))}
+    return problem, solution, record, checks
+
+
+def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None, observe=None,
+          warm_start: bool = True, verify: bool = True) -> AdaptiveRun:
+    """Run the loop from the scene's own mesh (module docstring). ``settings.theta = 1`` marks every
+    cell: uniform refinement of the scene's mesh, the yardstick of the adaptive runs.
+
+    ``true_error(mesh, u_vertices) -> {"error_h1_semi": ..., "error_h1": ...}`` (relative errors; e.g.
+    :func:`vemkit.studies.adaptivity_errors.scene_true_error`) is optional; ``progress(step, record)``
+    is called after every step, ``observe(step, run)`` too with the AdaptiveRun so far (its problem,
+    solution and indicators are the step's); ``warm_start=False`` starts every solve cold (to measure the gain);
+    ``verify``: every solution must pass the independent check (VerificationError otherwise).
+    """
+    if scene.order != 1:  # the estimator (vemkit.vem.estimator) and the warm start are written for k = 1
+        raise InputError(f"discretization.order = {scene.order}: vemkit adapt supports order 1 only; drop "
+                         "discretization.order or use vemkit solve", key="discretization.order")
     mesh = scene_mesh(scene)
-    run = None
+    circles = curved_sides(scene.domain)
+    run, previous = None, None
     for step in range(settings.max_steps):
         start = time.perf_counter()
-        problem = scene_problem(scene, mesh)
-        problem.info["contact_sides"] = tuple(scene.contact_sides)
-        solution = solve(problem, scene.solver_options)
-        solved = time.perf_counter()
+        problem, solution, record, checks = _solve_step(scene, mesh, previous, warm_start, verify, settings.max_dofs)
         found = scene_indicators(scene, problem, solution)
-        record = {"n_dofs": problem.n_dofs, "n_cells": mesh.n_cells, "estimate": found["estimate"],
-                  "solve_time": solved - start, "iterations": int(solution.iterations)}
+        record["estimate"] = found["estimate"]
         if true_error is not None:
-            record["true_error"] = float(true_error(problem, solution))
+            measured = time.perf_counter()
+            errors = true_error(problem.mesh, problem.dofs.expand(solution.u))
+            record["error_time"] = time.perf_counter() - measured
+            start += record["error_time"]  # measuring is no cost of the loop
+            record.update(true_error=errors["error_h1_semi"], true_error_h1=errors["error_h1"])
             record["effectivity"] = found["estimate"] / record["true_error"] if record["true_error"] > 0 else np.nan
-        run = AdaptiveRun(problem, solution, found, (run.history if run else []) + [record])
-        reason = _stop_reason(found["estimate"], problem.n_dofs, step, settings)
+        run = AdaptiveRun(problem, solution, found, (run.history if run else []) + [record], checks=checks)
+        reason = _stop_reason(found["estimate"], step, settings)
         if reason is None:
-            marked = dorfler_marking(found["indicator"], settings.theta)
-            refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging)
-            record["marked"] = int(marked.size)
+            marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
+            refined = _refined(mesh, marked, settings.max_hanging, circles)
+            record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
             if 2 * refined.mesh.n_vertices > settings.max_dofs:
                 reason = "max_dofs"
-            mesh = refined.mesh
+            elif refined.refined.size == 0:
+                reason = "unrefinable"
+            mesh, previous = refined.mesh, (refined, problem, solution)
         record["wall_time"] = time.perf_counter() - start
         if progress is not None:
             progress(step, record)
+        if observe is not None:
+            observe(step, run)
         if reason is not None:
             run.reason = reason
             return run
@@ -121,7 +221,18 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
     return run
 
 
-def _stop_reason(estimate: float, n_dofs: int, step: int, settings: AdaptivitySettings):
+def _refined(mesh, marked, max_hanging, circles):
+    """refine_cells with new boundary vertices on the curved sides; if that leaves a marked cell whole
+    (a vertex moved onto a circle can dent a thin cut cell until its centre leaves its kernel: a cell
+    of the square family at a hole), this step keeps them on the chords instead."""
+    refined = refine_cells(mesh, marked, max_hanging=max_hanging, circles=circles)
+    if refined.skipped.size and circles:
+        straight = refine_cells(mesh, marked, max_hanging=max_hanging, circles={})
+        refined = straight if straight.skipped.size < refined.skipped.size else refined
+    return refined
+
+
+def _stop_reason(estimate: float, step: int, settings: AdaptivitySettings):
     if estimate <= settings.target:
         return "target"
     if step + 1 >= settings.max_steps:
@@ -129,34 +240,54 @@ def _stop_reason(estimate: float, n_dofs: int, step: int, settings: AdaptivitySe
     return None
 
 
+#: why the loop stopped, in words (the CLI's note when the target was not reached)
+STOP_REASONS = {
+    "target": "the relative estimate reached adaptivity.target",
+    "max_dofs": "the next mesh would exceed adaptivity.max_dofs (or --max-dofs)",
+    "max_steps": "adaptivity.max_steps solves were done",
+    "unrefinable": "no marked cell could be split (no centre in its kernel)",
+}
 _STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop records
     ("estimate", "relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
-    ("true_error", "relative H1-seminorm error against the exact or reference solution", "1"),
+    ("true_error", "relative H1-seminorm error of Pi_1 u_h against the exact or reference solution", "1"),
+    ("true_error_h1", "relative full H1-norm error of Pi_1 u_h against the exact or reference solution", "1"),
     ("effectivity", "estimate / true_error", "1"),
     ("marked", "cells marked for refinement (0: the last step)", "1"),
-    ("wall_time", "wall time of the step: assembly, solve, estimate, refinement", "s"),
-    ("solve_time", "assembly and contact solve", "s"),
+    ("skipped", "marked cells that could not be split (no centre in their kernel)", "1"),
+    ("linear_iterations", "inner linear iterations (CG) or direct solves of the contact solve", "1"),
+    ("warm_start", "1: the solve started from the previous step's solution prolongated to this mesh", "1"),
+    ("wall_time", "wall time of the step: assembly, solve, check, estimate, refinement (not error_time)", "s"),
+    ("error_time", "wall time of measuring true_error (not part of wall_time)", "s"),
+    ("solve_time", "assembly, contact solve and independent check", "s"),
 )
 #: name: (long name, units) of the per-step history; n_dofs, n_cells, iterations as in the convergence records
 HISTORY_ATTRS = {**{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
                  **{name: (long_name, units) for name, long_name, units in _STEP_VARIABLES}}
+_INTEGER_HISTORY = ("n_dofs", "n_cells", "marked", "skipped", "iterations", "linear_iterations", "warm_start")
 
 
 def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
     """The final solution file (SPEC §6) plus ``error_indicator`` per face and the per-step history
     on the ``adapt_step`` dimension (SPEC §9). Entries a step does not have are not stored."""
-    ds = solution_dataset(run.problem, run.solution, scene_yaml=scene.to_yaml(), extra_attrs=extra_attrs)
+    attrs = {"mesh_family": str(run.problem.mesh.meta.get("family", "")), **run.checks, **(extra_attrs or {})}
+    try:
+        with floating_point_errors_raise():
+            ds = solution_dataset(run.problem, run.solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
+    except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
+        raise ResultError(f"the stresses of the solution overflow double precision ({error}); "
+                          "rescale the units of the scene (E, k, tractions)") from None
     ds["error_indicator"] = ("mesh2d_nFaces", run.indicators["indicator"],
                              {"long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
-                              "mesh": "mesh2d", "location": "face", "units": "sqrt(daN mm)"})
+                              "mesh": "mesh2d", "location": "face", "units": "sqrt(energy)"})
     steps = len(run.history)
     for name, (long_name, units) in HISTORY_ATTRS.items():
-        values = [record.get(name, 0 if name == "marked" else None) for record in run.history]
+        values = [record.get(name, 0 if name in ("marked", "skipped") else None) for record in run.history]
         if any(v is None for v in values):
             continue
-        dtype = np.int64 if name in ("n_dofs", "n_cells", "marked", "iterations") else float
+        dtype = np.int64 if name in _INTEGER_HISTORY else float
         ds[f"adapt_{name}"] = ("adapt_step", np.asarray(values, dtype=dtype), {"long_name": long_name, "units": units})
     ds = ds.assign_coords(adapt_step=("adapt_step", np.arange(steps), {"long_name": "adaptive step"}))
     ds.attrs.update({"adapt_stop_reason": run.reason, "adapt_steps": steps,
-                     "adapt_estimate": float(run.history[-1]["estimate"])})
+                     "adapt_estimate": float(run.history[-1]["estimate"]),
+                     "adapt_wall_time": float(sum(r["wall_time"] for r in run.history))})
     return ds

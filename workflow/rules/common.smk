@@ -16,6 +16,7 @@ from vemkit.studies.sweep_dimensions import dimension_name
 CONFIG_PARTS = {
     "paper": ("../schemas/config.schema.yaml", "config/config.yaml"),
     "studies": ("../schemas/sweeps.schema.yaml", "config/sweeps.yaml"),
+    "adaptivity": ("../schemas/adaptivity.schema.yaml", "config/adaptivity.yaml"),
 }
 
 
@@ -91,7 +92,20 @@ def _check_config():
                             "of 2 (nested with the square levels, SPEC 5)")
 
 
+def _check_order():
+    """The paper workflow measures errors with Pi_1 of vertex values (SPEC 5): k = 1 only."""
+    from vemkit.config.scene import load_scene
+    from vemkit.exceptions import SceneError
+    from vemkit.studies.convergence import require_order1
+
+    try:
+        require_order1(load_scene(config["scene"], config["overrides"]), "the paper workflow (Table 1, convergence)")
+    except SceneError as error:
+        raise config_error("config/config.yaml (scene, overrides)", "overrides", str(error)) from None
+
+
 _check_config()
+_check_order()
 
 
 def ntag(n):
@@ -236,6 +250,8 @@ _check_tradeoff()
 SWEEP_TARGETS = [f"results/sweeps/{name}.nc" for name in SWEEPS] + [
     f"results/sweeps/{name}/{kind}.png" for name, spec in SWEEPS.items() for kind in spec["figures"]]
 STABILITY_TARGETS = [f"results/stability/stability.{ext}" for ext in ("nc", "md", "png")]
+#: the adaptive loop as a configuration of the speed-accuracy study (adaptivity.smk: rule tradeoff_adaptive)
+TRADEOFF_ADAPTIVE = ["results/tradeoff/runs/adaptive.json"] if config["adaptivity_study"].get("tradeoff") else []
 TRADEOFF_TARGETS = ["results/tradeoff/tradeoff.nc", "results/tradeoff/pareto.md", "results/tradeoff/pareto.png"]
 EXTRAS_TARGETS = SWEEP_TARGETS + TRADEOFF_TARGETS + STABILITY_TARGETS
 

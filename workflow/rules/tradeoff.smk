@@ -26,7 +26,7 @@ rule tradeoff_family:
 
 rule tradeoff:
     input:
-        [f"results/tradeoff/runs/{family}.json" for family in TRADEOFF["families"]],
+        [f"results/tradeoff/runs/{family}.json" for family in TRADEOFF["families"]] + TRADEOFF_ADAPTIVE,
     output:
         nc="results/tradeoff/tradeoff.nc",
         md="results/tradeoff/pareto.md",

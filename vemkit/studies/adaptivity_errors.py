@@ -1,0 +1,105 @@
+"""The true error of each adaptive step (SPEC §9): against the scene's exact solution or a reference.
+
+- ``exact:`` in the scene (SPEC §7): :func:`vemkit.vem.norms.relative_exact_errors`, the relative
+  errors of Π_1 u_h against the exact field, as ``vemkit solve`` reports them.
+- ``adaptivity.reference: FILE`` (a solution file of the same scene on a fine mesh, relative to the
+  scene file): :func:`reference_errors`, ‖Π_1(u_h − u_ref)‖ / ‖Π_1 u_ref‖ (full H1 norm, H1 seminorm,
+  L2) with Π_1 on each solution's own mesh, as ``vemkit.vem.norms.projection_error`` (SPEC §5) —
+  but an adapted mesh is finer than the reference in places (the corners), where a reference cell
+  holds several adapted cells. The quadrature is therefore taken on the common refinement: the
+  degree-2 rule on the reference cells that lie in one adapted cell, and the same rule on the
+  adapted cells inside the other reference cells. For meshes nested with the reference (squares
+  refined by quadrisection against a finer square mesh, the paper scene) every integrand is then a
+  polynomial on each quadrature cell and the errors are exact; otherwise the quadrature resolves
+  the cell boundaries to the finer mesh's size.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from vemkit.config.expressions import vector_field
+from vemkit.exceptions import InputError
+from vemkit.studies.convergence import ReferenceSolution
+from vemkit.studies.tradeoff import check_reference_scene
+from vemkit.vem.norms import locate_points, reference_quadrature, relative_exact_errors
+from vemkit.vem.projection import projected_solution
+
+
+def _common_quadrature(mesh, reference: ReferenceSolution):
+    """(points, weights, adapted cell, reference cell) on the common refinement (module docstring)."""
+    points, weights, ref_cells = reference.quadrature
+    cells = locate_points(mesh, points)
+    if np.any(cells < 0):
+        raise InputError("adaptivity.reference: the reference mesh covers points outside the adapted mesh "
+                         "(another body?); give a solution file of this scene", key="adaptivity.reference")
+    n_ref = reference.mesh.n_cells
+    low, high = np.full(n_ref, np.iinfo(np.int64).max), np.full(n_ref, -1)
+    np.minimum.at(low, ref_cells, cells)
+    np.maximum.at(high, ref_cells, cells)
+    split = low != high  # a reference cell whose points lie in several adapted cells
+    fine_points, fine_weights, fine_cells = reference_quadrature(mesh)
+    fine_ref = locate_points(reference.mesh, fine_points)
+    take = (fine_ref >= 0) & split[np.maximum(fine_ref, 0)]
+    keep = ~split[ref_cells]
+    return (np.concatenate([points[keep], fine_points[take]]), np.concatenate([weights[keep], fine_weights[take]]),
+            np.concatenate([cells[keep], fine_cells[take]]), np.concatenate([ref_cells[keep], fine_ref[take]]))
+
+
+def reference_errors(mesh, u_vertices, reference: ReferenceSolution) -> dict:
+    """{"error_h1", "error_h1_semi", "error_l2"}: Π_1 u_h on ``mesh`` against the reference (module docstring)."""
+    points, weights, cells, ref_cells = _common_quadrature(mesh, reference)
+    mine, ref = projected_solution(mesh, u_vertices), reference.projected
+    ref_values = ref.evaluate(ref_cells, points)
+    diff = mine.evaluate(cells, points) - ref_values
+    grad = mine.gradient[cells] - ref.gradient[ref_cells]
+    l2, semi = np.sum(weights * np.sum(diff**2, axis=1)), np.sum(weights * np.sum(grad**2, axis=(1, 2)))
+    ref_l2 = np.sum(weights * np.sum(ref_values**2, axis=1))
+    ref_semi = np.sum(weights * np.sum(ref.gradient[ref_cells] ** 2, axis=(1, 2)))
+    return {"error_h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
+            "error_h1_semi": float(np.sqrt(semi / ref_semi)), "error_l2": float(np.sqrt(l2 / ref_l2))}
+
+
+def reference_path(scene) -> Path | None:
+    """The file ``adaptivity.reference`` names, relative to the scene file (None: no reference)."""
+    name = scene.adaptivity_options.get("reference")
+    if name is None:
+        return None
+    base = Path(scene.source).parent if scene.source and Path(scene.source).is_file() else Path.cwd()
+    return base / name
+
+
+def load_reference(scene) -> ReferenceSolution | None:
+    """The reference solution of ``adaptivity.reference``, checked to solve the scene's problem."""
+    path = reference_path(scene)
+    if path is None:
+        return None
+    if not path.is_file():
+        raise InputError(f"adaptivity.reference = {str(path)!r}: no such file; give a solution file written by "
+                         "vemkit solve (relative to the scene file)", key="adaptivity.reference")
+    try:
+        reference = ReferenceSolution(path)
+    except (OSError, ValueError, KeyError) as error:
+        raise InputError(f"adaptivity.reference = {str(path)!r}: not a vemkit solution file "
+                         f"({' '.join(str(error).split())[:120]}); give the output of vemkit solve",
+                         key="adaptivity.reference") from None
+    try:
+        check_reference_scene(scene, str(reference.dataset.attrs.get("scene", "")))
+    except ValueError as error:
+        raise InputError(f"adaptivity.reference = {str(path)!r}: {error}; solve this scene on a fine mesh for "
+                         "the reference", key="adaptivity.reference") from None
+    return reference
+
+
+def scene_true_error(scene):
+    """``true_error(mesh, u_vertices) -> {"error_h1", "error_h1_semi", "error_l2"}`` for the adaptive
+    loop: against ``exact:`` if the scene has it, else against ``adaptivity.reference``; None without either."""
+    if scene.exact_displacement is not None:
+        field = vector_field(scene.exact_displacement)
+        return lambda mesh, u: relative_exact_errors(mesh, u, field)
+    reference = load_reference(scene)
+    if reference is None:
+        return None
+    return lambda mesh, u: reference_errors(mesh, u, reference)
