@@ -32,3 +32,26 @@ def test_every_level_is_nested_in_the_reference():
         refine = 2 ** case.get("options", {}).get("levels", 0) if case["family"] == "hanging" else 1
         for n in case["levels"]:
             assert settings["reference"]["n"] % (n * refine) == 0 and n * refine < settings["reference"]["n"], (name, n)
+
+
+def test_the_paper_workflow_refuses_order2_overrides(tmp_path):
+    """Table 1 and the convergence study measure Pi_1 of vertex values: k = 2 would be mis-measured."""
+    import yaml
+    from test_workflow import dry_run
+
+    path = tmp_path / "k2.yaml"
+    path.write_text(yaml.safe_dump({"overrides": ["discretization.order=2"]}))
+    run = dry_run("--configfile", str(path))
+    message = run.stdout + run.stderr
+    assert run.returncode != 0
+    assert "discretization.order = 2" in message and "Traceback" not in message
+
+
+def test_the_tradeoff_study_runs_the_k2_families():
+    import yaml
+
+    families = yaml.safe_load((ROOT / "config" / "sweeps.yaml").read_text(encoding="utf-8"))["tradeoff"]["families"]
+    k2 = [name for name, spec in families.items() if spec.get("order") == 2]
+    assert k2
+    jobs = planned_jobs("results/tradeoff/pareto.md")
+    assert jobs["tradeoff_family"] == len(families)

@@ -27,6 +27,7 @@ import xarray as xr
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import git_commit, package_versions
 from vemkit.io.solution_file import read_solution
+from vemkit.studies.solution_order import projected_k2, refuse_order2, require_order1, solution_order  # noqa: F401
 
 
 #: keys of one error record, with their meaning and units
@@ -136,16 +137,24 @@ class ReferenceSolution:
 
         self.path = str(path)
         self.mesh, self.dataset = solution if solution is not None else read_solution(path)
-        self.projected = _cached_projection(_projected(self.mesh, self.dataset))
+        self.order = solution_order(self.dataset)
+        if self.order == 2:  # Pi_2 of every k = 2 degree of freedom; a degree-5 rule (quadratic projections)
+            self.projected = projected_k2(self.mesh, self.dataset)
+            self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh, degree=5)
+        else:
+            self.projected = _cached_projection(_projected(self.mesh, self.dataset))
+            self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh)
         self.displacement = _displacement(self.dataset)
         self.areas = self.mesh.cell_areas
-        self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh)
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
 
     def errors(self, mesh, dataset) -> dict:
-        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), SPEC 5."""
+        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), SPEC 5.
+        Both are k = 1 measures of vertex values: a k = 2 solution or reference is refused."""
         from vemkit.vem.norms import paper_error, projection_error
 
+        refuse_order2(self.dataset, "the convergence study's reference")
+        refuse_order2(dataset, "a solution of the convergence study")
         out = projection_error(mesh, _projected(mesh, dataset), self.mesh, self.projected, self.quadrature)
         out["paper"] = paper_error(mesh, _displacement(dataset), self.mesh, self.displacement,
                                    self.projected, self.areas)
@@ -233,6 +242,7 @@ def solved_error_records(family: str, spec: dict, stabilization: str, meshes, re
     def solve(mesh_spec, n, mesh):
         scene = study_scene(scene_path, overrides, mesh_spec["family"], mesh_spec.get("options") or {}, n,
                             stabilization)
+        require_order1(scene, "the convergence study")
         problem, _, ds = solve_scene(scene, mesh=mesh)
         return problem.mesh, ds
 

@@ -10,6 +10,15 @@ Every run solves the scene on one mesh with one configuration and measures
   kernels), and the number of free unknowns (DOFs). Mesh generation is recorded apart
   (``mesh_time``): a mesh is built once and reused.
 
+A family may set ``order: 2`` (k = 2 virtual elements, ``vemkit.contact.problem_k2``). Its error is
+that of Pi_2 u_h (3.8, the projection of every k = 2 degree of freedom, cell means recovered)
+against the reference's projection (``vemkit.vem.norms_k2.projection_error_k2``, degree-5 rule on
+the reference cells: exact for nested meshes), never Pi_1 of its vertex values; its DOFs count the
+whole k = 2 space (vertex values, edge and cell means: ``n_dofs``; the condensed system the solver
+sees: ``n_unknowns``), and its cost includes the condensation. The reference is the k = 1 2^-8
+solution of the main workflow, so errors of k = 2 runs below the reference's own error (about 0.4 %
+in H1 on the paper scene, README "Order 2") measure the distance to that reference, not to u.
+
 Runs whose mesh is finer than the reference somewhere (hanging nodes: n 2^levels > n_ref) are
 skipped: the error measure needs the reference at least as fine. The solver tolerance means the
 Newton residual for ssn and eps_u = eps_lambda = tol (with the CG tolerance) for uzawa.
@@ -28,12 +37,15 @@ import time
 import numpy as np
 import xarray as xr
 
+from vemkit.exceptions import InputError
 from vemkit.solvers.verification import STATUS_MEANINGS, guarded_solve
 
 SCENE_SECTIONS = ("domain", "material", "body_force", "boundary", "contact")  # must match the reference's
 RECORD_FLOATS = ("tol", "error_h1", "error_h1_semi", "error_l2", "wall_time", "assembly_time", "mesh_time",
                  "cost_time", "residual", "h_min")
 RECORD_INTS = ("n", "n_dofs", "n_cells", "iterations", "status")
+#: integer keys a record may omit (k = 1 producers such as the adaptive configuration): their defaults
+RECORD_OPTIONAL_INTS = {"order": lambda r: 1, "n_unknowns": lambda r: r["n_dofs"]}
 RECORD_STRINGS = ("family", "family_name", "solver", "stabilization", "message")
 
 
@@ -58,20 +70,21 @@ def _finest_ok(spec: dict, n: int, reference_n: int) -> bool:
 
 def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tolerances, stabilizations,
                repeats: int = 1, time_budget=None, reference_n: int = 256, max_iterations=None, progress=None) -> list[dict]:
-    """Records of every run of one mesh family (``spec``: {family, options}); see the module docstring.
+    """Records of every run of one mesh family (``spec``: {family, options, order}); see the module docstring.
 
-    ``reference``: a ``vemkit.studies.convergence.ReferenceSolution``. All-triangle families are solved with
-    the first stabilization only (the VEM space is P1 there, the stabilization vanishes).
-    ``max_iterations``: {solver: limit}.
+    ``reference``: a ``vemkit.studies.convergence.ReferenceSolution``. All-triangle k = 1 families are
+    solved with the first stabilization only (the VEM space is P1 there, the stabilization vanishes;
+    not so for k = 2: the space has a cell mean beyond P2). ``max_iterations``: {solver: limit}.
     """
-    from vemkit.vem.norms import projection_error
     from vemkit.mesh.families import build_mesh
-    from vemkit.vem.projection import projected_solution
     from vemkit.contact.problem import scene_problem
 
+    order = family_order(spec)
     records = []
-    stabs = list(stabilizations)[:1] if spec["family"] == "triangle" else list(stabilizations)
-    _warm_up(scene, spec, stabs, solvers)
+    stabs = list(stabilizations)[:1] if spec["family"] == "triangle" and order == 1 else list(stabilizations)
+    order_override = [f"discretization.order={order}"] if order != 1 else []
+    _warm_up(scene.with_overrides(order_override), spec, stabs, solvers)
+    measure = _ErrorMeasure(reference)
     for n in levels:
         if not _finest_ok(spec, n, reference_n):
             continue
@@ -80,8 +93,8 @@ def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tol
         mesh_time = time.perf_counter() - t0
         for stab in stabs:
             mesh_section = {"family": spec["family"], "n": int(n), **(spec.get("options") or {})}
-            run_scene = scene.with_overrides([f"discretization.stabilization={stab}",
-                                              f"discretization.mesh={json.dumps(mesh_section)}"])
+            run_scene = scene.with_overrides(order_override + [f"discretization.stabilization={stab}",
+                                                               f"discretization.mesh={json.dumps(mesh_section)}"])
             t0 = time.perf_counter()
             problem = scene_problem(run_scene, mesh)
             assembly_time = time.perf_counter() - t0
@@ -92,28 +105,66 @@ def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tol
                         options["max_iterations"] = int(max_iterations[solver])
                     if solver == "uzawa":
                         options.update(eps_u=float(tol), eps_lambda=float(tol))
-                    best = guarded_solve(problem, options, time_budget=time_budget, check_tol=None)
-                    for _ in range(int(repeats) - 1 if best.converged else 0):  # a failure is not repeated
-                        again = guarded_solve(problem, options, time_budget=time_budget, check_tol=None)
-                        best = again if again.converged and again.wall_time < best.wall_time else best
+                    best = _best_solve(problem, options, repeats, time_budget)
                     record = {"family": label, "family_name": spec["family"], "solver": solver, "tol": float(tol),
-                              "stabilization": stab, "n": int(n), "n_dofs": int(problem.n_dofs),
-                              "n_cells": int(mesh.n_cells), "h_min": float(_smallest_edge(mesh)),
-                              "iterations": best.iterations, "status": best.code, "message": best.message,
-                              "wall_time": best.wall_time, "assembly_time": assembly_time, "mesh_time": mesh_time,
+                              "stabilization": stab, "n": int(n), "order": order,
+                              "n_dofs": int(getattr(problem, "n_space_dofs", problem.n_dofs)),
+                              "n_unknowns": int(problem.n_dofs), "n_cells": int(mesh.n_cells),
+                              "h_min": float(_smallest_edge(mesh)), "iterations": best.iterations,
+                              "status": best.code, "message": best.message, "wall_time": best.wall_time,
+                              "assembly_time": assembly_time, "mesh_time": mesh_time,
                               "cost_time": assembly_time + best.wall_time,
                               "residual": float(best.checks.get("worst", np.nan)) if best.checks else float("nan")}
-                    if best.converged:
-                        u = problem.dofs.expand(best.solution.u)
-                        err = projection_error(mesh, projected_solution(mesh, u), reference.mesh, reference.projected,
-                                               reference.quadrature)
-                        record.update(error_h1=err["h1"], error_h1_semi=err["h1_semi"], error_l2=err["l2"])
-                    else:
-                        record.update(error_h1=float("nan"), error_h1_semi=float("nan"), error_l2=float("nan"))
+                    record.update(measure(problem, best) if best.converged else
+                                  {key: float("nan") for key in ("error_h1", "error_h1_semi", "error_l2")})
                     records.append(record)
                     if progress is not None:
                         progress(record)
     return records
+
+
+def family_order(spec: dict) -> int:
+    """The polynomial order k of a family spec (``order``: 1 or 2, default 1)."""
+    order = spec.get("order", 1)
+    if order not in (1, 2):
+        raise InputError(f"tradeoff family order {order!r} is not supported: use order 1 or 2", key="order")
+    return int(order)
+
+
+def _best_solve(problem, options, repeats, time_budget):
+    """The fastest of ``repeats`` guarded solves (a failure is not repeated)."""
+    best = guarded_solve(problem, options, time_budget=time_budget, check_tol=None)
+    for _ in range(int(repeats) - 1 if best.converged else 0):
+        again = guarded_solve(problem, options, time_budget=time_budget, check_tol=None)
+        best = again if again.converged and again.wall_time < best.wall_time else best
+    return best
+
+
+class _ErrorMeasure:
+    """error_h1, error_h1_semi, error_l2 of a converged run against ``reference``: Pi_1 u_h of a k = 1
+    run (``vemkit.vem.norms.projection_error``, as before k = 2 existed), Pi_2 u_h of a k = 2 run
+    (``projection_error_k2`` with a degree-5 rule on the reference cells, built on first use)."""
+
+    def __init__(self, reference):
+        self.reference = reference
+        self._quadrature5 = None
+
+    def __call__(self, problem, outcome) -> dict:
+        from vemkit.vem.norms import projection_error, reference_quadrature
+        from vemkit.vem.norms_k2 import projection_error_k2
+        from vemkit.vem.projection import projected_solution
+
+        ref, mesh = self.reference, problem.mesh
+        if getattr(problem, "order", 1) == 1 and getattr(ref, "order", 1) == 1:
+            err = projection_error(mesh, projected_solution(mesh, problem.dofs.expand(outcome.solution.u)),
+                                   ref.mesh, ref.projected, ref.quadrature)
+        else:
+            if self._quadrature5 is None:
+                self._quadrature5 = reference_quadrature(ref.mesh, degree=5)
+            mine = problem.projected(outcome.solution.u) if getattr(problem, "order", 1) == 2 else \
+                projected_solution(mesh, problem.dofs.expand(outcome.solution.u))
+            err = projection_error_k2(mesh, mine, ref.mesh, ref.projected, self._quadrature5)
+        return {"error_h1": err["h1"], "error_h1_semi": err["h1_semi"], "error_l2": err["l2"]}
 
 
 def _warm_up(scene, spec, stabilizations, solvers):
@@ -151,8 +202,9 @@ def pareto_front(cost, error) -> np.ndarray:
 
 
 def describe(ds, i) -> str:
-    """One run as "family, solver, tol, stabilization, n"."""
-    return (f"{ds['family'].values[i]}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
+    """One run as "family[ (k = 2)], solver, tol, stabilization, n"."""
+    order = int(ds["order"].values[i]) if "order" in ds else 1
+    return (f"{ds['family'].values[i]}{' (k = 2)' if order == 2 else ''}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
             f"{ds['stabilization'].values[i]}, n = {int(ds['n'].values[i])}")
 
 
@@ -232,9 +284,14 @@ def tradeoff_dataset(records, *, targets=(0.1, 0.05, 0.02, 0.01), gains=(), erro
         ds[key] = ("run", np.array([float(r[key]) for r in records]))
     for key in RECORD_INTS:
         ds[key] = ("run", np.array([int(r[key]) for r in records], dtype=np.int64))
+    for key, default in RECORD_OPTIONAL_INTS.items():
+        ds[key] = ("run", np.array([int(r[key]) if key in r else int(default(r)) for r in records], dtype=np.int64))
     units = {"wall_time": "s", "assembly_time": "s", "mesh_time": "s", "cost_time": "s", "h_min": "mm"}
     long_names = {
-        "error_h1": "||Pi_1(u_h - u_ref)||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm)", "error_h1_semi": "same, H1 seminorm",
+        "error_h1": "||Pi_k u_h - Pi_1 u_ref||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm; Pi_k: the run's order)",
+        "error_h1_semi": "same, H1 seminorm", "order": "polynomial order k of the virtual elements",
+        "n_dofs": "free DOFs of the discrete space (k = 2: vertex values, edge and cell means)",
+        "n_unknowns": "unknowns of the solved system (k = 2: cell means condensed out)",
         "error_l2": "same, L2 norm", "cost_time": "assembly + contact solve (linear solver set-up included)",
         "wall_time": "contact solve, best of the repeats", "mesh_time": "mesh generation (not in cost_time)",
         "residual": "worst independent check (vemkit.studies.robustness)", "tol": "solver tolerance", "h_min": "shortest edge",
@@ -257,6 +314,27 @@ def tradeoff_dataset(records, *, targets=(0.1, 0.05, 0.02, 0.01), gains=(), erro
                      "vemkit_version": vemkit.__version__,
                      "missing_values": "errors of runs that did not converge (status != 0): _FillValue -9999.0"})
     return ds
+
+
+def order_comparison(ds, targets, error: str = "error_h1") -> list[str]:
+    """Markdown lines: per target error, the cheapest k = 1 and the cheapest k = 2 run (in wall time)
+    and the time ratio; nothing unless both orders were run."""
+    orders = ds["order"].values if "order" in ds else np.ones(ds.sizes["run"], dtype=np.int64)
+    if not (np.any(orders == 1) and np.any(orders == 2)):
+        return []
+    best = {k: cheapest_for_targets(ds.isel(run=np.flatnonzero(orders == k)), targets, error) for k in (1, 2)}
+    lines = ["", "## First against second order (k = 1 against k = 2)", "",
+             "| target error | cheapest k = 1 | time [s] | DOFs | cheapest k = 2 | time [s] | DOFs | time k = 2 / k = 1 |",
+             "|---|---|---:|---:|---|---:|---:|---:|"]
+    for one, two in zip(best[1], best[2], strict=True):
+        cells = []
+        for row in (one, two):
+            t = row.get("cost_time")
+            cells.append(f"{t['configuration']} | {t['cost_time']:.3f} | {t['n_dofs']}" if t else "not reached | | ")
+        ratio = (f"{two['cost_time']['cost_time'] / one['cost_time']['cost_time']:.2f}"
+                 if one["reached"] and two["reached"] else "")
+        lines.append(f"| {_percent(one['target'])} | {cells[0]} | {cells[1]} | {ratio} |")
+    return lines
 
 
 def _percent(x) -> str:
@@ -290,6 +368,7 @@ def tradeoff_markdown(ds) -> str:
             t = row["cost_time"]
             lines.append(f"**For {_percent(row['target'])} error the cheapest configuration is** {t['configuration']}: "
                          f"{t['cost_time']:.3f} s, {t['n_dofs']} DOFs, error {_percent(t['error'])}.  ")
+    lines += order_comparison(ds, [row["target"] for row in answers], error)
     for cost, name, title in (("cost_time", "pareto_time", "wall time"), ("n_dofs", "pareto_dofs", "DOFs")):
         idx = np.flatnonzero(ds[name].values == 1)
         idx = idx[np.argsort(ds[cost].values[idx])]
