@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/adaptivity.py [--quick] [--scenes lbracket,paper,kirsch,cook]
 
 Per scene of config/adaptivity.yaml, in this one process: the reference solution (or the scene's
-exact solution; the workflow's results/adaptivity/LABEL/reference.nc is reused when it was made
+exact solution; the workflow's results/adaptive/LABEL/reference.nc is reused when it was made
 with the same settings), then the adaptive and the uniform run from the scene's mesh (the workflow's
 ``snakemake adaptivity`` runs the same: ``vemkit.studies.adaptivity_compare``), compared by
 ``adaptivity_compare.compare`` on the error config/adaptivity.yaml names: the relative H1-seminorm
@@ -48,11 +48,11 @@ def case_of(label: str, quick: bool) -> dict:
 
 
 def _workflow_reference(label: str, case: dict, quick: bool):
-    """The workflow's reference file of this scene (results/adaptivity/LABEL/reference.nc) if it was
+    """The workflow's reference file of this scene (results/adaptive/LABEL/reference.nc) if it was
     computed for the same scene and reference settings: it is an input here, not what is measured."""
     import xarray as xr
 
-    path = ROOT / "results" / "adaptivity" / label / "reference.nc"
+    path = ROOT / "results" / "adaptive" / label / "reference.nc"
     if quick or not path.is_file():
         return None
     kind, size = next(iter(case["reference"].items()))

@@ -1,5 +1,7 @@
 """Local refinement with hanging nodes (vemkit.mesh.refine): valid meshes, exact geometry, patch test."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -121,3 +123,56 @@ def test_bad_cell_indices_are_refused():
 
     with pytest.raises(InputError, match="cell indices"):
         refine_cells(build_mesh("square", 2), [4])
+
+
+def test_a_non_convex_cell_is_split_from_its_kernel_when_centroid_and_vertex_mean_lie_outside():
+    # a thin L: centroid (2.87, 2.87) and vertex mean (3.67, 3.67) see neither inner edge; its kernel
+    # is the unit square at the corner, whose centroid becomes the new vertex
+    v = [[0, 0], [10, 0], [10, 1], [1, 1], [1, 10], [0, 10]]
+    mesh = from_polygons(v, [list(range(6))], {"outer": [[i, (i + 1) % 6] for i in range(6)]})
+    refined = refine_cells(mesh, [0])
+    assert refined.skipped.size == 0 and refined.mesh.n_cells == 6
+    validate_mesh(refined.mesh)
+    assert np.allclose(refined.mesh.vertices[-1], [0.5, 0.5], atol=1e-12)
+    assert np.isclose(refined.mesh.cell_areas.sum(), 19.0, rtol=1e-14)
+
+
+def test_cut_cells_at_a_circular_hole_are_split_with_every_new_vertex_on_the_circle():
+    """The L-bracket's bore (radius 2 at (5, 25)) on squares h = 2.5 starts as an octagon in four
+    cut cells that wrap its corners; vertices moved onto the circle dent them until neither centroid
+    nor vertex mean sees every edge. Every refinement splits them from a kernel point instead."""
+    from vemkit.config.scene import load_scene
+    from vemkit.mesh.families import scene_mesh
+    from vemkit.studies.adaptivity import curved_sides
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "config" / "scenes" / "lbracket.yaml",
+                       ["discretization.mesh.h=2.5"])
+    mesh, circles = scene_mesh(scene), curved_sides(scene.domain)
+    area = mesh.cell_areas.sum()
+    for step in range(4):
+        bore = np.unique(mesh.boundary["bore"])
+        at_bore = [k for k in range(mesh.n_cells) if np.isin(mesh.cell(k), bore).any()]
+        refined = refine_cells(mesh, at_bore, circles=circles)
+        assert refined.skipped.size == 0 and np.array_equal(refined.refined, at_bore)
+        mesh = refined.mesh
+        validate_mesh(mesh)
+        on_bore = np.unique(mesh.boundary["bore"])
+        assert on_bore.size == 2 * bore.size == 16 * 2**step
+        assert np.allclose(np.linalg.norm(mesh.vertices[on_bore] - [5.0, 25.0], axis=1), 2.0, atol=1e-13)
+        # the bore's polygon (16 * 2^step sides inscribed in the circle) grows towards the circle
+        bore_area = 0.5 * on_bore.size * 4.0 * np.sin(2 * np.pi / on_bore.size)
+        assert mesh.cell_areas.sum() < area and np.isclose(mesh.cell_areas.sum(), 700.0 - bore_area, rtol=1e-13)
+        area = mesh.cell_areas.sum()
+
+
+def test_a_new_vertex_the_circle_would_push_out_of_its_cell_stays_on_the_chord():
+    # a thin strip x + y in [1, 1.05] whose side on the unit circle is one chord: the circle's midpoint
+    # (0.707, 0.707) lies beyond the strip, so that cell keeps its new vertex at the chord's midpoint
+    v = [[1, 0], [1.05, 0], [0, 1.05], [0, 1]]
+    mesh = from_polygons(v, [[0, 1, 2, 3]], {"outer": [[0, 1], [1, 2], [2, 3]], "hole": [[3, 0]]},
+                         {"circles": {"hole": [0.0, 0.0, 1.0]}})
+    refined = refine_cells(mesh, [0])
+    assert refined.skipped.size == 0 and refined.mesh.n_cells == 4
+    validate_mesh(refined.mesh)
+    hole = np.unique(refined.mesh.boundary["hole"])
+    assert hole.size == 3 and np.allclose(refined.mesh.vertices[hole[-1]], [0.5, 0.5], atol=1e-15)

@@ -59,3 +59,15 @@ def test_bad_settings_are_refused_naming_the_key(tmp_path, entry, key):
     run = dry_run("adaptivity", "--configfile", _config(tmp_path, {"mine": entry}))
     message = run.stdout + run.stderr
     assert run.returncode != 0 and key in message and "adaptivity_study" in message and "Traceback" not in message
+
+
+def test_every_output_is_written_under_results_adaptive():
+    """Issue 12: the pipeline writes results/adaptive/*.nc (per scene: the runs, the reference, the
+    mesh snapshots; the figures and the summary beside them)."""
+    run = dry_run("adaptivity")
+    assert run.returncode == 0, run.stdout + run.stderr
+    outputs = [path.strip() for line in re.findall(r"^\s+output: (.+)$", run.stdout, re.M) for path in line.split(",")]
+    assert outputs and all(path.startswith("results/adaptive/") for path in outputs), outputs
+    scenes = [label for label, case in STUDY["scenes"].items() if (ROOT / case["scene"]).is_file()]
+    for label in scenes:
+        assert {f"results/adaptive/{label}/{mode}.nc" for mode in ("adaptive", "uniform")} <= set(outputs)

@@ -8,14 +8,17 @@ hanging node on a straight edge is a vertex but not a corner) is split into m po
 where s_i is the midpoint of the geometric edge c_i c_{i+1} and z the centroid of the cell. A
 square becomes its four quadrants (quadrisection), a triangle three quadrilaterals, a Voronoi cell
 m quadrilaterals. The split needs z in the kernel of the cell (z to the left of every edge), which
-holds for convex cells; for a non-convex cell the vertex mean is tried next, and a cell with neither
-in its kernel is left whole (reported in ``RefinedMesh.skipped``).
+holds for convex cells; for a non-convex cell the vertex mean is tried next, then the centroid of
+the kernel itself (the cell's bounding box cut by the left half-plane of every edge: a cut cell at
+a circular hole, dented by its new vertices on the circle, or one wrapping a corner of the hole's
+polygon). A cell whose new vertices on a circle leave it no kernel gets them on its chords instead;
+a cell without a kernel at all (not star-shaped) is left whole (reported in ``RefinedMesh.skipped``).
 
 A new edge midpoint is inserted as a vertex into the one or two cells sharing that edge, so the mesh
 stays vertex-conforming: the neighbour is not refined, it simply gains a vertex (SPEC §3).
 ``max_hanging = k`` also refines every cell that would otherwise carry more than k vertices inside
 one of its geometric edges (repeated until none does). On a circular side (``mesh.meta["circles"]``:
-{side: [cx, cy, r]}) a new boundary vertex is placed on the circle, not on the chord. Boundary
+{side: [cx, cy, r]}) a new boundary vertex is placed on the circle, not on the chord (see above). Boundary
 edges keep their side names. The prolongation maps vertex values of the old mesh to the new one
 (linear along split edges, the vertex mean at cell centres): a warm start for the next solve.
 """
@@ -57,6 +60,7 @@ class _Splits(NamedTuple):
     points: np.ndarray  # (new, 2) their coordinates
     ends: np.ndarray  # (new, 2) the old edge (min, max) of each new vertex
     t: np.ndarray  # (new,) the parameter along min -> max
+    chords: np.ndarray  # (new, 2) the coordinates on the old edge (points: moved onto a circle)
 
 
 def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: dict) -> _Splits:
@@ -68,11 +72,11 @@ def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: dict) -> _
     rows = np.unique(np.stack([lo * n + hi, np.round(t * 1e9).astype(np.int64)], axis=1), axis=0)
     keys, ticks = rows[:, 0], rows[:, 1] / 1e9
     ends = np.stack([keys // n, keys % n], axis=1)
-    points = mesh.vertices[ends[:, 0]] + ticks[:, None] * (mesh.vertices[ends[:, 1]] - mesh.vertices[ends[:, 0]])
-    points = _on_circles(mesh, ends, points, circles)
+    chords = mesh.vertices[ends[:, 0]] + ticks[:, None] * (mesh.vertices[ends[:, 1]] - mesh.vertices[ends[:, 0]])
+    points = _on_circles(mesh, ends, chords.copy(), circles)
     unique_keys, first = np.unique(keys, return_index=True)
     ptr = np.r_[first, keys.size].astype(np.int64)
-    return _Splits(unique_keys, ptr, n + np.arange(keys.size), points, ends, ticks)
+    return _Splits(unique_keys, ptr, n + np.arange(keys.size), points, ends, ticks, chords)
 
 
 def _on_circles(mesh: Mesh, ends: np.ndarray, points: np.ndarray, circles: dict) -> np.ndarray:
@@ -119,8 +123,25 @@ def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles:
     return _assemble(mesh, refine, splits, points, offsets, ring, ring_corner)
 
 
-def _assemble(mesh: Mesh, refine, splits: _Splits, points, offsets, ring, ring_corner) -> RefinedMesh:
+def _centres(mesh: Mesh, refine, splits: _Splits, points, offsets, ring):
+    """(split centres, points): a cell that new vertices moved onto a circle leave without a kernel
+    point gets them back on its chords (its boundary edges are its own), then it is tried again."""
     centres = split_centres(points, offsets, ring, refine)
+    stuck = refine[np.isnan(centres[:, 0])]
+    if stuck.size == 0:
+        return centres, points
+    slots = np.concatenate([ring[offsets[c]:offsets[c + 1]] for c in stuck]) - mesh.n_vertices
+    new = slots[slots >= 0]
+    moved = new[np.any(splits.points[new] != splits.chords[new], axis=1)]
+    if moved.size == 0:
+        return centres, points
+    points = points.copy()
+    points[mesh.n_vertices + moved] = splits.chords[moved]
+    return split_centres(points, offsets, ring, refine), points
+
+
+def _assemble(mesh: Mesh, refine, splits: _Splits, points, offsets, ring, ring_corner) -> RefinedMesh:
+    centres, points = _centres(mesh, refine, splits, points, offsets, ring)
     ok = ~np.isnan(centres[:, 0])
     split, skipped = refine[ok], refine[~ok]
     n_new = points.shape[0]

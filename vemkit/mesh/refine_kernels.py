@@ -153,8 +153,58 @@ def _kernel_point(points, ring, s, n, zx, zy):
 
 
 @numba.njit(cache=True)
+def _clip(poly, m, ax, ay, ex, ey, out):
+    """Sutherland-Hodgman: the convex polygon poly[:m] cut to the left of the line a + s e; out its
+    vertices, the count returned."""
+    k = 0
+    for i in range(m):
+        px, py, qx, qy = poly[i, 0], poly[i, 1], poly[(i + 1) % m, 0], poly[(i + 1) % m, 1]
+        dp = ex * (py - ay) - ey * (px - ax)
+        dq = ex * (qy - ay) - ey * (qx - ax)
+        if dp >= 0.0:
+            out[k, 0], out[k, 1] = px, py
+            k += 1
+        if (dp >= 0.0) != (dq >= 0.0):
+            w = dp / (dp - dq)
+            out[k, 0], out[k, 1] = px + w * (qx - px), py + w * (qy - py)
+            k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def kernel_centroid(points, ring, s, n):
+    """Centroid of the kernel of the counter-clockwise polygon ring[s:s + n] (the points that see
+    every edge: the cell's bounding box cut by the left half-plane of each edge); (nan, nan) if the
+    kernel has no area."""
+    poly, out = np.empty((n + 4, 2)), np.empty((n + 4, 2))
+    lo_x, lo_y, hi_x, hi_y = np.inf, np.inf, -np.inf, -np.inf
+    for i in range(n):
+        x, y = points[ring[s + i], 0], points[ring[s + i], 1]
+        lo_x, lo_y, hi_x, hi_y = min(lo_x, x), min(lo_y, y), max(hi_x, x), max(hi_y, y)
+    poly[0, 0], poly[0, 1], poly[1, 0], poly[1, 1] = lo_x, lo_y, hi_x, lo_y
+    poly[2, 0], poly[2, 1], poly[3, 0], poly[3, 1] = hi_x, hi_y, lo_x, hi_y
+    m = 4
+    for i in range(n):
+        u, v = ring[s + i], ring[s + (i + 1) % n]
+        m = _clip(poly, m, points[u, 0], points[u, 1], points[v, 0] - points[u, 0], points[v, 1] - points[u, 1], out)
+        poly, out = out, poly
+        if m < 3:
+            return np.nan, np.nan
+    area, sx, sy = 0.0, 0.0, 0.0
+    for i in range(m):
+        cross = poly[i, 0] * poly[(i + 1) % m, 1] - poly[(i + 1) % m, 0] * poly[i, 1]
+        area += cross
+        sx += (poly[i, 0] + poly[(i + 1) % m, 0]) * cross
+        sy += (poly[i, 1] + poly[(i + 1) % m, 1]) * cross
+    if area <= 1e-14 * (hi_x - lo_x) * (hi_y - lo_y):
+        return np.nan, np.nan
+    return sx / (3 * area), sy / (3 * area)
+
+
+@numba.njit(cache=True)
 def split_centres(points, offsets, ring, cells):
-    """Per cell: the centroid, else the vertex mean, if in the kernel; (nan, nan) if neither is."""
+    """Per cell: the centroid, else the vertex mean, else the kernel's centroid, if in the kernel;
+    (nan, nan) if the cell has no kernel (it is not star-shaped)."""
     out = np.full((cells.shape[0], 2), np.nan)
     for k in range(cells.shape[0]):
         c = cells[k]
@@ -172,6 +222,10 @@ def split_centres(points, offsets, ring, cells):
             out[k, 0], out[k, 1] = sx / (3 * area), sy / (3 * area)
         elif _kernel_point(points, ring, s, n, mx, my):
             out[k, 0], out[k, 1] = mx, my
+        else:
+            zx, zy = kernel_centroid(points, ring, s, n)
+            if not np.isnan(zx) and _kernel_point(points, ring, s, n, zx, zy):
+                out[k, 0], out[k, 1] = zx, zy
     return out
 
 

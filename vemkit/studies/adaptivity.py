@@ -202,7 +202,7 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
         reason = _stop_reason(found["estimate"], step, settings)
         if reason is None:
             marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
-            refined = _refined(mesh, marked, settings.max_hanging, circles)
+            refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
             if 2 * refined.mesh.n_vertices > settings.max_dofs:
                 reason = "max_dofs"
@@ -219,17 +219,6 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             return run
     run.reason = "max_steps"
     return run
-
-
-def _refined(mesh, marked, max_hanging, circles):
-    """refine_cells with new boundary vertices on the curved sides; if that leaves a marked cell whole
-    (a vertex moved onto a circle can dent a thin cut cell until its centre leaves its kernel: a cell
-    of the square family at a hole), this step keeps them on the chords instead."""
-    refined = refine_cells(mesh, marked, max_hanging=max_hanging, circles=circles)
-    if refined.skipped.size and circles:
-        straight = refine_cells(mesh, marked, max_hanging=max_hanging, circles={})
-        refined = straight if straight.skipped.size < refined.skipped.size else refined
-    return refined
 
 
 def _stop_reason(estimate: float, step: int, settings: AdaptivitySettings):

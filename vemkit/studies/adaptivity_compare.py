@@ -92,7 +92,7 @@ def _number(value, fmt: str) -> str:
 
 
 def summary_markdown(comparisons: dict) -> str:
-    """{scene: compare(...)} as the Markdown table of results/adaptivity/summary.md."""
+    """{scene: compare(...)} as the Markdown table of results/adaptive/summary.md."""
     lines = ["# Adaptive against uniform refinement", "",
              "Rates: slope of log(error) against log(DOFs) over the asymptotic steps (optimal k = 1: −0.5). "
              "DOFs ratio: uniform / adaptive DOFs at the finest uniform step's error. Times: the adaptive loop's "

@@ -11,7 +11,10 @@
   adapted cells inside the other reference cells. For meshes nested with the reference (squares
   refined by quadrisection against a finer square mesh, the paper scene) every integrand is then a
   polynomial on each quadrature cell and the errors are exact; otherwise the quadrature resolves
-  the cell boundaries to the finer mesh's size.
+  the cell boundaries to the finer mesh's size. On a curved side (a circular hole) a mesh finer
+  there than the reference has its boundary vertices further out on the circle: reference points in
+  the slivers between the two polygons are taken by the nearest adapted cell (Π_1 u_h extended
+  linearly over a distance below that cell's diameter).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
@@ -33,6 +37,8 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     points, weights, ref_cells = reference.quadrature
     cells = locate_points(mesh, points)
     if np.any(cells < 0):
+        cells[cells < 0] = _nearest_cells(mesh, points[cells < 0])
+    if np.any(cells < 0):
         raise InputError("adaptivity.reference: the reference mesh covers points outside the adapted mesh "
                          "(another body?); give a solution file of this scene", key="adaptivity.reference")
     n_ref = reference.mesh.n_cells
@@ -46,6 +52,13 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     keep = ~split[ref_cells]
     return (np.concatenate([points[keep], fine_points[take]]), np.concatenate([weights[keep], fine_weights[take]]),
             np.concatenate([cells[keep], fine_cells[take]]), np.concatenate([ref_cells[keep], fine_ref[take]]))
+
+
+def _nearest_cells(mesh, points):
+    """The cell whose vertex mean is nearest each point, −1 where that is farther than its diameter."""
+    means = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
+    distance, nearest = cKDTree(means).query(points)
+    return np.where(distance <= mesh.cell_diameters[nearest], nearest, -1)
 
 
 def reference_errors(mesh, u_vertices, reference: ReferenceSolution) -> dict:

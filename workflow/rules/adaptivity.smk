@@ -20,15 +20,15 @@ def adaptivity_case(label):
 
 def adaptivity_reference(label):
     """The reference solution a scene's errors are measured against ([] : the scene's exact solution)."""
-    return [] if adaptivity_case(label)["reference"] is None else [f"results/adaptivity/{label}/reference.nc"]
+    return [] if adaptivity_case(label)["reference"] is None else [f"results/adaptive/{label}/reference.nc"]
 
 
 def adaptivity_snapshots(label, mode):
-    return [f"results/adaptivity/{label}/{mode}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)]
+    return [f"results/adaptive/{label}/{mode}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)]
 
 
-ADAPTIVITY_TARGETS = ["results/adaptivity/summary.md"] + [
-    f"results/adaptivity/{label}/{name}.png" for label in ADAPTIVITY_SCENES for name in ("convergence", "meshes")]
+ADAPTIVITY_TARGETS = ["results/adaptive/summary.md"] + [
+    f"results/adaptive/{label}/{name}.png" for label in ADAPTIVITY_SCENES for name in ("convergence", "meshes")]
 
 
 ADAPTIVITY_SCENE_PATTERN = "|".join(map(re.escape, ADAPTIVITY_SCENES)) if ADAPTIVITY_SCENES else "noscene"
@@ -42,15 +42,15 @@ def adaptivity_reference_case(label):
 
 rule adaptivity_reference:
     output:
-        "results/adaptivity/{adaptive_scene}/reference.nc",
+        "results/adaptive/{adaptive_scene}/reference.nc",
     params:
         case=lambda wc: adaptivity_reference_case(wc.adaptive_scene),
     wildcard_constraints:
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
     log:
-        "logs/adaptivity/{adaptive_scene}/reference.log",
+        "logs/adaptive/{adaptive_scene}/reference.log",
     benchmark:
-        "results/benchmarks/adaptivity/{adaptive_scene}/reference.tsv"
+        "results/benchmarks/adaptive/{adaptive_scene}/reference.tsv"
     script:
         "../scripts/adaptivity_reference.py"
 
@@ -59,52 +59,52 @@ rule adaptivity_run:
     input:
         reference=lambda wc: adaptivity_reference(wc.adaptive_scene),
     output:
-        nc="results/adaptivity/{adaptive_scene}/{mode}.nc",
-        snapshots=[f"results/adaptivity/{{adaptive_scene}}/{{mode}}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)],
+        nc="results/adaptive/{adaptive_scene}/{mode}.nc",
+        snapshots=[f"results/adaptive/{{adaptive_scene}}/{{mode}}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)],
     params:
         case=lambda wc: adaptivity_case(wc.adaptive_scene),
     wildcard_constraints:
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
         mode="adaptive|uniform",
     log:
-        "logs/adaptivity/{adaptive_scene}/{mode}.log",
+        "logs/adaptive/{adaptive_scene}/{mode}.log",
     benchmark:
-        "results/benchmarks/adaptivity/{adaptive_scene}/{mode}.tsv"
+        "results/benchmarks/adaptive/{adaptive_scene}/{mode}.tsv"
     script:
         "../scripts/adaptivity_run.py"
 
 
 rule adaptivity_figures:
     input:
-        adaptive="results/adaptivity/{adaptive_scene}/adaptive.nc",
-        uniform="results/adaptivity/{adaptive_scene}/uniform.nc",
+        adaptive="results/adaptive/{adaptive_scene}/adaptive.nc",
+        uniform="results/adaptive/{adaptive_scene}/uniform.nc",
         snapshots=lambda wc: adaptivity_snapshots(wc.adaptive_scene, "adaptive"),
     output:
-        convergence="results/adaptivity/{adaptive_scene}/convergence.png",
-        meshes="results/adaptivity/{adaptive_scene}/meshes.png",
+        convergence="results/adaptive/{adaptive_scene}/convergence.png",
+        meshes="results/adaptive/{adaptive_scene}/meshes.png",
     params:
         error=lambda wc: adaptivity_case(wc.adaptive_scene)["error"],
     wildcard_constraints:
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
     log:
-        "logs/adaptivity/{adaptive_scene}/figures.log",
+        "logs/adaptive/{adaptive_scene}/figures.log",
     script:
         "../scripts/adaptivity_figures.py"
 
 
 rule adaptivity_summary:
     input:
-        adaptive=[f"results/adaptivity/{label}/adaptive.nc" for label in ADAPTIVITY_SCENES],
-        uniform=[f"results/adaptivity/{label}/uniform.nc" for label in ADAPTIVITY_SCENES],
+        adaptive=[f"results/adaptive/{label}/adaptive.nc" for label in ADAPTIVITY_SCENES],
+        uniform=[f"results/adaptive/{label}/uniform.nc" for label in ADAPTIVITY_SCENES],
     output:
-        md="results/adaptivity/summary.md",
-        json="results/adaptivity/summary.json",
+        md="results/adaptive/summary.md",
+        json="results/adaptive/summary.json",
     params:
         scenes=ADAPTIVITY_SCENES,
         errors=[adaptivity_case(label)["error"] for label in ADAPTIVITY_SCENES],
         targets=ADAPTIVITY.get("targets", [0.01]),
     log:
-        "logs/adaptivity/summary.log",
+        "logs/adaptive/summary.log",
     script:
         "../scripts/adaptivity_summary.py"
 
