@@ -74,27 +74,25 @@ def test_a_sliver_joins_the_neighbour_it_shares_most_with():
 
 
 def test_boxes_meet_segments_matches_brute_force():
-    import sys
+    from vemkit.mesh.families import voronoi_kernels
 
-    voronoi_module = sys.modules["vemkit.mesh.families.voronoi"]
     rng = np.random.default_rng(5)
     lo = rng.uniform(0, 10, (400, 2))
     hi = lo + rng.uniform(0, 0.5, (400, 2))
     a, b = rng.uniform(0, 10, (60, 2)), rng.uniform(-1, 1, (60, 2))
     seg_lo, seg_hi = np.minimum(a, a + b), np.maximum(a, a + b)
-    got = voronoi_module._boxes_meet_segments(lo, hi, seg_lo, seg_hi, np.zeros(2), 2.0, 20)
+    got = voronoi_kernels.boxes_meet_segments(lo, hi, seg_lo, seg_hi, np.zeros(2), 2.0, 20)
     want = ((seg_lo[None, :, :] <= hi[:, None, :]) & (lo[:, None, :] <= seg_hi[None, :, :])).all(axis=2).any(axis=1)
     np.testing.assert_array_equal(got, want)
     assert 0 < want.sum() < 400
 
 
 def test_voronoi_fan_kernel_equals_its_numpy_twin_bit_for_bit():
-    import sys
-
     import triangle as shewchuk
 
-    voronoi_module = sys.modules["vemkit.mesh.families.voronoi"]
+    from vemkit.mesh.families import voronoi_kernels
+
     points = np.random.default_rng(2).random((500, 2))
     tris = shewchuk.delaunay(points).astype(np.int64)
-    for got, want in zip(voronoi_module._fans(points, tris, 480), voronoi_module.fans_reference(points, tris, 480)):
+    for got, want in zip(voronoi_kernels.fans(points, tris, 480), voronoi_kernels.fans_reference(points, tris, 480)):
         np.testing.assert_array_equal(got, want)

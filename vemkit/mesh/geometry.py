@@ -2,8 +2,10 @@
 
 - the shoelace formula, once: ``polygon_area_centroid`` / ``polygon_area`` for one polygon (Numba,
   callable from other Numba kernels: the element stiffness uses it) and ``areas_centroids`` /
-  ``polygon_areas`` for many polygons in CSR form (vectorized numpy, the same formula), and
-  ``counter_clockwise`` which reverses the clockwise ones;
+  ``polygon_areas`` for many polygons in CSR form (the same formula summed in numpy's order: a
+  Numba kernel with the bits of its vectorized twin ``areas_centroids_numpy``; its per-polygon parts
+  ``area_centroid_few`` / ``area_centroid_many`` serve other kernels), and ``counter_clockwise``
+  which reverses the clockwise ones;
 - ``bin_boxes``: items binned on a uniform g x g grid by their bounding boxes, for point location
   and segment-intersection searches (``vemkit.vem.norms``, ``vemkit.mesh.checks``).
 """
@@ -62,12 +64,25 @@ def polygon_area(px, py):
 
 
 def areas_centroids(coords: np.ndarray, offsets: np.ndarray):
-    """Signed areas ``(M,)`` and centroids ``(M, 2)`` of M polygons in CSR form, vectorized.
+    """Signed areas ``(M,)`` and centroids ``(M, 2)`` of M polygons in CSR form.
 
     Polygon k has the points ``coords[offsets[k]:offsets[k + 1]]``. The formula of
-    ``polygon_area_centroid``; the sums run in numpy's order (pairwise), so results may differ from
-    the kernel's in the last bits. Every mesh family depends on these exact bits: keep them.
+    ``polygon_area_centroid``; the sums run in numpy's order (``np.add.reduceat``: pairwise), so
+    results may differ from ``polygon_area_centroid``'s in the last bits. Every mesh family depends
+    on these exact bits: keep them. A Numba kernel repeats numpy's summation order (bit for bit
+    ``areas_centroids_numpy``, the vectorized twin; tests compare them); offsets that are not a plain
+    CSR of all of ``coords`` (empty polygons, a tail) and polygons of over 129 points go to the twin.
     """
+    coords = np.ascontiguousarray(coords, dtype=np.float64).reshape(-1, 2)
+    offsets = np.ascontiguousarray(offsets, dtype=np.int64)
+    if offsets.size < 2:
+        return np.zeros(0), np.zeros((0, 2))
+    area, centroid, plain = _areas_centroids_kernel(coords, offsets)
+    return (area, centroid) if plain else areas_centroids_numpy(coords, offsets)
+
+
+def areas_centroids_numpy(coords: np.ndarray, offsets: np.ndarray):
+    """``areas_centroids`` vectorized with numpy (its twin, and the reference of its bits)."""
     coords = np.asarray(coords, dtype=np.float64).reshape(-1, 2)
     offsets = np.asarray(offsets, dtype=np.int64)
     if offsets.size < 2:
@@ -81,6 +96,84 @@ def areas_centroids(coords: np.ndarray, offsets: np.ndarray):
         cx = np.add.reduceat((x + x[nxt]) * cross, offsets[:-1]) / (6 * area)
         cy = np.add.reduceat((y + y[nxt]) * cross, offsets[:-1]) / (6 * area)
     return area, np.stack([cx, cy], axis=1)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _areas_centroids_kernel(coords, offsets):
+    """``areas_centroids_numpy`` polygon by polygon; ``plain`` False (results unused) unless the
+    offsets start at 0, increase strictly and end at len(coords), and no polygon has more than
+    129 points (numpy then sums by halves; recursion would not survive Numba's cache)."""
+    m = offsets.shape[0] - 1
+    area, centroid = np.empty(m), np.empty((m, 2))
+    plain = offsets[0] == 0 and offsets[m] == coords.shape[0]
+    longest = 0
+    for k in range(m):
+        plain = plain and offsets[k + 1] > offsets[k]
+        longest = max(longest, offsets[k + 1] - offsets[k])
+    if not plain or longest > 129:
+        return area, centroid, False
+    work = np.empty((3, longest))
+    for k in range(m):
+        if offsets[k + 1] - offsets[k] <= 8:  # two kernels: one with both paths runs 3x slower
+            area[k], centroid[k, 0], centroid[k, 1] = area_centroid_few(coords, None, offsets[k], offsets[k + 1])
+        else:
+            area[k], centroid[k, 0], centroid[k, 1] = area_centroid_many(coords, None, offsets[k], offsets[k + 1], work)
+    return area, centroid, True
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def area_centroid_few(points, refs, start, stop):
+    """Signed area and centroid of the polygon ``points[refs[start:stop]]`` (``points[start:stop]``
+    if refs is None) of at most 8 points, with the bits of ``areas_centroids_numpy``: numpy's
+    ``reduceat`` adds to a polygon's first term the sum of the others, in order."""
+    n = stop - start
+    c0, x0, y0 = _shoelace_terms(points, refs, start, n, 0)
+    sc = sx = sy = 0.0
+    for i in range(1, n):
+        c, cx, cy = _shoelace_terms(points, refs, start, n, i)
+        sc, sx, sy = sc + c, sx + cx, sy + cy
+    area = 0.5 * (c0 + sc)
+    return area, (x0 + sx) / (6 * area), (y0 + sy) / (6 * area)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def area_centroid_many(points, refs, start, stop, work):
+    """``area_centroid_few`` for 9 to 129 points: numpy adds the others pairwise (8 running sums,
+    then the rest in order). ``work``: (3, >= stop - start) scratch."""
+    n = stop - start
+    for i in range(n):
+        work[0, i], work[1, i], work[2, i] = _shoelace_terms(points, refs, start, n, i)
+    area = 0.5 * (work[0, 0] + _pairwise_sum(work[0], 1, n - 1))
+    return (area, (work[1, 0] + _pairwise_sum(work[1], 1, n - 1)) / (6 * area),
+            (work[2, 0] + _pairwise_sum(work[2], 1, n - 1)) / (6 * area))
+
+
+@numba.njit(cache=True, inline="always")
+def _shoelace_terms(points, refs, start, n, i):
+    """Point i's terms of ``areas_centroids_numpy``: cross, (x_i + x_i+1) cross, (y_i + y_i+1) cross."""
+    j = i + 1 if i + 1 < n else 0
+    if refs is None:
+        a, b = start + i, start + j
+    else:
+        a, b = refs[start + i], refs[start + j]
+    c = points[a, 0] * points[b, 1] - points[b, 0] * points[a, 1]
+    return c, (points[a, 0] + points[b, 0]) * c, (points[a, 1] + points[b, 1]) * c
+
+
+@numba.njit(cache=True)
+def _pairwise_sum(a, lo, n):
+    """numpy's pairwise sum of a[lo:lo + n], 8 <= n <= 128 (what ``np.add.reduceat`` adds to a
+    segment's first element): 8 running sums, combined pairwise, then the rest in order."""
+    r = a[lo:lo + 8].copy()
+    i = 8
+    while i < n - n % 8:
+        for j in range(8):
+            r[j] += a[lo + i + j]
+        i += 8
+    res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    for i in range(n - n % 8, n):
+        res += a[lo + i]
+    return res
 
 
 def polygon_areas(coords: np.ndarray, offsets: np.ndarray) -> np.ndarray:
