@@ -184,13 +184,16 @@ def _scene_mesh(args):
     """The mesh a scene's discretization.mesh and domain ask for (SPEC §8: vemkit mesh --scene)."""
     from vemkit.config.limits import check_scene_resources
     from vemkit.config.scene import load_scene
-    from vemkit.mesh.families import scene_mesh
 
     if args.family is not None or args.n is not None or args.option:
         raise InputError("vemkit mesh --scene takes the mesh from the scene: drop FAMILY N and --option "
                          "(use --set discretization.mesh.KEY=VALUE)", key="arguments")
     scene = load_scene(args.scene, args.set or ())
+    if scene.mesh_file is not None:  # never write over the mesh file the scene reads
+        _outputs(args, [args.scene, scene.mesh_file])
     check_scene_resources(scene, args.max_dofs)
+    from vemkit.mesh.families import scene_mesh
+
     return scene_mesh(scene), scene.mesh_options.get("family", "file")
 
 
@@ -271,8 +274,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+MAX_MESSAGE = 1000  # characters of an error line: a 4000-character path or a list of cells is cut
+
+
 def _fail(message, status: int = EXIT_FAILURE) -> int:
-    print(f"vemkit: error: {' '.join(str(message).split())}", file=sys.stderr)
+    text = " ".join(str(message).split())
+    text = text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE - 3] + "..."
+    print(f"vemkit: error: {text}", file=sys.stderr)
     return status
 
 

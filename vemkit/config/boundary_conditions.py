@@ -19,8 +19,9 @@ from vemkit.config.domain import Domain
 from vemkit.config.expressions import Expression, compile_expression
 from vemkit.exceptions import ExpressionError, SceneError
 
-__all__ = ["MAX_NORMAL_K_OVER_E", "PROBES", "boundary_expressions", "check_contact", "check_foundation",
-           "check_mesh_size", "check_sides", "side_points"]
+__all__ = ["MAX_NORMAL_K_OVER_E", "PROBES", "boundary_expressions", "check_contact", "check_expressions_on_mesh",
+           "check_file_sides", "check_foundation", "check_mesh_size", "check_rigid_motions", "check_sides",
+           "free_rigid_motion", "side_points"]
 
 #: contact.normal.k / material.E above this is refused (README "Input rules and limits"): measured,
 #: ssn's independent check is 5e-9 at k/E = 5e8 and fails at 5e11 (paper scene, n = 8)
@@ -139,6 +140,9 @@ def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
 
 def check_mesh_size(mesh: dict) -> None:
     sizes = [key for key in ("n", "h", "cells") if key in mesh]
+    if "\0" in mesh.get("file", ""):
+        raise SceneError("discretization.mesh.file: a file name cannot contain a NUL character; fix the scene",
+                         key="discretization.mesh.file")
     if "file" in mesh:
         extra = sizes + [key for key in mesh if key not in ("file", *sizes)]
         if extra:
@@ -200,3 +204,88 @@ def check_contact(data: dict, given_contact: dict, domain, compiled: dict) -> No
 
 def _domain_name(data) -> str:
     return "unit_square" if data["domain"] == "unit_square" else "domain"
+
+
+# -- rigid motions (before assembly), mesh files' sides, expressions at the mesh's vertices ------
+def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | None:
+    """Which rigid motion u = (a - θ y, b + θ x) keeps every prescribed component at zero change,
+    in words; None when the prescribed components (rows of ``prescribed``: u1, u2 at each of
+    ``coordinates``) hold all three."""
+    centre = coordinates.mean(axis=0) if coordinates.size else np.zeros(2)
+    scale = max(float(np.ptp(coordinates, axis=0).max()) if coordinates.size else 1.0, 1e-300)
+    x, y = ((coordinates - centre) / scale).T
+    one, zero = np.ones_like(x), np.zeros_like(x)
+    rows = np.concatenate([np.stack([one, zero, -y], axis=1)[prescribed[:, 0]],
+                           np.stack([zero, one, x], axis=1)[prescribed[:, 1]]])
+    if rows.shape[0] == 0:
+        return "every rigid motion (nothing is prescribed)"
+    for component, axis in ((0, "x"), (1, "y")):
+        if not prescribed[:, component].any():
+            return f"a translation in {axis}"
+    _, singular, vt = np.linalg.svd(rows, full_matrices=True)
+    rank = int(np.sum(singular > 1e-9 * singular[0]))
+    if rank == 3:
+        return None
+    a, b, theta = vt[rank]  # a motion the constraints do not see
+    if abs(theta) < 1e-9:
+        direction = np.array([a, b]) / np.hypot(a, b)
+        named = {(1.0, 0.0): "x", (0.0, 1.0): "y"}.get(tuple(np.round(np.abs(direction), 12)))
+        return f"a translation in {named}" if named else \
+            f"a translation along ({direction[0]:.3g}, {direction[1]:.3g})"
+    point = centre + scale * np.array([-b / theta, a / theta])
+    return f"a rotation about ({point[0]:.6g}, {point[1]:.6g})"
+
+
+def rigid_motion_error(motion: str) -> SceneError:
+    return SceneError(f"boundary.dirichlet leaves {motion} of the body free (the stiffness is singular); "
+                      "prescribe a component that stops it, e.g. clamp a side", key="boundary.dirichlet")
+
+
+def check_rigid_motions(data: dict, domain: Domain | None) -> None:
+    """The Dirichlet sides hold every rigid motion, tested on the corners of their edges (every mesh
+    of the body has them as vertices, and its other vertices on those edges add no constraint);
+    ``domain`` None (a mesh file): tested once the mesh is read."""
+    if domain is None:
+        return
+    x0, y0, x1, y1 = domain.bounds
+    polygonal = domain.discretize(max(x1 - x0, y1 - y0) / PROBES)
+    points, held = [], []
+    for side, components in _dirichlet(data["boundary"]).items():
+        ends = polygonal.points[polygonal.segments[polygonal.segment_sides == side].ravel()]
+        points.append(ends)
+        held.append(np.tile([c is not None for c in components], (ends.shape[0], 1)))
+    motion = free_rigid_motion(np.concatenate(points), np.concatenate(held))
+    if motion is not None:
+        raise rigid_motion_error(motion)
+
+
+def check_file_sides(scene, header) -> None:
+    """Every side the scene's boundary names is in its mesh file (``header``: what the file declares,
+    :func:`vemkit.config.mesh_file_header.mesh_file_header`); a gmsh side that may still come from an
+    unnamed physical group (a number) or ``untagged`` is checked when the file is read."""
+    boundary = scene.data["boundary"]
+    for part in ("dirichlet", "neumann", "contact"):
+        for side in boundary[part]:
+            if side in header.sides or (not header.sides_complete and (side.isdigit() or side == "untagged")):
+                continue
+            listed = ", ".join(header.sides) or "none"
+            raise SceneError(f"boundary.{part}: side {side!r} is not in the mesh file {scene.mesh_options['file']} "
+                             f"(its {'sides' if header.sides_complete else 'named sides'}: {listed}); fix the scene "
+                             "or the file", key=f"boundary.{part}")
+
+
+def check_expressions_on_mesh(scene, mesh) -> None:
+    """Every expression finite at the vertices where it acts (a pole at a vertex that the probes
+    before meshing missed, or any point of a mesh file's body): tractions and pressures on their
+    sides, the body force and the exact solution everywhere. The gap and the Dirichlet values are
+    evaluated at their vertices when they are used."""
+    x, y = mesh.vertices[:, 0], mesh.vertices[:, 1]
+    for side in scene.neumann_sides:
+        if side not in mesh.boundary:
+            continue  # the problem names the missing side
+        on_side = np.unique(mesh.boundary[side])
+        pressure = scene.pressure(side)
+        for expression in (pressure,) if pressure is not None else scene.traction(side):
+            evaluate_checked(expression, (x[on_side], y[on_side]))
+    for expression in (*scene.body_force, *(scene.exact_displacement or ())):
+        evaluate_checked(expression, (x, y))

@@ -10,6 +10,10 @@ A request is refused, with the estimate in the message, when its DOFs exceed ``m
 (default :data:`DEFAULT_MAX_DOFS`; ``vemkit solve --max-dofs`` raises it) or its estimated peak
 memory exceeds :data:`MEMORY_FRACTION` of the memory available to the process (MemAvailable,
 a cgroup limit, RLIMIT_AS, whichever is smallest) — that one always.
+
+A mesh file's counts are the ones it declares (:mod:`vemkit.config.mesh_file_header`); a triangle
+mesh adds the triangles of the body's parts thinner than h (:mod:`vemkit.config.mesh_resolution`).
+:func:`memory_budget` bounds what a third-party reader of a user's file may allocate.
 """
 
 from __future__ import annotations
@@ -17,18 +21,24 @@ from __future__ import annotations
 import math
 import os
 import resource
+from contextlib import contextmanager
 from typing import NamedTuple
 
+from vemkit.config.boundary_conditions import check_file_sides
+from vemkit.config.domain import domain_from_spec
+from vemkit.config.mesh_file_header import mesh_file_header
+from vemkit.config.mesh_resolution import scene_cells_per_length, thin_part_triangles
 from vemkit.exceptions import ResourceLimitError
 
 __all__ = ["BASE_BYTES", "BYTES_PER_DOF", "DEFAULT_MAX_DOFS", "MEMORY_FRACTION", "Resources",
            "available_memory", "check_resources", "check_scene_resources", "domain_area", "estimate_mesh",
-           "estimate_resources", "scene_resources"]
+           "estimate_resources", "memory_budget", "scene_resources"]
 
 DEFAULT_MAX_DOFS = 4_000_000  # the paper's finest level (n = 1024) has 2.1 million on squares
 BASE_BYTES = 400 * 2**20  # Python with numpy, scipy, numba, xarray, netCDF4 loaded
 BYTES_PER_DOF = 2_500  # measured 1.0-1.6 kB (see the module docstring); a margin on top
 MEMORY_FRACTION = 0.8
+MAX_CELLS_PER_SIDE = 1e8  # estimates are capped here (1e16 cells), so that extreme sizes stay numbers
 
 
 class Resources(NamedTuple):
@@ -86,7 +96,8 @@ def estimate_mesh(mesh_options: dict, area: float = 1.0) -> tuple[int, int]:
     """
     family = mesh_options.get("family")
     triangles = family == "triangle"
-    n = math.ceil(_cells_per_length(mesh_options, area, 2.0 if triangles else 1.0) * math.sqrt(area))
+    per_side = _cells_per_length(mesh_options, area, 2.0 if triangles else 1.0) * math.sqrt(area)
+    n = math.ceil(min(per_side, MAX_CELLS_PER_SIDE))  # h = 1e-300: a lower bound, far beyond any limit
     if family == "square" or (triangles and mesh_options.get("kind") == "structured"):
         return (2 if triangles else 1) * n * n, (n + 1) ** 2
     if triangles:
@@ -155,8 +166,14 @@ def scene_resources(scene) -> Resources | None:
     """Cells, DOFs and peak memory of solving ``scene``, predicted without building its mesh
     (None for a mesh read from a file: its size is known once it is read)."""
     if "family" not in scene.mesh_options:
-        return None
+        if scene.mesh_file is None:
+            return None
+        header = mesh_file_header(scene.mesh_file)
+        return estimate_resources(header.cells, header.vertices)
     cells, vertices = estimate_mesh(scene.mesh_options, domain_area(scene.domain))
+    if scene.mesh_options["family"] == "triangle":  # quality triangles fill parts thinner than h
+        extra = thin_part_triangles(domain_from_spec(scene.domain), 1.0 / scene_cells_per_length(scene))
+        cells, vertices = cells + extra, vertices + extra // 2
     # k = 2 (discretization.order): 2 DOFs per vertex, edge (Euler: about V + C) and cell; measured peak
     # memory per DOF as for k = 1 (benchmarks/order2.py: 0.80 GiB at 525 312 DOFs, k = 1 0.74 GiB)
     nodes = vertices if scene.order == 1 else 2 * (vertices + cells)
@@ -170,7 +187,46 @@ def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS) -> Res
     if estimate is None:
         return None
     options = scene.mesh_options
+    if "file" in options:
+        check_resources(estimate, max_dofs, what=f"the mesh file {options['file']} ({estimate.vertices:,} "
+                        "vertices)", fix="a coarser mesh")
+        check_file_sides(scene, mesh_file_header(scene.mesh_file))
+        return estimate
     size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells"))
     check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
                     fix="a coarser discretization.mesh")
     return estimate
+
+
+def _address_space() -> int | None:
+    """The bytes of address space this process has mapped now (None if unknown)."""
+    try:
+        with open("/proc/self/statm", encoding="ascii") as handle:
+            return int(handle.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+@contextmanager
+def memory_budget(extra_bytes: int):
+    """Let the code inside map at most ``extra_bytes`` more memory (RLIMIT_AS lowered for its
+    duration, restored after): an allocation beyond is a MemoryError at once, instead of a machine
+    that swaps. For third-party readers of user files (meshio, netCDF) whose allocations follow
+    what the file says; no effect where the limit cannot be read or set."""
+    mapped = _address_space()
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    limit = None if mapped is None else mapped + int(extra_bytes)
+    if limit is not None and hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    if limit is None or (soft != resource.RLIM_INFINITY and soft <= limit):
+        yield
+        return
+    try:
+        resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    except (ValueError, OSError):
+        yield
+        return
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))

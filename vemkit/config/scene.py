@@ -22,10 +22,11 @@ import jsonschema
 import yaml
 
 from vemkit.config.boundary_conditions import (boundary_expressions, check_contact,
-                                               check_mesh_size, check_sides, compile_checked,
-                                               evaluate_checked, inside_points)
+                                               check_mesh_size, check_rigid_motions, check_sides,
+                                               compile_checked, evaluate_checked, inside_points)
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
 from vemkit.config.expressions import Expression
+from vemkit.config.mesh_resolution import check_mesh_resolution
 from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
 from vemkit.exceptions import SceneError
 
@@ -85,6 +86,14 @@ _MESH_SIZE_KEYS = {"n": ("h", "cells", "file"), "h": ("n", "cells", "file"), "ce
 
 
 # -- overrides -----------------------------------------------------------------------------------
+def _branch_for(node: dict, segment: str) -> dict:
+    """The alternative of a oneOf (``domain``: unit_square or a mapping) that has ``segment``."""
+    for branch in map(_resolve, node.get("oneOf", ())):
+        if ("items" in branch) if segment.isdigit() else ("properties" in branch):
+            return branch
+    return node
+
+
 def _apply_override(data: dict, override: str) -> None:
     """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema."""
     key_text, separator, value_text = str(override).partition("=")
@@ -94,6 +103,7 @@ def _apply_override(data: dict, override: str) -> None:
     value = _parse_yaml(value_text, f"--set {override}")
     node, container, path = _resolve(_validator().schema), data, []
     for position, segment in enumerate(segments):
+        node = _branch_for(node, segment)
         if "properties" in node:
             if segment not in node["properties"]:
                 raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
@@ -160,9 +170,34 @@ def _document_order(data, error) -> tuple:
     return tuple(position)
 
 
+def _branch_names(branches) -> str:
+    """What the alternatives of a oneOf accept, in words."""
+    names = []
+    for branch in map(_resolve, branches):
+        if "enum" in branch:
+            names += [str(v) for v in branch["enum"]]
+        elif branch.get("type") == "object" and branch.get("required"):
+            names.append(f"a mapping with {', '.join(branch['required'])}")
+        else:
+            types = branch.get("type", [])
+            names += [_TYPE_NAMES.get(t, t) for t in ([types] if isinstance(types, str) else types)]
+    return " or ".join(names)
+
+
 def _schema_error_message(error, fix=_scene_fix) -> str:
     path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
     key, value = _key(path), error.instance
+    if keyword == "oneOf":  # the value took one branch when the problem lies inside it: report that
+        deeper = [e for e in error.context or () if len(e.absolute_path) > len(path)]
+        if deeper:
+            return _schema_error_message(jsonschema.exceptions.best_match(deeper), fix)
+        title = f" ({schema['title']})" if "title" in schema else ""
+        return f"{key} = {_show(value)}: must be {_branch_names(error.validator_value)}{title}; {fix(key)}"
+    if "propertyNames" in error.absolute_schema_path:
+        return f"{key}: {_show(value)} is not a side name (letters, digits, _ and -); fix the scene"
+    if keyword == "minProperties":
+        return f"{key} = {{}}: {NO_DIRICHLET}" if key == "boundary.dirichlet" else \
+            f"{key} = {{}}: must have at least {error.validator_value} entries; {fix(key)}"
     if keyword == "additionalProperties":
         allowed = list(schema.get("properties", {}))
         extra = next(k for k in value if k not in allowed)
@@ -235,9 +270,11 @@ def _semantic_checks(data: dict, given: dict) -> dict:
     check_sides(data, None if from_file else
                  (UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names))
     probed = None if from_file else domain
+    check_mesh_resolution(data["discretization"]["mesh"], domain)
     compiled = boundary_expressions(data, probed)
+    check_rigid_motions(data, probed)
     compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", data["body_force"][i]) for i in (0, 1))
-    for expression in compiled["body_force"]:
+    for expression in compiled["body_force"] if not from_file else ():  # a file's body: at its vertices
         evaluate_checked(expression, inside_points(domain))
     if "contact" in data:
         check_contact(data, given.get("contact", {}), probed, compiled)

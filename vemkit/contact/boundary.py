@@ -212,7 +212,14 @@ def _gap_values(gap, coords, normals, check=True):
     else:
         g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (coords.shape[0],)).copy()
     if not np.all(np.isfinite(g)) or (check and np.any(g < 0)):
-        raise SceneError("contact.gap must be finite and >= 0 at every contact vertex (2.11)", key="contact.gap")
+        bad = int(np.flatnonzero(~np.isfinite(g) | (g < 0))[0])
+        where = f"{g[bad]:.6g} at x={coords[bad, 0]:.6g}, y={coords[bad, 1]:.6g}"
+        if isinstance(gap, FoundationLine):
+            raise SceneError(f"contact.foundation: the contact side is beyond the foundation line (gap {where}: the body "
+                             "starts out penetrating it); move contact.foundation.point or flip its normal",
+                             key="contact.foundation")
+        raise SceneError(f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}",
+                         key="contact.gap")
     return g
 
 

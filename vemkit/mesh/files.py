@@ -2,7 +2,9 @@
 
 ``read_mesh(path)`` reads ``.nc`` (UGRID) or ``.msh`` (gmsh, versions 2 and 4 through meshio) and
 validates the mesh like a family's: a broken mesh is refused with a one-line ``MeshError`` naming
-the file and the cell or vertex (SPEC §8).
+the file and the cell or vertex (SPEC §8). Before parsing, the file must be a regular file whose
+declared counts fit its size, a plane mesh and the machine (``vemkit.config.mesh_file_header``);
+the parser runs within a memory budget (``vemkit.config.limits.memory_budget``).
 
 gmsh: the 2D elements (linear triangles and quadrilaterals, mixed freely) are the cells, turned
 counter-clockwise if needed; nodes used by no cell (geometry points) are dropped; z must be 0.
@@ -30,13 +32,16 @@ import json
 from pathlib import Path
 
 import meshio
+import meshio.gmsh
 import numpy as np
 import xarray as xr
 import xugrid
 
+from vemkit.config.domain import SIDE_NAME
+from vemkit.config.limits import check_resources, estimate_resources, memory_budget
+from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.config.domain import SIDE_NAME
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
 
@@ -81,26 +86,34 @@ def write_ugrid(mesh: Mesh, path) -> None:
 
 
 def read_ugrid(path) -> Mesh:
-    """Read a mesh written by ``write_ugrid`` (or any UGRID-1.0 file with one 2D topology)."""
+    """Read a mesh written by ``write_ugrid`` (or any UGRID-1.0 file with one 2D topology).
+
+    Only the variables of the mesh are read (node coordinates, face table, boundary parts), never
+    the rest of the file (a solution file's fields)."""
     with xr.open_dataset(Path(path), mask_and_scale=False) as ds:
-        ds = ds.load()
-    topologies = [v for v in ds.variables if ds[v].attrs.get("cf_role") == "mesh_topology"]
-    if len(topologies) != 1:
-        raise ValueError(f"{path}: expected one UGRID mesh topology variable, found {topologies or 'none'}")
-    topo = ds[topologies[0]].attrs
-    x_name, y_name = topo["node_coordinates"].split()
-    faces = ds[topo["face_node_connectivity"]]
-    fill = faces.attrs.get("_FillValue", FILL_VALUE)
-    start = int(faces.attrs.get("start_index", 0))
-    table = np.asarray(faces.values, dtype=np.int64)
+        topologies = [v for v in ds.variables if ds[v].attrs.get("cf_role") == "mesh_topology"]
+        if len(topologies) != 1:
+            raise ValueError(f"{path}: expected one UGRID mesh topology variable, found {topologies or 'none'}")
+        topo = ds[topologies[0]].attrs
+        x_name, y_name = topo["node_coordinates"].split()
+        faces = ds[topo["face_node_connectivity"]]
+        fill = faces.attrs.get("_FillValue", FILL_VALUE)
+        start = int(faces.attrs.get("start_index", 0))
+        table = np.asarray(faces.values, dtype=np.int64)
+        vertices = np.stack([ds[x_name].values, ds[y_name].values], axis=1).astype(np.float64)
+        names = json.loads(topo.get("vemkit_boundary_parts", "[]"))
+        boundary = {name: np.asarray(ds[f"boundary_{name}"].values, dtype=np.int64) for name in names}
+        try:
+            meta = json.loads(topo.get("vemkit_meta", "{}"))
+        except ValueError:
+            meta = None
+    if not isinstance(meta, dict):
+        raise MeshError(f"{Path(path).name}: the attribute vemkit_meta must be a JSON mapping (text); fix or remove it",
+                        key=str(path))
     valid = table != fill
     sizes = valid.sum(axis=1)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
     cell_vertices = table[valid] - start
-    vertices = np.stack([ds[x_name].values, ds[y_name].values], axis=1).astype(np.float64)
-    names = json.loads(topo.get("vemkit_boundary_parts", "[]"))
-    boundary = {name: np.asarray(ds[f"boundary_{name}"].values, dtype=np.int64) for name in names}
-    meta = json.loads(topo.get("vemkit_meta", "{}"))
     return Mesh(vertices, offsets, cell_vertices, boundary, meta)
 
 
@@ -146,24 +159,38 @@ def _json_scalar(value):
 
 
 # -- any mesh file ------------------------------------------------------------------------------
-MESH_SUFFIXES = {".msh": "gmsh", ".nc": "UGRID netCDF"}
 _GMSH_CELLS = ("triangle", "quad")
+READ_BASE_BYTES = 512 << 20  # what meshio / xarray may map beyond the file's own size ...
+READ_BYTES_PER_FILE_BYTE = 16  # ... and per byte of the file (measured: gmsh text, 5 x its size)
+MAX_FILE_COORDINATE_OVER_EDGE = 1e7  # a unit square at 1e9 has a shoelace area of rounding noise
 
 
 def read_mesh(path) -> Mesh:
-    """The validated mesh in ``path`` (``.msh``: gmsh 2 or 4; ``.nc``: UGRID); MeshError otherwise."""
+    """The validated mesh in ``path`` (``.msh``: gmsh 2 or 4; ``.nc``: UGRID); MeshError otherwise.
+
+    Before the file is parsed: it must be a regular file whose declared counts fit its size, a plane
+    mesh and this machine (``vemkit.config.mesh_file_header``, ``vemkit.config.limits``); the parser
+    then runs within a memory budget of ``READ_BASE_BYTES + READ_BYTES_PER_FILE_BYTE`` x the file
+    size (a node tag of 10^10 in a small file would otherwise make meshio allocate gigabytes)."""
     path = Path(path)
-    if path.suffix not in MESH_SUFFIXES:
-        raise MeshError(f"{path}: unknown mesh file type {path.suffix!r}; give a gmsh .msh or a UGRID .nc file",
-                        key=str(path))
-    if not path.is_file():
-        raise MeshError(f"{path}: no such mesh file", key=str(path))
+    header = mesh_file_header(path)
+    check_resources(estimate_resources(header.cells, header.vertices), None, what=f"the mesh file {path.name}",
+                    fix="a coarser mesh")
+    kind = MESH_SUFFIXES[path.suffix]
     try:
-        mesh = read_gmsh(path) if path.suffix == ".msh" else read_ugrid(path)
+        with memory_budget(READ_BASE_BYTES + READ_BYTES_PER_FILE_BYTE * header.size):
+            mesh = read_gmsh(path) if path.suffix == ".msh" else read_ugrid(path)
     except MeshError:
         raise
+    except MemoryError:
+        raise MeshError(f"{path.name}: cannot be read as {kind}: reading it needs far more memory than a mesh of "
+                        f"{header.vertices:,} nodes (a node number or count beyond what the file holds)",
+                        key=str(path)) from None
     except Exception as error:  # a file the reader cannot parse: say which and why, in one line
-        raise MeshError(f"{path.name}: cannot be read as {MESH_SUFFIXES[path.suffix]}: {error}", key=str(path)) from None
+        reason = " ".join(str(error).split())
+        raise MeshError(f"{path.name}: cannot be read as {kind}: {reason[:200] or type(error).__name__}",
+                        key=str(path)) from None
+    _check_precision(mesh, path)
     try:
         validate_mesh(mesh)
     except MeshError as error:
@@ -171,10 +198,30 @@ def read_mesh(path) -> Mesh:
     return mesh
 
 
+def _check_precision(mesh: Mesh, path: Path) -> None:
+    """An edge far shorter than its distance from the origin loses its cells' shape in double precision
+    (a unit square at x = 1e9: its shoelace area is rounding noise): refused naming the file when the
+    ratio passes ``MAX_FILE_COORDINATE_OVER_EDGE`` (a plate at 1e6 still solves to 15 digits)."""
+    v, refs = mesh.vertices, mesh.cell_vertices
+    if v.size == 0 or refs.size == 0 or not np.isfinite(v).all() or refs.min() < 0 or refs.max() >= v.shape[0] \
+            or mesh.cell_sizes.min() < 3:
+        return  # validate_mesh names the vertex or the cell
+    half = mesh.half_edges
+    length = np.hypot(*(v[half[:, 1]] - v[half[:, 0]]).T)
+    reach = np.abs(v[half[:, 0]]).max(axis=1)
+    ratio = np.divide(reach, length, out=np.zeros_like(reach), where=length > 0)
+    worst = int(np.argmax(ratio))
+    if ratio[worst] > MAX_FILE_COORDINATE_OVER_EDGE:
+        a, b = half[worst]
+        raise MeshError(f"{path.name}: edge ({a}, {b}) is {length[worst]:.3g} long at |x|, |y| = {reach[worst]:.3g}, more "
+                        f"than {MAX_FILE_COORDINATE_OVER_EDGE:.0e} times shorter than its distance from the origin: too "
+                        "small for double precision there; shift the mesh near the origin", key=str(path))
+
+
 def read_gmsh(path) -> Mesh:
     """The mesh of a gmsh file (not validated; see ``read_mesh``), sides from physical line groups."""
     path = Path(path)
-    data = meshio.read(path, file_format="gmsh")
+    data = meshio.gmsh.read(path)  # not meshio.read: on a broken file it prints and exits the process
     if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
         v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
         raise MeshError(f"{path.name}: node {v} (counting from 0) has z = {data.points[v, 2]:g}; give a plane mesh "
@@ -190,8 +237,9 @@ def read_gmsh(path) -> Mesh:
         elif block.type == "line":
             lines.append(np.asarray(block.data, dtype=np.int64))
             line_tags.append(np.zeros(len(block.data), np.int64) if tags is None else np.asarray(tags, np.int64))
-        elif block.dim == 1:
-            raise MeshError(f"{path.name}: element type {block.type!r} is not supported; give linear lines", key=str(path))
+        elif block.dim != 0:
+            raise MeshError(f"{path.name}: element type {block.type!r} ({block.dim}D) is not supported; give a plane "
+                            "mesh of linear triangles and quadrilaterals with linear lines", key=str(path))
     if not polygons:
         raise MeshError(f"{path.name}: no triangles or quadrilaterals in the file", key=str(path))
     sizes = np.concatenate([np.full(len(p), p.shape[1]) for p in polygons])

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.config.boundary_conditions import free_rigid_motion  # before assembly, also from the domain
 from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly import DofMap
 
@@ -78,31 +79,3 @@ def apply_fixed_dofs(stiffness: sp.csr_matrix, load: np.ndarray, dofs: DofMap):
     K.sort_indices()
     load[fixed] = diagonal * g
     return K, load
-
-
-def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | None:
-    """Which rigid motion u = (a - θ y, b + θ x) keeps every prescribed component at zero change,
-    in words; None when the prescribed components hold all three."""
-    centre = coordinates.mean(axis=0) if coordinates.size else np.zeros(2)
-    scale = max(float(np.ptp(coordinates, axis=0).max()) if coordinates.size else 1.0, 1e-300)
-    x, y = ((coordinates - centre) / scale).T
-    one, zero = np.ones_like(x), np.zeros_like(x)
-    rows = np.concatenate([np.stack([one, zero, -y], axis=1)[prescribed[:, 0]],
-                           np.stack([zero, one, x], axis=1)[prescribed[:, 1]]])
-    if rows.shape[0] == 0:
-        return "every rigid motion (nothing is prescribed)"
-    for component, axis in ((0, "x"), (1, "y")):
-        if not prescribed[:, component].any():
-            return f"a translation in {axis}"
-    _, singular, vt = np.linalg.svd(rows, full_matrices=True)
-    rank = int(np.sum(singular > 1e-9 * singular[0]))
-    if rank == 3:
-        return None
-    a, b, theta = vt[rank]  # a motion the constraints do not see
-    if abs(theta) < 1e-9:
-        direction = np.array([a, b]) / np.hypot(a, b)
-        named = {(1.0, 0.0): "x", (0.0, 1.0): "y"}.get(tuple(np.round(np.abs(direction), 12)))
-        return f"a translation in {named}" if named else \
-            f"a translation along ({direction[0]:.3g}, {direction[1]:.3g})"
-    point = centre + scale * np.array([-b / theta, a / theta])
-    return f"a rotation about ({point[0]:.6g}, {point[1]:.6g})"
