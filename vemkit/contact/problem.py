@@ -118,6 +118,22 @@ def _scene_gap(scene):
     return gap if gap is not None else (lambda x, y: np.zeros_like(x))
 
 
+def scene_problem_data(scene) -> dict:
+    """The keyword arguments of ``discrete_problem`` (and its k = 2 twin) that a scene gives:
+    boundary conditions as callables, the gap or foundation, the contact law, the body force."""
+    body = None
+    if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
+        body = vector_field(scene.body_force)
+    normal, friction = scene.normal_compliance, scene.friction_bound
+    law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
+    pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
+    return dict(dirichlet=scene.dirichlet, pressure=pressures, contact=scene.contact_sides, gap=_scene_gap(scene),
+                neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides
+                         if side not in pressures},
+                law=law, body_force=body, stabilization=scene.stabilization,
+                contact_quadrature=scene.contact_quadrature)
+
+
 def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
     """Assemble the discrete problem (3.16) of a scene, on its own mesh unless one is given."""
     if scene.order == 2:  # k = 2 (vemkit.contact.problem_k2)
@@ -125,27 +141,8 @@ def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
         return scene_problem_k2(scene, mesh)
     mesh = scene_mesh(scene) if mesh is None else mesh
     check_expressions_on_mesh(scene, mesh)  # a pole at a vertex: refused, not integrated around
-    body = None
-    if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
-        body = vector_field(scene.body_force)
-    normal, friction = scene.normal_compliance, scene.friction_bound
-    law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
     t0 = time.perf_counter()
-    pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
-    problem = discrete_problem(
-        mesh,
-        scene.E,
-        scene.nu,
-        dirichlet=scene.dirichlet,
-        neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides if side not in pressures},
-        pressure=pressures,
-        contact=scene.contact_sides,
-        gap=_scene_gap(scene),
-        law=law,
-        body_force=body,
-        stabilization=scene.stabilization,
-        contact_quadrature=scene.contact_quadrature,
-        contact_gauss_points=scene.contact_gauss_points,
-    )
+    problem = discrete_problem(mesh, scene.E, scene.nu, contact_gauss_points=scene.contact_gauss_points,
+                               **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
     return problem

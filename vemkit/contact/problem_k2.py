@@ -29,11 +29,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from vemkit.config.boundary_conditions import check_expressions_on_mesh
-from vemkit.config.expressions import vector_field
 from vemkit.contact.boundary import ContactBoundary
 from vemkit.contact.boundary_k2 import change_variables, check_quadrature, contact_boundary_k2, midpoint_change, midpoint_edges
 from vemkit.contact.laws import ContactLaw
-from vemkit.contact.problem import _scene_gap
+from vemkit.contact.problem import scene_problem_data
 from vemkit.exceptions import SceneError
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.mesh import Mesh
@@ -154,18 +153,8 @@ def scene_problem_k2(scene, mesh: Mesh | None = None) -> DiscreteProblemK2:
     """Assemble the k = 2 discrete problem of a scene (``discretization.order: 2``)."""
     mesh = scene_mesh(scene) if mesh is None else mesh
     check_expressions_on_mesh(scene, mesh)  # a pole at a vertex: refused, not integrated around
-    body = None
-    if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
-        body = vector_field(scene.body_force)
-    normal, friction = scene.normal_compliance, scene.friction_bound
-    law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
     t0 = time.perf_counter()
-    pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
-    problem = discrete_problem_k2(
-        mesh, scene.E, scene.nu, dirichlet=scene.dirichlet,
-        neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides if side not in pressures},
-        pressure=pressures, contact=scene.contact_sides, gap=_scene_gap(scene), law=law, body_force=body,
-        stabilization=scene.stabilization, contact_quadrature=scene.contact_quadrature)
+    problem = discrete_problem_k2(mesh, scene.E, scene.nu, **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
     problem.info["order"] = 2
     return problem
