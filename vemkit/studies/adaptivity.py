@@ -28,16 +28,15 @@ import xarray as xr
 
 from vemkit.config.domain import CircleHole, domain_from_spec
 from vemkit.contact.problem import scene_problem
-from vemkit.exceptions import InputError, ResultError, VerificationError
+from vemkit.exceptions import InputError, ResultError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.solution import contact_state
-from vemkit.solvers.verification import CHECK_KEYS, verify_solution
 from vemkit.studies.convergence import RECORD_KEYS
-from vemkit.studies.scene_solve import check_tolerance
+from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
 from vemkit.vem.load import cell_averages
 
@@ -139,16 +138,9 @@ def prolongated_start(refined, problem, solution, new_problem):
 
 
 def _checked(problem, solution, solver_options) -> dict:
-    """The independent check of ``vemkit solve`` (vemkit.studies.scene_solve); VerificationError if it fails."""
-    tol = check_tolerance(solver_options)
-    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
-    if not checks["passed"]:
-        worst = max(CHECK_KEYS, key=lambda k: checks[k])
-        raise VerificationError(
-            f"{solution.method} stopped after {solution.iterations} iterations on the {problem.mesh.n_cells}-cell "
-            f"adapted mesh but the independent check fails: {worst} = {checks[worst]:.1e} > {tol:.1e}; try "
-            "solver.method=ssn or a smaller solver.tol", solver=solution.method, iterations=solution.iterations)
-    return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
+    """The independent check of ``vemkit solve``; VerificationError naming the adapted mesh if it fails."""
+    return verified(problem, solution, solver_options, where=f" on the {problem.mesh.n_cells}-cell adapted mesh",
+                    source="")
 
 
 def _solve_step(scene, mesh, previous, warm_start: bool, verify: bool, max_dofs: int):

@@ -36,14 +36,16 @@ def check_tolerance(solver_options: dict) -> float:
     return min(max(CHECK_FACTOR * loosest, CHECK_FLOOR), CHECK_CAP)
 
 
-def _verified(problem, solution, solver_options) -> dict:
+def verified(problem, solution, solver_options, where: str = "", source: str = " (from solver.tol)") -> dict:
+    """The independent check at :func:`check_tolerance`: {check_worst, check_tolerance}, or a
+    VerificationError whose message says ``where`` the solve was (e.g. " on the 96-cell adapted mesh")."""
     tol = check_tolerance(solver_options)
     checks = verify_solution(problem, solution.u, solution.multiplier, tol)
     if not checks["passed"]:
         worst = max(CHECK_KEYS, key=lambda k: checks[k])
         raise VerificationError(
-            f"{solution.method} stopped after {solution.iterations} iterations but the independent "
-            f"check fails: {worst} = {checks[worst]:.1e} > {tol:.1e} (from solver.tol); try "
+            f"{solution.method} stopped after {solution.iterations} iterations{where} but the independent "
+            f"check fails: {worst} = {checks[worst]:.1e} > {tol:.1e}{source}; try "
             "solver.method=ssn or a smaller solver.tol", solver=solution.method,
             iterations=solution.iterations)
     return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
@@ -62,7 +64,7 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
     solution = solve(problem, scene.solver_options, progress=progress)
     attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
     if verify:
-        attrs.update(_verified(problem, solution, scene.solver_options))
+        attrs.update(verified(problem, solution, scene.solver_options))
     if scene.exact_displacement is not None and scene.order == 2:  # Pi_2 u_h (vemkit.vem.norms_k2)
         from vemkit.vem.norms_k2 import relative_exact_errors_k2
         attrs.update(relative_exact_errors_k2(problem.mesh, problem.projected(solution.u),

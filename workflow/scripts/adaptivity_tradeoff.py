@@ -1,14 +1,7 @@
 """Rule tradeoff_adaptive: the adaptive loop as configurations of the speed-accuracy study
 (vemkit.studies.adaptivity_compare.tradeoff_records), against the study's reference solution."""
 
-import os
-import sys
-
-# single-threaded solves, as rule tradeoff_family (see there)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"
-_NUMPY_EARLY = "numpy" in sys.modules
+from _single_thread import NUMPY_EARLY  # first: one BLAS thread before numpy loads (see there)
 
 from _helpers import logged  # noqa: E402
 
@@ -19,7 +12,7 @@ with logged(smk):
     from vemkit.studies.adaptivity_compare import tradeoff_records
     from vemkit.studies.convergence import ReferenceSolution, write_records
 
-    if _NUMPY_EARLY:
+    if NUMPY_EARLY:
         print("warning: numpy was loaded before the thread counts were set to 1", flush=True)
     s, a = smk.params.settings, smk.params.adaptive
     scene = load_scene(s["scene"], s["overrides"] + [f"discretization.mesh={{family: square, n: {int(a['n'])}}}"])

@@ -15,20 +15,6 @@ from _helpers import logged
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 
 
-def node_values(mesh, ds):
-    """k = 1: (n_vertices, 2) vertex values; k = 2: (n_nodes, 2) vertex values, edge and cell means."""
-    import numpy as np
-
-    u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
-    if int(ds.attrs.get("order", 1)) == 1:
-        return u
-    if not np.array_equal(ds["mesh2d_edge_nodes"].values.astype(np.int64), mesh.edges):
-        raise ValueError("the file's edges are not the mesh's edge order: the edge means cannot be placed")
-    edge = np.stack([ds["u1_edge_mean"].values, ds["u2_edge_mean"].values], axis=1)
-    face = np.stack([ds["u1_face_mean"].values, ds["u2_face_mean"].values], axis=1)
-    return np.concatenate([u, edge, face])
-
-
 def projected(mesh, ds, values):
     from vemkit.config.scene import scene_from_yaml
     from vemkit.vem.norms_k2 import projected_solution_k2
@@ -58,17 +44,16 @@ def regions(mesh, ds, radius):
 
 
 with logged(smk):
-    import numpy as np
-
     from vemkit.config.scene import scene_from_yaml
     from vemkit.io.solution_file import read_solution
+    from vemkit.studies.solution_order import solution_node_values
     from vemkit.vem.norms import paper_error, reference_quadrature
     from vemkit.vem.norms_k2 import projection_error_k2, trace_error
 
     s = smk.params.settings
     case = s["cases"][smk.wildcards.case]
     ref_mesh, ref_ds = read_solution(smk.input.reference)
-    ref_values = node_values(ref_mesh, ref_ds)
+    ref_values = solution_node_values(ref_mesh, ref_ds)
     ref_proj = projected(ref_mesh, ref_ds, ref_values)
     quadrature = reference_quadrature(ref_mesh, degree=5)
     masks, zone_boundary = regions(ref_mesh, ref_ds, s["region_radius"])
@@ -77,11 +62,11 @@ with logged(smk):
     paper_mesh = paper_values = None
     if case["order"] == 1:
         paper_mesh, paper_ds = read_solution(smk.input.paper_reference)
-        paper_values = node_values(paper_mesh, paper_ds)
+        paper_values = solution_node_values(paper_mesh, paper_ds)
     records = []
     for n, path in zip(case["levels"], smk.input.solutions, strict=True):
         mesh, ds = read_solution(path)
-        values = node_values(mesh, ds)
+        values = solution_node_values(mesh, ds)
         err = projection_error_k2(mesh, projected(mesh, ds, values), ref_mesh, ref_proj, quadrature, masks)
         record = {"case": smk.wildcards.case, "family": case["family"], "order": case["order"], "n": n,
                   "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])), "n_unknowns": int(ds.attrs["n_dofs"]),

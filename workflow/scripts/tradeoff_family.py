@@ -1,15 +1,6 @@
 """Rule tradeoff_family: every level, solver, tolerance and stabilization of one mesh family."""
 
-import os
-import sys
-
-# The rule asks for 2 threads only to keep other jobs off the core it times; Snakemake sets the BLAS
-# and OpenMP thread counts to the rule's threads, but vemkit's solves are meant single-threaded
-# (multi-threaded BLAS slows the sparse solves down): back to 1 before numpy loads.
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"
-_NUMPY_EARLY = "numpy" in sys.modules
+from _single_thread import NUMPY_EARLY  # first: one BLAS thread before numpy loads (see there)
 
 from _helpers import logged  # noqa: E402
 
@@ -19,7 +10,7 @@ with logged(smk):
     from vemkit.studies import tradeoff
     from vemkit.studies.convergence import ReferenceSolution, write_records
 
-    if _NUMPY_EARLY:
+    if NUMPY_EARLY:
         print("warning: numpy was loaded before the thread counts were set to 1", flush=True)
     s = smk.params.settings
     scene = load_scene(s["scene"], s["overrides"])
