@@ -58,3 +58,44 @@ def test_known_errors_of_the_k1_interpolant_of_x_squared(n):
     assert err["h1_semi"] == pytest.approx(h / 2, rel=1e-12)
     assert err["share_left half"] == pytest.approx(0.5, rel=1e-12)  # the error density is uniform
     assert trace_error(coarse, vertex_values, fine, ref_values, ["bottom"]) == pytest.approx(h * h / np.sqrt(6), rel=1e-12)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_trace_errors_of_the_interpolants_of_a_cubic(order):
+    """u = (x^3, 0) on the bottom of 4 x 4 squares, an edge x = c + eta m, m in [-1, 1]: the linear
+    interpolant misses by eta^2 (1 - m^2)(3c + eta m) (the cubic's secant), the quadratic one with the
+    vertex values and the edge mean by eta^3 (m^3 - m) (zero at both ends, zero mean). Given the
+    interpolant as u_h, both errors of ``trace_errors`` are that number."""
+    from vemkit.vem.norms_k2 import trace_errors
+
+    mesh = build_mesh("square", 4)
+    values = np.stack([mesh.vertices[:, 0] ** 3, 0 * mesh.vertices[:, 0]], axis=1) if order == 1 else \
+        interpolate_k2(mesh, lambda x, y: (x**3, 0 * x))
+    err = trace_errors(mesh, "bottom", values, lambda p: np.stack([p[:, 0] ** 3, 0 * p[:, 0]], axis=1))
+    m, w = np.polynomial.legendre.leggauss(10)
+    eta, squared = 0.125, 0.0
+    for c in (np.arange(4) + 0.5) / 4:
+        miss = eta**2 * (1 - m**2) * (3 * c + eta * m) if order == 1 else eta**3 * (m**3 - m)
+        squared += eta * np.sum(w * miss**2)
+    expected = np.sqrt(squared / (1 / 7))  # ||x^3||^2 on [0, 1] = 1/7
+    assert err["interpolation_contact_l2"] == pytest.approx(expected, rel=1e-12)
+    assert err["contact_l2"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_trace_errors_against_a_nested_reference_trace_is_trace_error():
+    """With the reference's trace as the field and pieces nested in its edges, ``trace_errors`` gives
+    ``trace_error``'s number (the same integral over other pieces)."""
+    from vemkit.vem.norms_k2 import boundary_trace, nesting_subdivisions, trace_errors
+
+    def field(x, y):
+        return np.sin(3 * x) * np.exp(y), np.cos(2 * x + y)
+
+    fine, coarse = build_mesh("square", 32), build_mesh("hanging", 4, levels=1, rule="contact")
+    ref_values, coarse_values = interpolate_k2(fine, field), interpolate_k2(coarse, field)
+    m = nesting_subdivisions(coarse, fine, "bottom")
+    assert m == 4  # coarse bottom edges 1/8, reference edges 1/32
+    err = trace_errors(coarse, "bottom", coarse_values, lambda p: boundary_trace(fine, "bottom", ref_values, p), m)
+    assert err["contact_l2"] == pytest.approx(trace_error(coarse, coarse_values, fine, ref_values, "bottom"), rel=1e-10)
+    # the coarse values are the interpolant of the field, the reference a 4x finer one: I_h u_ref is
+    # I_h u up to the reference's own O(h^3 / 64) trace error
+    assert err["interpolation_contact_l2"] == pytest.approx(err["contact_l2"], rel=0.05)

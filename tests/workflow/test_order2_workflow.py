@@ -1,6 +1,7 @@
 """The Section 4 study's pipeline (workflow/rules/order2.smk): `snakemake order2` plans one solve per
-(case, level), the k = 2 reference, one error job per case, the gathered file and the figure (the
-default target's own test checks that it does not include them); every level nests in the reference."""
+(case, level) on the paper's scene and on each manufactured contact scene, the k = 2 reference, one error
+job per case and scene, the gathered files and the figures (the default target's own test checks that it
+does not include them); every level nests in the reference."""
 
 import ast
 from pathlib import Path
@@ -20,8 +21,12 @@ def test_order2_plans_every_case_and_level():
     jobs = planned_jobs("order2")
     levels = sum(len(case["levels"]) for case in settings["cases"].values())
     assert jobs["order2_solve"] == levels
+    assert jobs["order2_manufactured_solve"] == levels * len(settings["manufactured"])
     assert jobs["order2_reference"] == 1 and jobs["order2_errors"] == len(settings["cases"])
-    assert jobs["order2_gather"] == 1 and jobs["order2_figure"] == 1
+    assert jobs["order2_manufactured_errors"] == len(settings["cases"]) * len(settings["manufactured"])
+    assert jobs["order2_gather"] == 1 and jobs["order2_manufactured_gather"] == 1 and jobs["order2_figure"] == 2
+    for scene in settings["manufactured"]:
+        assert (ROOT / "config" / "order2" / f"{scene}.yaml").is_file()
     assert {case["order"] for case in settings["cases"].values()} == {1, 2}
 
 

@@ -188,3 +188,50 @@ def trace_error(coarse_mesh: Mesh, coarse_values, ref_mesh: Mesh, ref_values, pa
     ref = boundary_trace(ref_mesh, parts, ref_values, x)
     diff = boundary_trace(coarse_mesh, parts, coarse_values, x) - ref
     return float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)) / np.sum(weights * np.sum(ref**2, axis=1))))
+
+
+def trace_errors(mesh: Mesh, parts, node_values, field, subdivisions: int = 4, points: int = 5) -> dict:
+    """The errors on the boundary ``parts`` against a field known everywhere on them, relative to
+    ||u||_{L2(parts)}: ``contact_l2`` = ||u - u_h|| (the discrete trace, ``boundary_trace``) and
+    ``interpolation_contact_l2`` = ||u - I_h u||, I_h u the trace of the interpolant of the same order
+    as ``node_values`` (k = 1: linear between the vertex values; k = 2: the quadratic with the vertex
+    values and the edge mean, Section 3.1) -- the term ||u - u_I||_{L2(Gamma_C)} of the paper's a
+    priori estimate, whose square root gives its O(h^{k/2 + 1/2}) = O(h^{3/2}) claim for k = 2.
+
+    ``field(points (P, 2)) -> (P, 2)``. Every edge is cut into ``subdivisions`` equal pieces with a
+    ``points``-point Gauss rule each (exact for a piecewise quadratic field whose pieces nest)."""
+    from vemkit.vem.load import edge_quadrature
+    from vemkit.vem.load_k2 import trace_weights
+
+    edges = _part_edges(mesh, parts)
+    s, w = edge_quadrature(points)
+    t = ((np.arange(subdivisions)[:, None] + s[None, :]) / subdivisions).ravel()
+    weights = np.tile(w, subdivisions) / subdivisions
+    a, b = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
+    x = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]  # (E, Q, 2)
+    lengths = np.linalg.norm(b - a, axis=1)
+    exact = np.asarray(field(x.reshape(-1, 2)), dtype=float).reshape(x.shape)
+    discrete = boundary_trace(mesh, parts, node_values, x.reshape(-1, 2)).reshape(x.shape)
+    ua, ub = np.asarray(field(a), dtype=float), np.asarray(field(b), dtype=float)
+    if np.asarray(node_values).reshape(-1, 2).shape[0] == mesh.n_vertices:  # k = 1
+        interpolant = (1 - t)[None, :, None] * ua[:, None] + t[None, :, None] * ub[:, None]
+    else:
+        mean = np.einsum("q,eqk->ek", weights, exact)
+        tw = trace_weights(t)
+        interpolant = (tw[None, :, 0:1] * ua[:, None] + tw[None, :, 1:2] * ub[:, None]
+                       + tw[None, :, 2:3] * mean[:, None])
+    dx = lengths[:, None] * weights[None, :]
+    norm = np.sqrt(np.sum(dx * np.sum(exact**2, axis=2)))
+    return {"contact_l2": float(np.sqrt(np.sum(dx * np.sum((discrete - exact) ** 2, axis=2))) / norm),
+            "interpolation_contact_l2": float(np.sqrt(np.sum(dx * np.sum((interpolant - exact) ** 2, axis=2))) / norm)}
+
+
+def nesting_subdivisions(mesh: Mesh, ref_mesh: Mesh, parts) -> int:
+    """The power of two m such that 1/m of the longest edge of ``mesh`` on ``parts`` is at most the
+    shortest reference edge there: with nested dyadic meshes, each piece then lies in one reference edge."""
+    def lengths(m):
+        edges = _part_edges(m, parts)
+        return np.linalg.norm(m.vertices[edges[:, 1]] - m.vertices[edges[:, 0]], axis=1)
+
+    ratio = lengths(mesh).max() / lengths(ref_mesh).min()
+    return int(2 ** max(0, int(np.ceil(np.log2(ratio) - 1e-9))))

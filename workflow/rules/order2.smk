@@ -1,12 +1,16 @@
-# The Section 4 study (issue 14): k = 1 against k = 2 virtual elements on the paper's scene, uniform
-# squares and squares refined at Gamma_C (hanging nodes), errors against a k = 2 reference on a fine
-# square mesh, observed orders, a figure. Not in the default target: `snakemake -j2 order2`.
+# The Section 4 study (issue 14): k = 1 against k = 2 virtual elements, uniform squares and squares
+# refined at Gamma_C (hanging nodes), on the paper's scene (errors against a k = 2 reference on a fine
+# square mesh) and on manufactured contact solutions (config/order2/*.yaml, errors against the exact
+# u: sliding, sticking, and a separation point inside Gamma_C), observed orders, figures. Not in the
+# default target: `snakemake -j2 order2`.
 #
 #   results/order2/solutions/{case}/n{n}.nc    one solve (SPEC §6 file; k = 2 adds edge/cell means)
 #   results/order2/reference.nc                the k = 2 reference (square, ORDER2["reference"]["n"])
 #   results/order2/errors/{case}.json          the errors of one case at every level
 #   results/order2/order2.nc, orders.md        every run, the observed orders (per DOF), the table
 #   results/order2/order2.png                  errors against DOFs, log-log
+#   results/order2/manufactured/{scene}/{case}/n{n}.nc, manufactured/errors/{scene}/{case}.json
+#   results/order2/manufactured.nc, manufactured.md, manufactured.png   the same for the exact solutions
 #
 # The paper's own measure (SPEC §5) needs vertex values on nested square meshes and a k = 1
 # reference: it is reported for the k = 1 cases against the main workflow's 2^-8 reference.
@@ -25,8 +29,11 @@ ORDER2 = {
                                "levels": [4, 8, 16, 32]},
     },
     "region_radius": 0.1,  # the error shares near the corners and near the contact-zone boundary
+    # the manufactured contact solutions: config/order2/{scene}.yaml (tests/manufactured_contact.py)
+    "manufactured": ["sliding", "sticking", "separation"],
 }
 ORDER2_CASES = list(ORDER2["cases"])
+MANUFACTURED = ORDER2["manufactured"]
 
 
 def order2_settings():
@@ -38,11 +45,22 @@ def order2_settings():
     }
 
 
+def manufactured_settings(scene):
+    """A manufactured scene with its own material, contact law and solver settings, the study's cases."""
+    return {"scene": f"config/order2/{scene}.yaml", "overrides": [], "study": scene, **ORDER2}
+
+
 def order2_solutions(case):
     return [f"results/order2/solutions/{case}/n{n}.nc" for n in ORDER2["cases"][case]["levels"]]
 
 
-ORDER2_TARGETS = ["results/order2/order2.nc", "results/order2/orders.md", "results/order2/order2.png"]
+def manufactured_solutions(scene, case):
+    return [f"results/order2/manufactured/{scene}/{case}/n{n}.nc" for n in ORDER2["cases"][case]["levels"]]
+
+
+ORDER2_TARGETS = ["results/order2/order2.nc", "results/order2/orders.md", "results/order2/order2.png",
+                  "results/order2/manufactured.nc", "results/order2/manufactured.md",
+                  "results/order2/manufactured.png"]
 
 
 rule order2_solve:
@@ -91,6 +109,40 @@ rule order2_errors:
         "../scripts/order2_errors.py"
 
 
+rule order2_manufactured_solve:
+    input:
+        "config/order2/{scene}.yaml",
+    output:
+        "results/order2/manufactured/{scene}/{case}/n{n}.nc",
+    params:
+        settings=lambda wc: manufactured_settings(wc.scene),
+    wildcard_constraints:
+        case="|".join(map(re.escape, ORDER2_CASES)),
+        scene="|".join(map(re.escape, MANUFACTURED)),
+    log:
+        "logs/order2/manufactured/{scene}/{case}/n{n}.log",
+    benchmark:
+        "results/benchmarks/order2/manufactured/{scene}/{case}/n{n}.tsv"
+    script:
+        "../scripts/order2_solve.py"
+
+
+rule order2_manufactured_errors:
+    input:
+        solutions=lambda wc: manufactured_solutions(wc.scene, wc.case),
+    output:
+        "results/order2/manufactured/errors/{scene}/{case}.json",
+    params:
+        settings=lambda wc: manufactured_settings(wc.scene),
+    wildcard_constraints:
+        case="|".join(map(re.escape, ORDER2_CASES)),
+        scene="|".join(map(re.escape, MANUFACTURED)),
+    log:
+        "logs/order2/manufactured/errors/{scene}/{case}.log",
+    script:
+        "../scripts/order2_manufactured_errors.py"
+
+
 rule order2_gather:
     input:
         [f"results/order2/errors/{case}.json" for case in ORDER2_CASES],
@@ -99,19 +151,39 @@ rule order2_gather:
         md="results/order2/orders.md",
     params:
         settings=order2_settings(),
+        title="k = 1 against k = 2 on the paper's scene (Section 4 study)",
+        measure="Errors relative to a k = 2 reference on fine squares",
     log:
         "logs/order2/gather.log",
     script:
         "../scripts/order2_gather.py"
 
 
+rule order2_manufactured_gather:
+    input:
+        [f"results/order2/manufactured/errors/{scene}/{case}.json" for scene in MANUFACTURED for case in ORDER2_CASES],
+    output:
+        nc="results/order2/manufactured.nc",
+        md="results/order2/manufactured.md",
+    params:
+        settings=ORDER2,
+        title="k = 1 against k = 2 on manufactured contact solutions (Section 4 study)",
+        measure="Errors relative to the exact solution (config/order2/*.yaml, tests/manufactured_contact.py)",
+    log:
+        "logs/order2/manufactured_gather.log",
+    script:
+        "../scripts/order2_gather.py"
+
+
 rule order2_figure:
     input:
-        "results/order2/order2.nc",
+        "results/order2/{table}.nc",
     output:
-        "results/order2/order2.png",
+        "results/order2/{table}.png",
+    wildcard_constraints:
+        table="order2|manufactured",
     log:
-        "logs/order2/figure.log",
+        "logs/order2/figure_{table}.log",
     script:
         "../scripts/order2_figure.py"
 
@@ -125,4 +197,5 @@ rule order2:
 localrules:
     order2,
     order2_gather,
+    order2_manufactured_gather,
     order2_figure,

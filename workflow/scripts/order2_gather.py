@@ -1,5 +1,6 @@
-"""Rule order2_gather: every run of the Section 4 study in one netCDF file, the observed orders and
-the Markdown table.
+"""Rules order2_gather and order2_manufactured_gather: every run of the Section 4 study in one netCDF
+file, the observed orders and the Markdown table (one section per study: the paper's scene, or each
+manufactured contact solution).
 
 Orders are per degree of freedom, p = -2 dlog(error) / dlog(DOFs) between consecutive levels of a
 case: on uniform meshes (DOFs ~ h^-2) it is the order in h; on meshes refined at Gamma_C it says what
@@ -10,65 +11,88 @@ and cell means; the cell means are condensed out of the solve: n_unknowns).
 from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
-ERRORS = ("error_h1", "error_h1_semi", "error_l2", "error_contact_l2", "error_paper")
 LABELS = {"error_h1": "H1", "error_h1_semi": "H1 semi", "error_l2": "L2", "error_contact_l2": "L2(Gamma_C)",
-          "error_paper": "paper's measure"}
+          "error_interpolation_contact_l2": "u - I_h u on Gamma_C", "error_paper": "paper's measure"}
+LABELS_ONLY = ("study", "case", "n", "family", "contact_zone_boundary")
 
 
-def dataset(records, settings, boundary):
+def error_keys(records):
+    return [k for k in LABELS if k in records[0]]
+
+
+def dataset(records, settings, title, measure):
     import numpy as np
     import xarray as xr
 
     from vemkit.io.provenance import git_commit, package_versions
 
     run = "run"
-    ds = xr.Dataset(coords={"case": (run, [r["case"] for r in records]), "n": (run, [r["n"] for r in records])})
-    for key in [k for k in records[0] if k not in ("case", "n", "family")]:
+    ds = xr.Dataset(coords={"study": (run, [r["study"] for r in records]), "case": (run, [r["case"] for r in records]),
+                            "n": (run, [r["n"] for r in records])})
+    for key in [k for k in records[0] if k not in LABELS_ONLY]:
         ds[key] = (run, np.array([r.get(key, np.nan) for r in records], dtype=float if "error" in key or
                                  "share" in key or key == "wall_time" else np.int64))
     ds["family"] = (run, [r["family"] for r in records])
-    for key in ERRORS:
+    if "contact_zone_boundary" in records[0]:  # the discrete solution's first change of contact state
+        ds["contact_zone_boundary_x"] = (run, [(r["contact_zone_boundary"] or [np.nan])[0] for r in records],
+                                         {"long_name": "x where the discrete solution's contact state changes"})
+    for key in error_keys(records):
         order = np.full(len(records), np.nan)
         for i in range(1, len(records)):
-            if records[i]["case"] == records[i - 1]["case"]:
+            if (records[i]["study"], records[i]["case"]) == (records[i - 1]["study"], records[i - 1]["case"]):
                 order[i] = -2 * np.log(records[i][key] / records[i - 1][key]) / np.log(
                     records[i]["n_dofs"] / records[i - 1]["n_dofs"])
         ds[key.replace("error", "order")] = (run, order, {"long_name": f"observed order of {key} per DOF^(-1/2)"})
-    ds.attrs.update({
-        "title": "vemkit: k = 1 against k = 2 virtual elements on the paper's scene (Section 4 study)",
-        "error_measure": "relative errors of Pi_k u_h against Pi_2 u_ref (k = 2 reference on fine squares), broken "
-                         "over the reference cells (vemkit.vem.norms_k2.projection_error_k2); error_contact_l2: "
-                         "||u_h - u_ref||_L2(Gamma_C) / ||u_ref||; error_paper: SPEC 5 against the k = 1 2^-8 "
-                         "reference (k = 1 only); share_*: part of the squared H1-seminorm error within "
-                         f"{settings['region_radius']} of a corner or of the contact-zone boundary",
-        "contact_zone_boundary": str(boundary), "settings": str(settings), "git_commit": git_commit(),
-        "package_versions": str(package_versions())})
+    ds.attrs.update({"title": f"vemkit: {title}", "error_measure": f"{measure}; {MEASURES}", "settings": str(settings),
+                     "git_commit": git_commit(), "package_versions": str(package_versions())})
     return ds
 
 
-def markdown(ds, boundary):
+MEASURES = ("relative errors of Pi_k u_h; error_contact_l2: ||u - u_h||_L2(Gamma_C) / ||u||; "
+            "error_interpolation_contact_l2: ||u - I_h u||_L2(Gamma_C) / ||u||, I_h the interpolant of order k; "
+            "error_paper: SPEC 5 against the k = 1 2^-8 reference (k = 1, paper scene only); share_*: part of the "
+            "squared H1-seminorm error within region_radius of a corner or of the contact-zone boundary")
+
+
+def study_table(part, keys):
+    """The Markdown rows of one study."""
+    shares = "share_corner_xmin_ymin" in part
+    zone = "contact_zone_boundary_x" in part
+    lines = ["| case | n | DOFs | " + " | ".join(f"{LABELS[k]} | order" for k in keys)
+             + (" | share near corners x=0 | share near contact-zone boundary" if shares else "")
+             + (" | contact-zone boundary x" if zone else "") + " |",
+             "|---|---|---|" + "---|---|" * len(keys) + ("---|---|" if shares else "") + ("---|" if zone else "")]
+    for i in range(part.sizes["run"]):
+        row = part.isel(run=i)
+        cells = [f"{float(row[k]):.3e} | {float(row[k.replace('error', 'order')]):.2f}" for k in keys]
+        extra = ""
+        if shares:
+            left = float(row["share_corner_xmin_ymin"] + row["share_corner_xmin_ymax"])
+            extra += f" | {left:.2f} | {float(row['share_contact_zone_boundary']):.3f}"
+        if zone:
+            extra += f" | {float(row['contact_zone_boundary_x']):.4f}"
+        lines.append(f"| {str(row['case'].values)} | {int(row['n'])} | {int(row['n_dofs'])} | " + " | ".join(cells)
+                     + extra + " |")
+    return lines
+
+
+def markdown(ds, keys, title, measure, boundary):
     import numpy as np
 
-    lines = ["# k = 1 against k = 2 on the paper's scene (Section 4 study)", "",
-             f"Errors relative to a k = 2 reference on fine squares; contact-zone boundary of the reference at "
-             f"{boundary}. Orders per DOF: p = -2 dlog e / dlog N.", "",
-             "| case | n | DOFs | " + " | ".join(f"{LABELS[k]} | order" for k in ERRORS)
-             + " | share near corners x=0 | share near contact-zone boundary |",
-             "|---|---|---|" + "---|---|" * len(ERRORS) + "---|---|"]
-    for i in range(ds.sizes["run"]):
-        row = ds.isel(run=i)
-        cells = [f"{float(row[k]):.3e} | {float(row[k.replace('error', 'order')]):.2f}" for k in ERRORS]
-        left = float(row["share_corner_xmin_ymin"] + row["share_corner_xmin_ymax"])
-        lines.append(f"| {str(row['case'].values)} | {int(row['n'])} | {int(row['n_dofs'])} | " + " | ".join(cells)
-                     + f" | {left:.2f} | {float(row['share_contact_zone_boundary']):.3f} |")
-    lines += ["", "Finest-interval orders:", ""]
-    for case in dict.fromkeys(ds["case"].values.tolist()):
-        last = ds.where(ds["case"] == case, drop=True).isel(run=-1)
-        lines.append(f"- {case}: " + ", ".join(f"{LABELS[k]} {float(last[k.replace('error', 'order')]):.2f}"
-                                               for k in ERRORS if np.isfinite(float(last[k.replace('error', 'order')]))))
-    lines += ["", "At equal DOFs: the error of the uniform case, log-log interpolated at the DOFs of the other case's "
-              "finest level, against that case's error (same order k):", ""]
-    lines += equal_dof_comparison(ds)
+    lines = [f"# {title}", "", f"{measure}. Orders per DOF: p = -2 dlog e / dlog N; 'u - I_h u on Gamma_C': "
+             "the interpolant of order k of the exact (or reference) solution, the term of the paper's estimate."]
+    if boundary is not None:
+        lines[-1] += f" Contact-zone boundary of the reference at {boundary}."
+    for study in dict.fromkeys(ds["study"].values.tolist()):
+        part = ds.where(ds["study"] == study, drop=True)
+        lines += ["", f"## {study}", ""] + study_table(part, keys) + ["", "Finest-interval orders:", ""]
+        for case in dict.fromkeys(part["case"].values.tolist()):
+            last = part.where(part["case"] == case, drop=True).isel(run=-1)
+            lines.append(f"- {case}: " + ", ".join(f"{LABELS[k]} {float(last[k.replace('error', 'order')]):.2f}"
+                                                   for k in keys if np.isfinite(float(last[k.replace('error', 'order')]))))
+        lines += ["", "At equal DOFs: the error of the uniform case, log-log interpolated at the DOFs of the other "
+                  "case's finest level, against that case's error (same order k):", ""]
+        lines += equal_dof_comparison(part)
     return "\n".join(lines).replace("nan", "-") + "\n"
 
 
@@ -106,10 +130,13 @@ with logged(smk):
         with open(path, encoding="utf-8") as stream:
             data = json.load(stream)
         records += data["records"]
-        boundary = data["contact_zone_boundary"]
-    ds = dataset(records, smk.params.settings, boundary)
+        boundary = data.get("contact_zone_boundary", boundary)
+    title, measure = smk.params.title, smk.params.measure
+    ds = dataset(records, smk.params.settings, title, measure)
+    if boundary is not None:
+        ds.attrs["contact_zone_boundary"] = str(boundary)
     write_dataset(ds, smk.output.nc)
-    text = markdown(ds, boundary)
+    text = markdown(ds, error_keys(records), title, measure, boundary)
     with open(smk.output.md, "w", encoding="utf-8") as stream:
         stream.write(text)
     print(text)

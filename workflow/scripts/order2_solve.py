@@ -1,4 +1,5 @@
-"""Rule order2_solve: the paper's scene with order k on one mesh of one case of the Section 4 study."""
+"""Rules order2_solve and order2_manufactured_solve: a scene (the paper's, or a manufactured contact
+solution) with order k on one mesh of one case of the Section 4 study."""
 
 import json
 
@@ -17,7 +18,8 @@ with logged(smk):
     scene = study_scene(s["scene"], s["overrides"] + [f"discretization.order={case['order']}"], case["family"],
                         options, n)
     problem, solution, ds = solve_scene(scene, mesh=build_mesh(case["family"], n, **options), verify=True)
-    ds.attrs["workflow_run"] = json.dumps({"case": smk.wildcards.case, "n": n, "order": case["order"]})
+    ds.attrs["workflow_run"] = json.dumps({"study": s.get("study", "paper"), "case": smk.wildcards.case, "n": n,
+                                          "order": case["order"]})
     write_netcdf(ds, smk.output[0])
     print(f"{smk.output[0]}: k = {case['order']}, {ds.attrs.get('n_space_dofs', problem.n_dofs)} dofs "
           f"({problem.n_dofs} unknowns), {solution.method} {solution.iterations} iterations, "
