@@ -5,7 +5,21 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: reproduce test install bench clean-results
+.PHONY: reproduce test install bench clean-results clean-numba-cache
+
+# Numba's on-disk cache (cache=True) keys a kernel on its own source file only: a kernel that inlines
+# one from another module keeps the old compiled code after that module changes. So the compiled
+# kernels are dropped whenever any vemkit source is newer than the last drop (recompiled on first use).
+NUMBA_STAMP := $(VENV)/.numba-cache-sources
+VEMKIT_SOURCES := $(shell find vemkit -name '*.py' 2>/dev/null)
+
+$(NUMBA_STAMP): $(VEMKIT_SOURCES) | $(STAMP)
+	find vemkit -path '*__pycache__*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	touch $(NUMBA_STAMP)
+
+clean-numba-cache:
+	find vemkit -path '*__pycache__*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	rm -f $(NUMBA_STAMP)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -15,13 +29,13 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
-reproduce: $(STAMP)
+reproduce: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/snakemake -j$(JOBS) --quiet rules
 
-test: $(STAMP)
+test: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python benchmarks/assembly.py
 	$(BIN)/python benchmarks/contact.py
 	$(BIN)/python benchmarks/sweep.py
@@ -36,5 +50,5 @@ clean-results:
 # `make test`. MODE=no-accounting: the same without slurmdbd (job status through squeue).
 MODE ?= accounting
 .PHONY: cluster-test
-cluster-test: $(STAMP)
+cluster-test: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python workflow/cluster/cluster_test.py --mode $(MODE)

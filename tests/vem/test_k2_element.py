@@ -10,7 +10,7 @@ from conftest import POLYGONS, nonconvex_mesh
 from vemkit.vem.assembly_k2 import NodeMapK2, dirichlet_lift, interpolate_k2, stiffness_matrix_k2
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.element import STABILIZATIONS
-from vemkit.vem.element_k2 import element_stiffness_k2_matrix
+from vemkit.vem.stiffness_k2 import element_stiffness_k2_matrix
 from vemkit.vem.element_k2_reference import element_stiffness_k2_reference, field_dofs
 from vemkit.vem.load_k2 import body_force_k2, traction_load_k2
 

@@ -89,6 +89,18 @@ def vertex_cells(offsets, cell_vertices, n_vertices):
 
 
 @numba.njit(cache=True)
+def sort_prefix(buf, k):
+    """Sort buf[:k] in place (insertion sort: the rows of a sparsity pattern hold a few dozen columns)."""
+    for i in range(1, k):
+        x = buf[i]
+        j = i - 1
+        while j >= 0 and buf[j] > x:
+            buf[j + 1] = buf[j]
+            j -= 1
+        buf[j + 1] = x
+
+
+@numba.njit(cache=True)
 def _neighbours(v, offsets, cell_vertices, vc_ptr, vc, free_index, buf):
     """Sorted unique free neighbours of vertex v (itself included) into buf; returns their count."""
     k = 0
@@ -101,13 +113,7 @@ def _neighbours(v, offsets, cell_vertices, vc_ptr, vc, free_index, buf):
                 k += 1
     if k == 0:
         return 0
-    for i in range(1, k):  # insertion sort: k is small (sum of the cell sizes around v)
-        x = buf[i]
-        j = i - 1
-        while j >= 0 and buf[j] > x:
-            buf[j + 1] = buf[j]
-            j -= 1
-        buf[j + 1] = x
+    sort_prefix(buf, k)  # k is small (sum of the cell sizes around v)
     u = 1
     for i in range(1, k):
         if buf[i] != buf[u - 1]:

@@ -7,7 +7,7 @@ Cell c lists its 2n + 1 nodes as its n vertices (CCW), its n edges (edge i from 
 ``mesh.half_edge_edge``) and itself, which is the local order of the element kernel.
 
 Clamped nodes (Dirichlet, (2.4)) are eliminated while assembling, exactly as for k = 1
-(``vemkit.vem.assembly``, whose pattern builders are reused on the node lists): a Dirichlet side
+(``vemkit.vem.assembly``; the pattern is built by ``vemkit.vem.pattern_k2``): a Dirichlet side
 clamps its vertices and its edges. Prescribed non-zero values enter the load through
 ``dirichlet_lift``; ``interpolate_k2`` gives the degrees of freedom of a field (Dirichlet data,
 exact solutions).
@@ -27,9 +27,11 @@ import numba
 import numpy as np
 
 from vemkit.mesh.mesh import Mesh
-from vemkit.vem.assembly import ROW_CHUNKS, add_block, cells_of_rows, chunk_rows, dof_pattern, sorted_csr, vertex_adjacency, vertex_cells
+from vemkit.vem.assembly import ROW_CHUNKS, add_block, cells_of_rows, chunk_rows, sorted_csr, vertex_cells
 from vemkit.vem.element import stabilization_code
-from vemkit.vem.element_k2 import N_BASIS, element_stiffness_k2, largest_cell
+from vemkit.vem.element_k2 import largest_cell
+from vemkit.vem.pattern_k2 import dof_pattern_k2
+from vemkit.vem.stiffness_k2 import element_stiffness_k2, stiffness_workspace
 
 
 _CELL_NODES: "weakref.WeakKeyDictionary[Mesh, tuple]" = weakref.WeakKeyDictionary()
@@ -196,9 +198,8 @@ def _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
     for i in range(n):
         px[i] = vertices[nodes[start + i], 0]
         py[i] = vertices[nodes[start + i], 1]
-    Pi, D, PiT, rhsT, R, rhs, G, sig, vals = work
-    # the work arrays are passed whole (C-contiguous, faster loops); the kernel uses their [:m, :m] part
-    element_stiffness_k2(px[:n], py[:n], lam, mu, stab, K, Pi, D, PiT, rhsT, R, rhs, G, sig, vals)
+    # the work arrays are passed whole (C-contiguous, faster loops); the kernel uses their leading part
+    element_stiffness_k2(px[:n], py[:n], lam, mu, stab, K, work)
     return n
 
 
@@ -220,18 +221,15 @@ def condense_cell(K, n):
 def _element_workspace(nmax):
     """(K, work, px, py): the work arrays of one k = 2 element stiffness for up to nmax vertices."""
     mmax = 4 * nmax + 2
-    work = (np.empty((N_BASIS, mmax)), np.empty((mmax, N_BASIS)), np.empty((mmax, N_BASIS)), np.empty((mmax, 9)),
-            np.empty((mmax, mmax)), np.empty((9, mmax)), np.empty((9, 9)), np.empty((9, 3, 3)), np.empty((3, N_BASIS, 2)))
-    return np.empty((mmax, mmax)), work, np.empty(nmax), np.empty(nmax)
+    return np.empty((mmax, mmax)), stiffness_workspace(nmax), np.empty(nmax), np.empty(nmax)
 
 
 @numba.njit(cache=True)
-def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, condense, nmax, data):
-    """Zero, then add, the rows row_lo <= r < row_hi of every element stiffness touching them (as for k = 1)."""
+def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab, condense, nmax, data):
+    """Add the rows row_lo <= r < row_hi of every element stiffness touching them (as for k = 1)."""
     K, work, px, py = _element_workspace(nmax)
     rows = np.empty(2 * nmax + 1, dtype=np.int64)
     order = np.empty(2 * nmax + 1, dtype=np.int64)
-    data[4 * pindptr[row_lo] : 4 * pindptr[row_hi]] = 0.0  # this thread's rows: first touch here
     for c in cells_of_rows(row_lo, row_hi, free_nodes, nc_ptr, nc, offsets, nodes, free_index):
         start = offsets[c]
         size = offsets[c + 1] - start
@@ -240,13 +238,14 @@ def _scatter_rows_k2(row_lo, row_hi, vertices, offsets, nodes, free_index, free_
         n = _cell_stiffness(c, vertices, offsets, nodes, lam, mu, stab, px, py, K, work)
         if condense:
             condense_cell(K, n)
-        _add_rows(row_lo, row_hi, rows, size, order, K, pindptr, pindices, data)
+        _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)
 
 
 @numba.njit(cache=True)
-def _add_rows(row_lo, row_hi, rows, size, order, K, pindptr, pindices, data):
-    """data += the rows of K whose dof rows lie in [row_lo, row_hi): the cell's free columns are
-    sorted once, then each CSR row is found by one merge walk along its sorted column list."""
+def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
+    """data += the rows of K whose node rows lie in [row_lo, row_hi): the cell's free columns are
+    sorted once, then each CSR row is found by one merge walk along its sorted column list (the
+    even entries 2c of the scalar row 2r)."""
     count = 0
     for j in range(size):  # insertion sort of the free local columns by global row
         if rows[j] < 0:
@@ -261,26 +260,24 @@ def _add_rows(row_lo, row_hi, rows, size, order, K, pindptr, pindices, data):
         r = rows[i]
         if r < row_lo or r >= row_hi:
             continue
-        lo = pindptr[r]
-        deg2 = 2 * (pindptr[r + 1] - lo)
-        base = 4 * lo
-        p = lo
+        q = indptr[2 * r]
+        deg2 = indptr[2 * r + 1] - q
         for s in range(count):
             j = order[s]
-            while pindices[p] < rows[j]:
-                p += 1
-            add_block(data, base + 2 * (p - lo), base + 2 * (p - lo) + deg2, K, i, j)
+            while indices[q] < 2 * rows[j]:
+                q += 2
+            add_block(data, q, q + deg2, K, i, j)
 
 
 @numba.njit(cache=True, parallel=True)
-def scatter_stiffness_k2(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices, lam, mu, stab, condense, data):
-    """Every k = 2 element stiffness (3.9) summed into the CSR ``data`` (overwritten): contiguous row
+def scatter_stiffness_k2(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab, condense, data):
+    """Every k = 2 element stiffness (3.9) added into the CSR ``data`` (zeroed): contiguous row
     chunks, one thread each, a thread writing only its own rows (cells straddling two chunks are
     computed twice)."""
     nmax = largest_cell(offsets)
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, free_nodes.shape[0])
-        _scatter_rows_k2(lo, hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, pindptr, pindices,
+        _scatter_rows_k2(lo, hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices,
                          lam, mu, stab, condense, nmax, data)
 
 
@@ -294,11 +291,10 @@ def stiffness_matrix_k2(mesh: Mesh, lam: float, mu: float, stabilization: str, n
     stab = stabilization_code(stabilization)
     offsets, cn = cell_nodes(mesh)
     nc_ptr, nc = vertex_cells(offsets, cn, nodes.n_nodes)
-    pindptr, pindices = vertex_adjacency(offsets, cn, nc_ptr, nc, nodes.free_nodes)
-    indptr, indices = dof_pattern(pindptr, pindices)
-    data = np.empty(indices.shape[0])  # zeroed by the threads, each its own rows
+    indptr, indices = dof_pattern_k2(offsets, cn, nc_ptr, nc, nodes.free_nodes, nodes.free_index)
+    data = np.zeros(indices.shape[0])  # fresh zero pages from the system: no zeroing pass
     scatter_stiffness_k2(mesh.vertices, offsets, cn, nodes.free_index, nodes.free_nodes, nc_ptr, nc,
-                         pindptr, pindices, float(lam), float(mu), stab, nodes.condensed, data)
+                         indptr, indices, float(lam), float(mu), stab, nodes.condensed, data)
     return sorted_csr(data, indices, indptr, nodes.n_free)
 
 

@@ -30,8 +30,9 @@ translation comes from the interior mean, the rotation from the edge means alone
 The kernel works in the basis of [P2]^2 made of the rigid motions (1,0), (0,1), (-eta, xi) and nine
 non-rigid fields (xi, 0), (0, eta), (eta, xi), (xi^2, 0), (xi eta, 0), (eta^2, 0), (0, xi^2),
 (0, xi eta), (0, eta^2), with (xi, eta) = (x - x_K) / h, x_K the centroid and h the largest
-centroid-vertex distance. The plain-numpy twin ``element_k2_reference`` solves (3.8) and the
-constraints literally as one saddle-point system; the tests pin this kernel against it.
+centroid-vertex distance. The local stiffness (3.9) built on this projection is in
+``vemkit.vem.stiffness_k2``. The plain-numpy twin ``element_k2_reference`` solves (3.8) and the
+constraints literally as one saddle-point system; the tests pin the kernels against it.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ import math
 import numba
 import numpy as np
 
-from vemkit.vem.element import polygon_coordinates, stabilization_code
+from vemkit.vem.element import polygon_coordinates
 
 N_BASIS = 12
 # strain of the 9 non-rigid fields times h: STRAIN[b, (eps11, eps22, eps12), (1, xi, eta)]
@@ -101,26 +102,6 @@ def cell_frame(px, py):
 
 
 @numba.njit(cache=True)
-def basis_values(xi, eta, out):
-    """out (12, 2): the basis fields at the scaled point (xi, eta)."""
-    out[:, :] = 0.0
-    out[0, 0] = 1.0
-    out[1, 1] = 1.0
-    out[2, 0] = -eta
-    out[2, 1] = xi
-    out[3, 0] = xi
-    out[4, 1] = eta
-    out[5, 0] = eta
-    out[5, 1] = xi
-    out[6, 0] = xi * xi
-    out[7, 0] = xi * eta
-    out[8, 0] = eta * eta
-    out[9, 1] = xi * xi
-    out[10, 1] = xi * eta
-    out[11, 1] = eta * eta
-
-
-@numba.njit(cache=True)
 def stress_table(lam, mu, h, sig):
     """sig (9, 3, 3): sigma(q_b) = C eps(q_b) as (sigma11, sigma22, sigma12) x (1, xi, eta), SPEC §1."""
     for b in range(9):
@@ -163,7 +144,9 @@ def boundary_rhs(px, py, xc, yc, h, area, sig, rhs):
     gives the weights (T_a - T_b)/12 on v_a, (T_b - T_a)/12 on v_b and (T_a + T_b)/2 on the edge mean.
     """
     n = px.shape[0]
-    rhs[:, : 4 * n + 2] = 0.0
+    for b in range(9):  # (loops, not a slice: no view to build in the per-cell path)
+        for j in range(4 * n + 2):
+            rhs[b, j] = 0.0
     for i in range(n):
         j = (i + 1) % n
         dx = px[j] - px[i]
@@ -191,20 +174,25 @@ def boundary_rhs(px, py, xc, yc, h, area, sig, rhs):
 
 
 @numba.njit(cache=True)
-def cholesky_solve(G, rhs, m, out, lo, hi):
-    """out[lo:hi, :m] = G[lo:hi, lo:hi]^-1 rhs[lo:hi, :m] for an SPD diagonal block of G (factored
-    in place, lower triangle). The substitutions run row by row over all m right-hand sides at once.
-    """
+def cholesky_factor(G, lo, hi):
+    """G[lo:hi, lo:hi] = L L^T in place for an SPD diagonal block of G: the lower triangle keeps L,
+    its diagonal the reciprocals 1 / L_jj."""
     for j in range(lo, hi):
         s = G[j, j]
         for p in range(lo, j):
             s -= G[j, p] * G[j, p]
-        G[j, j] = 1.0 / math.sqrt(s)  # the diagonal keeps the reciprocal
+        G[j, j] = 1.0 / math.sqrt(s)
         for i in range(j + 1, hi):
             s = G[i, j]
             for p in range(lo, j):
                 s -= G[i, p] * G[j, p]
             G[i, j] = s * G[j, j]
+
+
+@numba.njit(cache=True)
+def cholesky_solve(G, rhs, m, out, lo, hi):
+    """out[lo:hi, :m] = G[lo:hi, lo:hi]^-1 rhs[lo:hi, :m] (G factored by ``cholesky_factor``). The
+    substitutions run row by row over all m right-hand sides at once."""
     for i in range(lo, hi):
         for c in range(m):
             out[i, c] = rhs[i, c]
@@ -256,17 +244,27 @@ def projection_workspace(nmax):
 
 
 @numba.njit(cache=True)
-def projection_k2(px, py, lam, mu, Pi, rhs, G, sig):
-    """Pi (12 x m): the coefficients of Pi_2 phi_j (3.8) in the kernel's basis; rhs (9 x m) keeps
-    a_K(phi_j, q_b). Returns the frame (area, xc, yc, h, M20, M11, M02)."""
-    n = px.shape[0]
-    m = 4 * n + 2
+def projection_system(px, py, lam, mu, rhs, G, sig):
+    """The system (3.8) of a polygon: G (9 x 9, factored by ``cholesky_factor``) and rhs (9 x m)
+    (``energy_matrix``, ``boundary_rhs``); returns the frame (area, xc, yc, h, M20, M11, M02)."""
     area, xc, yc, h, m20, m11, m02 = cell_frame(px, py)
     stress_table(lam, mu, h, sig)
     energy_matrix(sig, h, area, m20, m11, m02, G)
     boundary_rhs(px, py, xc, yc, h, area, sig, rhs)
     # about the centroid the constant strains (fields 0-2) and the zero-mean linear strains of the
-    # quadratic fields (3-8) are a_K-orthogonal: G is block diagonal, solved block by block
+    # quadratic fields (3-8) are a_K-orthogonal: G is block diagonal, factored block by block
+    cholesky_factor(G, 0, 3)
+    cholesky_factor(G, 3, 9)
+    return area, xc, yc, h, m20, m11, m02
+
+
+@numba.njit(cache=True)
+def projection_k2(px, py, lam, mu, Pi, rhs, G, sig):
+    """Pi (12 x m): the coefficients of Pi_2 phi_j (3.8) in the kernel's basis; rhs (9 x m) keeps
+    a_K(phi_j, q_b). Returns the frame (area, xc, yc, h, M20, M11, M02)."""
+    n = px.shape[0]
+    m = 4 * n + 2
+    area, xc, yc, h, m20, m11, m02 = projection_system(px, py, lam, mu, rhs, G, sig)
     cholesky_solve(G, rhs, m, Pi[3:, :], 0, 3)
     cholesky_solve(G, rhs, m, Pi[3:, :], 3, 9)
     for j in range(m):
@@ -280,106 +278,3 @@ def projection_k2(px, py, lam, mu, Pi, rhs, G, sig):
         Pi[2, 2 * n + 2 * i] = h * (px[j] - px[i]) / (2.0 * area)
         Pi[2, 2 * n + 2 * i + 1] = h * (py[j] - py[i]) / (2.0 * area)
     return area, xc, yc, h, m20, m11, m02
-
-
-@numba.njit(cache=True)
-def dof_matrix(px, py, xc, yc, h, area, m20, m11, m02, D, va, vb, vm):
-    """D (m x 12): the degrees of freedom of the 12 basis fields (vertex values, edge and cell means)."""
-    n = px.shape[0]
-    for i in range(n):
-        j = (i + 1) % n
-        xa, ya = (px[i] - xc) / h, (py[i] - yc) / h
-        xb, yb = (px[j] - xc) / h, (py[j] - yc) / h
-        basis_values(xa, ya, va)
-        basis_values(xb, yb, vb)
-        basis_values(0.5 * (xa + xb), 0.5 * (ya + yb), vm)
-        for b in range(N_BASIS):
-            D[2 * i, b] = va[b, 0]
-            D[2 * i + 1, b] = va[b, 1]
-            D[2 * n + 2 * i, b] = (va[b, 0] + 4.0 * vm[b, 0] + vb[b, 0]) / 6.0  # Simpson: exact
-            D[2 * n + 2 * i + 1, b] = (va[b, 1] + 4.0 * vm[b, 1] + vb[b, 1]) / 6.0
-    for b in range(N_BASIS):
-        D[4 * n, b] = 0.0
-        D[4 * n + 1, b] = 0.0
-    D[4 * n, 0] = 1.0
-    D[4 * n + 1, 1] = 1.0
-    D[4 * n, 6] = m20 / area
-    D[4 * n, 7] = m11 / area
-    D[4 * n, 8] = m02 / area
-    D[4 * n + 1, 9] = m20 / area
-    D[4 * n + 1, 10] = m11 / area
-    D[4 * n + 1, 11] = m02 / area
-
-
-@numba.njit(cache=True, fastmath={"contract", "reassoc"})
-def local_stiffness(m, mu, stab, Pi, rhs, D, PiT, rhsT, R, K):
-    """K = a_K(Pi phi_i, Pi phi_j) + alpha_K S_K((I - Pi) phi_i, (I - Pi) phi_j) (3.9) from the projection.
-
-    Every entry is a dot product of two contiguous rows (PiT, rhsT: transposed copies; R holds
-    (I - D Pi)^T), the form that vectorizes; ``reassoc`` lets the sums run in vector lanes.
-    """
-    for j in range(m):
-        for b in range(N_BASIS):
-            PiT[j, b] = Pi[b, j]
-        for b in range(9):
-            rhsT[j, b] = rhs[b, j]
-    for i in range(m):  # consistency a_K(Pi phi_i, Pi phi_j) = a_K(phi_i, Pi phi_j)
-        for j in range(i, m):
-            acc = 0.0
-            for b in range(9):
-                acc += rhsT[i, b] * PiT[j, 3 + b]
-            K[i, j] = acc
-    tr = 0.0
-    for i in range(m):
-        tr += K[i, i]
-    alpha = 1.0 if stab == 0 else (2.0 * mu if stab == 1 else tr / m)
-    for i in range(m):  # R[i, k] = delta_ik - (D Pi)[k, i]: dof k of phi_i - Pi phi_i
-        for k in range(m):
-            acc = 0.0
-            for b in range(N_BASIS):
-                acc += D[k, b] * PiT[i, b]
-            R[i, k] = -acc
-        R[i, i] += 1.0
-    for i in range(m):  # stabilization alpha (I - D Pi)^T (I - D Pi), the dofi-dofi S_K of (3.9)
-        for j in range(i, m):
-            acc = 0.0
-            for k in range(m):
-                acc += R[i, k] * R[j, k]
-            K[i, j] += alpha * acc
-    for i in range(m):
-        for j in range(i):
-            K[i, j] = K[j, i]
-
-
-@numba.njit(cache=True)
-def element_stiffness_k2(px, py, lam, mu, stab, K, Pi, D, PiT, rhsT, R, rhs, G, sig, vals):
-    """Local k = 2 stiffness (3.9) into K[:m, :m] (m = 4n + 2). Work: Pi (12 x m), D (m x 12),
-    PiT (m x 12), rhsT (m x 9), R (m x m), rhs (9 x m), G (9 x 9), sig (9, 3, 3), vals (3, 12, 2);
-    K and the work arrays may be larger (only their leading m rows / columns are used).
-
-    stab: 0 = dofi (alpha = 1), 1 = dofi-2mu (alpha = 2 mu), 2 = trace (alpha = tr(Kc) / m).
-    """
-    n = px.shape[0]
-    m = 4 * n + 2
-    area, xc, yc, h, m20, m11, m02 = projection_k2(px, py, lam, mu, Pi, rhs, G, sig)
-    dof_matrix(px, py, xc, yc, h, area, m20, m11, m02, D, vals[0], vals[1], vals[2])
-    local_stiffness(m, mu, stab, Pi, rhs, D, PiT, rhsT, R, K)
-    return area
-
-
-def work_arrays(nmax: int):
-    """The work arrays of ``element_stiffness_k2`` for cells of up to nmax vertices."""
-    m = 4 * nmax + 2
-    return (np.empty((N_BASIS, m)), np.empty((m, N_BASIS)), np.empty((m, N_BASIS)), np.empty((m, 9)),
-            np.empty((m, m)), np.empty((9, m)), np.empty((9, 9)), np.empty((9, 3, 3)), np.empty((3, N_BASIS, 2)))
-
-
-def element_stiffness_k2_matrix(coords, lam, mu, stabilization="dofi-2mu"):
-    """Convenience: the local k = 2 stiffness of one polygon (n, 2) from the Numba kernel."""
-    c = np.asarray(coords, float)
-    n = c.shape[0]
-    m = 4 * n + 2
-    K = np.empty((m, m))
-    element_stiffness_k2(c[:, 0].copy(), c[:, 1].copy(), float(lam), float(mu), stabilization_code(stabilization),
-                         K, *work_arrays(n))
-    return K

@@ -1,0 +1,103 @@
+"""Sparsity pattern of the global k = 2 matrix (``vemkit.vem.assembly_k2``), straight at the dof level.
+
+Free node r couples with every free node of the cells around it. The k = 1 builders
+(``vemkit.vem.assembly.vertex_adjacency`` then ``dof_pattern``) sort each candidate list with its
+duplicates and write a node pattern before expanding it; at k = 2 a vertex row has 4 x 9 candidates
+on quadrilaterals and the matrix 7 times the entries of k = 1 per node, so here the duplicates are
+dropped by a sparse set as they come, only the distinct columns are sorted, and the int32 dof
+indices (2 x 2 blocks) are written directly, by numpy-allocated memory (huge pages).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from vemkit.vem.assembly import ROW_CHUNKS, chunk_rows, sort_prefix
+
+
+@numba.njit(cache=True)
+def _row_columns(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf):
+    """The distinct free columns of node row r (the free nodes of the cells around it) into buf,
+    unsorted; returns their count. ``where`` is the index of a sparse set (Briggs and Torczon): an
+    entry counts only if it points back at itself, so the array is never cleared."""
+    g = free_nodes[r]
+    k = 0
+    for t in range(nc_ptr[g], nc_ptr[g + 1]):
+        c = nc[t]
+        for p in range(offsets[c], offsets[c + 1]):
+            col = free_index[nodes[p]]
+            if col < 0:
+                continue
+            s = where[col]
+            if 0 <= s < k and buf[s] == col:
+                continue
+            where[col] = k
+            buf[k] = col
+            k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free):
+    """(where, buf) of ``_row_columns`` for the rows [lo, hi): buf holds the longest candidate list."""
+    size = 1
+    for r in range(lo, hi):
+        g = free_nodes[r]
+        total = 0
+        for t in range(nc_ptr[g], nc_ptr[g + 1]):
+            total += offsets[nc[t] + 1] - offsets[nc[t]]
+        size = max(size, total)
+    return np.empty(n_free, dtype=np.int64), np.empty(size, dtype=np.int64)
+
+
+@numba.njit(cache=True)
+def _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices):
+    """Row r's columns, sorted (insertion sort: a row holds a few dozen), as the 2 x 2 dof blocks of
+    the scalar rows 2r and 2r + 1."""
+    k = _row_columns(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf)
+    sort_prefix(buf, k)
+    q0 = indptr[2 * r]
+    q1 = indptr[2 * r + 1]
+    for t in range(k):
+        indices[q0 + 2 * t] = indices[q1 + 2 * t] = 2 * buf[t]
+        indices[q0 + 2 * t + 1] = indices[q1 + 2 * t + 1] = 2 * buf[t] + 1
+
+
+@numba.njit(cache=True, parallel=True)
+def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
+    """indptr of ``dof_pattern_k2``: the number of distinct free nodes around each free node, doubled."""
+    n_free = free_nodes.shape[0]
+    degree = np.empty(n_free, dtype=np.int64)
+    for chunk in numba.prange(ROW_CHUNKS):
+        lo, hi = chunk_rows(chunk, n_free)
+        where, buf = _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free)
+        for r in range(lo, hi):
+            degree[r] = _row_columns(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf)
+    indptr = np.empty(2 * n_free + 1, dtype=np.int64)
+    indptr[0] = 0
+    for r in range(n_free):
+        indptr[2 * r + 1] = indptr[2 * r] + 2 * degree[r]
+        indptr[2 * r + 2] = indptr[2 * r + 1] + 2 * degree[r]
+    return indptr
+
+
+@numba.njit(cache=True, parallel=True)
+def _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices):
+    """The sorted columns of ``dof_pattern_k2`` into indices, each thread its own contiguous rows."""
+    n_free = free_nodes.shape[0]
+    for chunk in numba.prange(ROW_CHUNKS):
+        lo, hi = chunk_rows(chunk, n_free)
+        where, buf = _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free)
+        for r in range(lo, hi):
+            _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices)
+
+
+def dof_pattern_k2(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
+    """CSR pattern (indptr, int32 indices, sorted) of the k = 2 matrix: scalar rows 2r + a hold
+    (2c, 2c + 1) for every free node c sharing a cell with the free node r. The indices are
+    allocated here, by numpy (large arrays on huge pages: fewer page faults when first written)."""
+    indptr = _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index)
+    indices = np.empty(indptr[-1], dtype=np.int32)
+    _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices)
+    return indptr, indices
