@@ -248,6 +248,9 @@ def _cli(tmp_path, *args):
     (["solve", "--set", "discretization.order=3"], "discretization.order = 3"),
     (["solve", "--set", "discretization.order=2", "--set", "discretization.contact_quadrature=gauss"],
      "discretization.contact_quadrature"),
+    (["solve", "--set", "discretization.body_force_projection=p1"], "discretization.body_force_projection"),
+    (["solve", "--set", "discretization.order=2", "--set", "discretization.body_force_projection=p2"],
+     "discretization.body_force_projection"),
 ])
 def test_bad_order_2_requests_are_one_line_errors_through_the_cli(tmp_path, args, named):
     run = _cli(tmp_path, args[0], PAPER, "-o", "out.nc", *args[1:],

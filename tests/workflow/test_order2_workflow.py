@@ -21,9 +21,11 @@ def test_order2_plans_every_case_and_level():
     jobs = planned_jobs("order2")
     levels = sum(len(case["levels"]) for case in settings["cases"].values())
     assert jobs["order2_solve"] == levels
-    assert jobs["order2_manufactured_solve"] == levels * len(settings["manufactured"])
+    extra = settings["manufactured_cases"]
+    assert jobs["order2_manufactured_solve"] == (levels + sum(len(c["levels"]) for c in extra.values())) * len(
+        settings["manufactured"])
     assert jobs["order2_reference"] == 1 and jobs["order2_errors"] == len(settings["cases"])
-    assert jobs["order2_manufactured_errors"] == len(settings["cases"]) * len(settings["manufactured"])
+    assert jobs["order2_manufactured_errors"] == (len(settings["cases"]) + len(extra)) * len(settings["manufactured"])
     assert jobs["order2_gather"] == 1 and jobs["order2_manufactured_gather"] == 1 and jobs["order2_figure"] == 2
     for scene in settings["manufactured"]:
         assert (ROOT / "config" / "order2" / f"{scene}.yaml").is_file()

@@ -261,10 +261,19 @@ def _normalized(value, node: dict):
     return value
 
 
+def _check_order_options(discretization: dict) -> None:
+    """Options that exist for one order k only are refused at the other."""
+    if discretization["body_force_projection"] != "p0" and discretization["order"] != 2:
+        raise SceneError(f"discretization.body_force_projection = {discretization['body_force_projection']!r} "
+                         "needs discretization.order = 2 (k = 1 loads the cell mean of f1); drop it or set "
+                         "discretization.order=2", key="discretization.body_force_projection")
+
+
 def _semantic_checks(data: dict, given: dict) -> dict:
     """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
     written (before the defaults were filled in)."""
     check_mesh_size(data["discretization"]["mesh"])
+    _check_order_options(data["discretization"])
     domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
     from_file = "file" in data["discretization"]["mesh"]
     check_sides(data, None if from_file else
@@ -337,6 +346,8 @@ class Scene:
     contact_gauss_points = _field("discretization", "contact_gauss_points",
                                   doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
     order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
+    body_force_projection = _field("discretization", "body_force_projection",
+                                   doc="p0 (the paper's P_0 f1) or p1 (P_1 f1 against Pi_2 v): the k = 2 load")
     mesh_options = _field("discretization", "mesh", convert=dict,
                           doc="discretization.mesh: family, n / h / cells (or file) and the family "
                               "options given (a copy)")

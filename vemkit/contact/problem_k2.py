@@ -41,7 +41,7 @@ from vemkit.vem.constraints import apply_fixed_dofs, free_rigid_motion
 from vemkit.vem.condensation_k2 import cell_load, condense_load, recover_cell_means
 from vemkit.vem.constraints_k2 import DofMapK2, constrained_nodes_k2, dirichlet_components_k2
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes
-from vemkit.vem.load_k2 import body_force_k2, cell_frames, pressure_load_k2, traction_load_k2
+from vemkit.vem.load_k2 import body_force_k2, body_force_p1_k2, cell_frames, pressure_load_k2, traction_load_k2
 from vemkit.vem.norms_k2 import ProjectedSolutionK2, projected_solution_k2
 
 
@@ -117,29 +117,31 @@ def _constrained(mesh: Mesh, dirichlet) -> DofMapK2:
     return constrained_nodes_k2(mesh, prescribed, values, condensed=True)
 
 
-def _load_k2(mesh: Mesh, neumann, pressure, body_force) -> np.ndarray:
-    """(n_nodes, 2) load vector: tractions, normal pressures and the body force (Section 3.3)."""
+def _load_k2(mesh: Mesh, neumann, pressure, body_force, projection: str, lam: float, mu: float) -> np.ndarray:
+    """(n_nodes, 2) load vector: tractions, normal pressures and the body force (Section 3.3), whose
+    projection is the paper's P_0 f1 (``projection`` "p0") or P_1 f1 against Pi_2 v ("p1")."""
     f = np.zeros((mesh.n_vertices + mesh.edges.shape[0] + mesh.n_cells, 2))
     for name, traction in (neumann or {}).items():
         f += traction_load_k2(mesh, mesh.boundary[name], traction)
     for name, p in (pressure or {}).items():
         f += pressure_load_k2(mesh, mesh.boundary[name], p)
     if body_force is not None:
-        f += body_force_k2(mesh, body_force)
+        f += body_force_k2(mesh, body_force) if projection == "p0" else body_force_p1_k2(mesh, body_force, lam, mu)
     return f
 
 
 def discrete_problem_k2(mesh: Mesh, E: float, nu: float, *, dirichlet=("right",), neumann=None, pressure=None,
                         contact=(), gap=lambda x, y: np.zeros_like(x), law: ContactLaw | None = None,
                         body_force=None, stabilization: str = "dofi-2mu",
-                        contact_quadrature: str = "nodal") -> DiscreteProblemK2:
-    """Assemble (3.16) with k = 2 (arguments as ``vemkit.contact.problem.discrete_problem``)."""
+                        contact_quadrature: str = "nodal", body_force_projection: str = "p0") -> DiscreteProblemK2:
+    """Assemble (3.16) with k = 2 (arguments as ``vemkit.contact.problem.discrete_problem``;
+    ``body_force_projection``: "p0", the paper's P_0 f1, or "p1", P_1 f1 against Pi_2 v)."""
     _check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     check_quadrature(contact_quadrature)
     lam, mu = lame_parameters(E, nu)
     dofs = _constrained(mesh, dirichlet)
     K = stiffness_matrix_k2(mesh, lam, mu, stabilization, dofs.nodes)
-    full_load = _load_k2(mesh, neumann, pressure, body_force)
+    full_load = _load_k2(mesh, neumann, pressure, body_force, body_force_projection, lam, mu)
     f = condense_load(mesh, lam, mu, stabilization, dofs.nodes, full_load)
     dofs = dofs.with_change(midpoint_change(mesh, dofs, midpoint_edges(mesh, contact, dofs)))
     K, f = change_variables(K, f, dofs.change)
@@ -154,7 +156,8 @@ def scene_problem_k2(scene, mesh: Mesh | None = None) -> DiscreteProblemK2:
     mesh = scene_mesh(scene) if mesh is None else mesh
     check_expressions_on_mesh(scene, mesh)  # a pole at a vertex: refused, not integrated around
     t0 = time.perf_counter()
-    problem = discrete_problem_k2(mesh, scene.E, scene.nu, **scene_problem_data(scene))
+    problem = discrete_problem_k2(mesh, scene.E, scene.nu, body_force_projection=scene.body_force_projection,
+                                  **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
     problem.info["order"] = 2
     return problem

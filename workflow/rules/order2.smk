@@ -31,9 +31,15 @@ ORDER2 = {
     "region_radius": 0.1,  # the error shares near the corners and near the contact-zone boundary
     # the manufactured contact solutions: config/order2/{scene}.yaml (tests/manufactured_contact.py)
     "manufactured": ["sliding", "sticking", "separation"],
+    # their extra case: k = 2 with P_1 f1 in the load (the paper scene has no body force: same as P_0)
+    "manufactured_cases": {
+        "square-k2-p1": {"family": "square", "order": 2, "levels": [4, 8, 16, 32, 64],
+                         "overrides": ["discretization.body_force_projection=p1"]},
+    },
 }
 ORDER2_CASES = list(ORDER2["cases"])
 MANUFACTURED = ORDER2["manufactured"]
+MANUFACTURED_CASES = {**ORDER2["cases"], **ORDER2["manufactured_cases"]}
 
 
 def order2_settings():
@@ -47,7 +53,8 @@ def order2_settings():
 
 def manufactured_settings(scene):
     """A manufactured scene with its own material, contact law and solver settings, the study's cases."""
-    return {"scene": f"config/order2/{scene}.yaml", "overrides": [], "study": scene, **ORDER2}
+    return {"scene": f"config/order2/{scene}.yaml", "overrides": [], "study": scene, **ORDER2,
+            "cases": MANUFACTURED_CASES}
 
 
 def order2_solutions(case):
@@ -55,7 +62,7 @@ def order2_solutions(case):
 
 
 def manufactured_solutions(scene, case):
-    return [f"results/order2/manufactured/{scene}/{case}/n{n}.nc" for n in ORDER2["cases"][case]["levels"]]
+    return [f"results/order2/manufactured/{scene}/{case}/n{n}.nc" for n in MANUFACTURED_CASES[case]["levels"]]
 
 
 ORDER2_TARGETS = ["results/order2/order2.nc", "results/order2/orders.md", "results/order2/order2.png",
@@ -117,7 +124,7 @@ rule order2_manufactured_solve:
     params:
         settings=lambda wc: manufactured_settings(wc.scene),
     wildcard_constraints:
-        case="|".join(map(re.escape, ORDER2_CASES)),
+        case="|".join(map(re.escape, MANUFACTURED_CASES)),
         scene="|".join(map(re.escape, MANUFACTURED)),
     log:
         "logs/order2/manufactured/{scene}/{case}/n{n}.log",
@@ -135,7 +142,7 @@ rule order2_manufactured_errors:
     params:
         settings=lambda wc: manufactured_settings(wc.scene),
     wildcard_constraints:
-        case="|".join(map(re.escape, ORDER2_CASES)),
+        case="|".join(map(re.escape, MANUFACTURED_CASES)),
         scene="|".join(map(re.escape, MANUFACTURED)),
     log:
         "logs/order2/manufactured/errors/{scene}/{case}.log",
@@ -161,12 +168,12 @@ rule order2_gather:
 
 rule order2_manufactured_gather:
     input:
-        [f"results/order2/manufactured/errors/{scene}/{case}.json" for scene in MANUFACTURED for case in ORDER2_CASES],
+        [f"results/order2/manufactured/errors/{scene}/{case}.json" for scene in MANUFACTURED for case in MANUFACTURED_CASES],
     output:
         nc="results/order2/manufactured.nc",
         md="results/order2/manufactured.md",
     params:
-        settings=ORDER2,
+        settings={**ORDER2, "cases": MANUFACTURED_CASES},
         title="k = 1 against k = 2 on manufactured contact solutions (Section 4 study)",
         measure="Errors relative to the exact solution (config/order2/*.yaml, tests/manufactured_contact.py)",
     log:

@@ -15,8 +15,8 @@ with logged(smk):
     s = smk.params.settings
     case = s["cases"][smk.wildcards.case]
     n, options = level(smk.wildcards.n), dict(case.get("options") or {})
-    scene = study_scene(s["scene"], s["overrides"] + [f"discretization.order={case['order']}"], case["family"],
-                        options, n)
+    scene = study_scene(s["scene"], s["overrides"] + [f"discretization.order={case['order']}"]
+                        + list(case.get("overrides", [])), case["family"], options, n)
     problem, solution, ds = solve_scene(scene, mesh=build_mesh(case["family"], n, **options), verify=True)
     ds.attrs["workflow_run"] = json.dumps({"study": s.get("study", "paper"), "case": smk.wildcards.case, "n": n,
                                           "order": case["order"]})
