@@ -235,19 +235,27 @@ def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap, edge_normal):
     return ends
 
 
+def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
+    """(|e|, |e| nu_e, vertex weights, vertex normal sums) of the contact ``edges`` (a, b), nu_e the
+    outward normal (CCW boundary): each end of an edge gets ``end_weight`` |e| (trapezoid 1/2,
+    Simpson 1/6) and |e| nu_e (normalised later: the vertex normal)."""
+    t = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
+    length = np.linalg.norm(t, axis=1)
+    weighted_normal = np.stack([t[:, 1], -t[:, 0]], axis=1)
+    weight = np.zeros(mesh.n_vertices)
+    nsum = np.zeros((mesh.n_vertices, 2))
+    for end in (0, 1):
+        np.add.at(weight, edges[:, end], end_weight * length)
+        np.add.at(nsum, edges[:, end], weighted_normal)
+    return length, weighted_normal, weight, nsum
+
+
 def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap, quadrature: str = "nodal",
                      gauss_points: int = 3) -> ContactBoundary:
     """Collect the contact vertices and edges of the named boundary ``parts``; gap(x, y) -> array."""
     edges = np.concatenate([mesh.boundary[name] for name in parts]) if parts else np.zeros((0, 2), np.int64)
     nv = mesh.n_vertices
-    t = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
-    length = np.linalg.norm(t, axis=1)
-    weighted_normal = np.stack([t[:, 1], -t[:, 0]], axis=1)  # |e| * outward normal (CCW boundary)
-    weight = np.zeros(nv)
-    nsum = np.zeros((nv, 2))
-    for end in (0, 1):
-        np.add.at(weight, edges[:, end], 0.5 * length)
-        np.add.at(nsum, edges[:, end], weighted_normal)
+    length, weighted_normal, weight, nsum = edge_ends(mesh, edges, 0.5)
     verts = np.unique(edges)
     verts = verts[dofs.unconstrained_vertices()[verts]]
     normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)

@@ -42,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from vemkit.contact.boundary import ContactBoundary, _gap_values
+from vemkit.contact.boundary import ContactBoundary, _gap_values, edge_ends
 from vemkit.exceptions import SceneError
 from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly_k2 import edge_indices
@@ -73,14 +73,7 @@ def contact_boundary_k2(mesh: Mesh, parts, dofs: DofMapK2, gap, quadrature: str 
     check_quadrature(quadrature)
     edges = _contact_edges(mesh, parts)
     nv = mesh.n_vertices
-    t = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
-    length = np.linalg.norm(t, axis=1)
-    weighted_normal = np.stack([t[:, 1], -t[:, 0]], axis=1)  # |e| * outward normal (CCW boundary)
-    weight = np.zeros(nv)
-    nsum = np.zeros((nv, 2))
-    for end in (0, 1):
-        np.add.at(weight, edges[:, end], SIMPSON_END * length)
-        np.add.at(nsum, edges[:, end], weighted_normal)
+    length, weighted_normal, weight, nsum = edge_ends(mesh, edges, SIMPSON_END)
     unconstrained = dofs.unconstrained_nodes()
     verts = np.unique(edges)
     verts = verts[unconstrained[verts]]

@@ -67,9 +67,10 @@ def traction_load(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -> n
     return out
 
 
-def pressure_load(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> np.ndarray:
-    """(N, 2) nodal loads of a normal pressure p: the traction -p nu on every edge (a, b), nu its
-    outward normal (the body lies left of a -> b); pressure(x, y) -> p, or a number."""
+def pressure_traction(mesh: Mesh, edges: np.ndarray, pressure):
+    """(edges as (E, 2) int64, traction(x, y) on (E, points) arrays): the traction -p nu of a normal
+    pressure p on every edge (a, b), nu its outward normal (the body lies left of a -> b);
+    pressure(x, y) -> p, or a number. Shared by the k = 1 and k = 2 loads."""
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     tangent = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
     normal = np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
@@ -79,6 +80,12 @@ def pressure_load(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> n
         p = np.broadcast_to(pressure(x, y) if callable(pressure) else float(pressure), x.shape)
         return -p * normal[:, 0:1], -p * normal[:, 1:2]
 
+    return edges, traction
+
+
+def pressure_load(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> np.ndarray:
+    """(N, 2) nodal loads of a normal pressure p (``pressure_traction``)."""
+    edges, traction = pressure_traction(mesh, edges, pressure)
     return traction_load(mesh, edges, traction, points)
 
 

@@ -18,7 +18,7 @@ from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly_k2 import cell_nodes, edge_indices
 from vemkit.vem.element_k2 import (N_BASIS, cell_frame, cell_projection, cell_vertex_coordinates, largest_cell,
                                     projection_workspace)
-from vemkit.vem.load import traction_samples
+from vemkit.vem.load import pressure_traction, traction_samples
 
 
 def n_nodes(mesh: Mesh) -> int:
@@ -47,17 +47,8 @@ def traction_load_k2(mesh: Mesh, edges: np.ndarray, traction, points: int = 5) -
 
 
 def pressure_load_k2(mesh: Mesh, edges: np.ndarray, pressure, points: int = 5) -> np.ndarray:
-    """(n_nodes, 2) loads of a normal pressure p: the traction -p nu on every edge (a, b), nu its
-    outward normal (the body lies left of a -> b); pressure(x, y) -> p, or a number."""
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    tangent = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
-    normal = np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
-
-    def traction(x, y):  # x, y: (edges, points)
-        p = np.broadcast_to(pressure(x, y) if callable(pressure) else float(pressure), x.shape)
-        return -p * normal[:, 0:1], -p * normal[:, 1:2]
-
+    """(n_nodes, 2) loads of a normal pressure p (``vemkit.vem.load.pressure_traction``)."""
+    edges, traction = pressure_traction(mesh, edges, pressure)
     return traction_load_k2(mesh, edges, traction, points)
 
 
