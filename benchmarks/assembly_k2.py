@@ -4,7 +4,7 @@ Writes benchmarks/out/assembly_k2.{json,md}.
     .venv/bin/python benchmarks/assembly_k2.py [--quick] [--repeat R]
 
 Both assemblies start from the mesh and end with the CSR matrix (sparsity pattern and dof
-numbering included; k = 2 builds its NodeMapK2 inside the timed call), all dofs free, `dofi-2mu`.
+numbering included: each builds its space's DofMap inside the timed call), all dofs free, `dofi-2mu`.
 The best of R runs after a JIT warm-up is kept; wall time and process CPU time (all threads) are
 both recorded, because the machine may be shared: CPU time per dof is the steadier comparison.
 """
@@ -30,21 +30,20 @@ def timed(fn, repeat):
 
 def case(n: int, repeat: int) -> dict:
     from vemkit.mesh.families.square import square
-    from vemkit.vem.assembly import stiffness_matrix
-    from vemkit.vem.assembly_k2 import NodeMapK2, stiffness_matrix_k2
+    from vemkit.vem.space import VirtualElementSpace
     from vemkit.vem.elasticity import lame_parameters
 
     lam, mu = lame_parameters(2000.0, 0.4)
     warm = square(2)
-    stiffness_matrix(warm, lam, mu, "dofi-2mu")
-    stiffness_matrix_k2(warm, lam, mu, "dofi-2mu", NodeMapK2.from_clamped_edges(warm))
+    for order in (1, 2):
+        VirtualElementSpace(warm, order).stiffness_matrix(lam, mu, "dofi-2mu")
     mesh = square(n)
     t = time.perf_counter()
     mesh.edges  # noqa: B018  (mesh topology, cached on the mesh: not part of either assembly)
     row = {"mesh": f"{n}x{n} squares", "cells": mesh.n_cells, "mesh_edges_s": time.perf_counter() - t}
     runs = {
-        "k1": lambda: stiffness_matrix(mesh, lam, mu, "dofi-2mu"),
-        "k2": lambda: stiffness_matrix_k2(mesh, lam, mu, "dofi-2mu", NodeMapK2.from_clamped_edges(mesh)),
+        "k1": lambda: VirtualElementSpace(mesh, 1).stiffness_matrix(lam, mu, "dofi-2mu"),
+        "k2": lambda: VirtualElementSpace(mesh, 2).stiffness_matrix(lam, mu, "dofi-2mu"),
     }
     for k, fn in runs.items():
         wall, cpu, A = timed(fn, repeat)

@@ -5,7 +5,8 @@ effects)::
 
     scene = vemkit.load_scene("config/scenes/paper.yaml", ["discretization.mesh.n=32"])
     mesh = vemkit.build_mesh("voronoi", 32, seed=1)              # or vemkit.scene_mesh(scene)
-    problem = vemkit.discrete_problem(mesh, E=2000.0, nu=0.4, dirichlet=["right"], contact=["bottom"])
+    space = vemkit.VirtualElementSpace(mesh, 2)                  # one space, any element (k = 1, 2)
+    problem = vemkit.discrete_problem(mesh, E=2000.0, nu=0.4, dirichlet=["right"], contact=["bottom"], order=2)
     problem = vemkit.scene_problem(scene)                       # the same from a scene
     solution = vemkit.solve(problem, scene.solver_options)      # ssn or uzawa
     ds = vemkit.solution_dataset(problem, solution)             # xarray.Dataset (SPEC §6)
@@ -25,6 +26,8 @@ _API = {
     "scene_mesh": "vemkit.mesh.families",
     "validate_mesh": "vemkit.mesh.checks",
     "load_scene": "vemkit.config.scene",
+    "VirtualElementSpace": "vemkit.vem.space",
+    "element_for": "vemkit.vem.elements",
     "discrete_problem": "vemkit.contact.problem",
     "scene_problem": "vemkit.contact.problem",
     "solve": "vemkit.solvers.dispatch",

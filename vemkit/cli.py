@@ -84,8 +84,9 @@ def cmd_solve(args) -> int:
     output, vtu = _outputs(args, [args.scene] + ([Path(args.scene).parent / mesh_file] if mesh_file else []))
 
     from vemkit.config.limits import check_scene_resources
+    from vemkit.vem.elements import element_for
 
-    check_scene_resources(scene, args.max_dofs)  # before anything is built
+    check_scene_resources(scene, args.max_dofs, element_for(scene.order).layout)  # before anything is built
 
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite
@@ -113,6 +114,7 @@ def cmd_solve(args) -> int:
 def _adapt_inputs(args):
     """The scene, the adaptivity settings, the true-error measure and the output targets of ``adapt``."""
     from vemkit.config.limits import check_scene_resources
+    from vemkit.vem.elements import element_for
     from vemkit.config.scene import load_scene
     from vemkit.studies.adaptivity import AdaptivitySettings
     from vemkit.studies.adaptivity_errors import reference_path, scene_true_error
@@ -122,7 +124,7 @@ def _adapt_inputs(args):
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
     targets = _outputs(args, inputs)
-    check_scene_resources(scene, args.max_dofs)  # the first mesh; the loop keeps below max_dofs
+    check_scene_resources(scene, args.max_dofs, element_for(scene.order).layout)  # the first mesh; the loop keeps below max_dofs
     return scene, AdaptivitySettings.from_scene(scene, args.max_dofs), scene_true_error(scene), targets
 
 

@@ -162,9 +162,11 @@ def check_resources(estimate: Resources, max_dofs: int | None = DEFAULT_MAX_DOFS
             f"({_gib(free)}); use {fix}", key="memory", estimate=estimate._asdict())
 
 
-def scene_resources(scene) -> Resources | None:
+def scene_resources(scene, layout: dict | None = None) -> Resources | None:
     """Cells, DOFs and peak memory of solving ``scene``, predicted without building its mesh
-    (None for a mesh read from a file: its size is known once it is read)."""
+    (None for a mesh read from a file: its size is known once it is read). ``layout``: the nodes of
+    the scene's element per mesh entity (``Element.layout`` of ``vemkit.vem.elements``; default one
+    per vertex, k = 1)."""
     if "family" not in scene.mesh_options:
         if scene.mesh_file is None:
             return None
@@ -174,16 +176,18 @@ def scene_resources(scene) -> Resources | None:
     if scene.mesh_options["family"] == "triangle":  # quality triangles fill parts thinner than h
         extra = thin_part_triangles(domain_from_spec(scene.domain), 1.0 / scene_cells_per_length(scene))
         cells, vertices = cells + extra, vertices + extra // 2
-    # k = 2 (discretization.order): 2 DOFs per vertex, edge (Euler: about V + C) and cell; measured peak
-    # memory per DOF as for k = 1 (benchmarks/order2.py: 0.80 GiB at 525 312 DOFs, k = 1 0.74 GiB)
-    nodes = vertices if scene.order == 1 else 2 * (vertices + cells)
+    # nodes on vertices, edges (Euler: about V + C) and cells; measured peak memory per DOF of k = 2 as
+    # for k = 1 (benchmarks/order2.py: 0.80 GiB at 525 312 DOFs, k = 1 0.74 GiB)
+    layout = layout or {"vertex": 1}
+    nodes = sum(layout.get(entity, 0) * count
+                for entity, count in (("vertex", vertices), ("edge", vertices + cells), ("cell", cells)))
     return estimate_resources(cells, nodes)._replace(vertices=vertices)
 
 
-def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS) -> Resources | None:
-    """The prediction of :func:`scene_resources`; ResourceLimitError beyond ``max_dofs`` or the
-    machine's memory."""
-    estimate = scene_resources(scene)
+def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout: dict | None = None) -> Resources | None:
+    """The prediction of :func:`scene_resources` (``layout``: the element's nodes per entity);
+    ResourceLimitError beyond ``max_dofs`` or the machine's memory."""
+    estimate = scene_resources(scene, layout)
     if estimate is None:
         return None
     options = scene.mesh_options

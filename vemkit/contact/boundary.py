@@ -1,13 +1,18 @@
-"""The discrete contact boundary: Gamma_C vertices with their quadrature weights, normals and gaps.
+"""The discrete contact boundary: Gamma_C contact points with their quadrature weights, normals and gaps.
 
-``nodal`` quadrature (SPEC §3): each Gamma_C vertex gets half the length of each adjacent contact
-edge as weight; the outward normal of a vertex is the length-weighted mean of the outward
-normals of its contact edges (exact on straight parts), the tangent is tau = (-nu_2, nu_1)
-(on the bottom edge nu = (0, -1), tau = (1, 0)). Vertices with a Dirichlet condition (clamped,
-or a prescribed component) are dropped: they belong to the closure of Gamma_D, and their
-displacement is given.
+One contact boundary for every element, built from the space's trace on Gamma_C
+(``vemkit.contact.trace_nodes``): ``nodal`` quadrature (SPEC §3) puts the contact points at the
+trace nodes with the element's nodal rule -- the trapezoid at the Gamma_C vertices for k = 1 (half
+the length of each adjacent contact edge as weight), Simpson's rule at the vertices and edge
+midpoints for k = 2. The outward normal of a vertex is the length-weighted mean of the outward
+normals of its contact edges (exact on straight parts), that of a midpoint its edge's normal; the
+tangent is tau = (-nu_2, nu_1) (on the bottom edge nu = (0, -1), tau = (1, 0)). Points with a
+Dirichlet condition (clamped, or a prescribed component) are dropped: they belong to the closure of
+Gamma_D, and their displacement is given. ``ContactBoundary.vertices`` holds node numbers of the
+space: a mesh vertex v, or n_vertices + e for the midpoint of edge e (k = 2).
 
-``gauss`` quadrature (``contact_gauss_points`` N per edge): the normal-compliance term of (3.16),
+``gauss`` quadrature (``contact_gauss_points`` N per edge; for an element with linear traces, k = 1):
+the normal-compliance term of (3.16),
 
     int_{Gamma_C} p_nu(u_nu - g) v_nu ds  =  sum_e sum_q |e| w_q p_nu(t_eq) sum_a phi_a(s_q) v_a . nu_e,
 
@@ -33,9 +38,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.contact.trace_nodes import contact_edges, midpoint_edges, rule_weights
 from vemkit.exceptions import InputError, SceneError
-from vemkit.vem.assembly import DofMap
-from vemkit.mesh.mesh import Mesh
+from vemkit.mesh.mesh import Mesh, edge_indices
 
 QUADRATURES = ("nodal", "gauss")
 MAX_GAUSS_POINTS = 10
@@ -250,27 +255,68 @@ def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
     return length, weighted_normal, weight, nsum
 
 
-def contact_boundary(mesh: Mesh, parts, dofs: DofMap, gap, quadrature: str = "nodal",
-                     gauss_points: int = 3) -> ContactBoundary:
-    """Collect the contact vertices and edges of the named boundary ``parts``; gap(x, y) -> array."""
-    edges = np.concatenate([mesh.boundary[name] for name in parts]) if parts else np.zeros((0, 2), np.int64)
-    nv = mesh.n_vertices
-    length, weighted_normal, weight, nsum = edge_ends(mesh, edges, 0.5)
+def check_quadrature(space, quadrature: str) -> None:
+    """SceneError unless the quadrature suits the element: ``gauss`` needs linear traces (k = 1)."""
+    if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
+        raise SceneError(f"discretization.contact_quadrature = {quadrature!r} is not available with "
+                         f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
+                         "midpoints is used); set contact_quadrature: nodal", key="discretization.contact_quadrature")
+
+
+def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float):
+    """(vertices, weights, normals, edge data) of the Gamma_C vertices that are contact points."""
+    length, weighted_normal, weight, nsum = edge_ends(mesh, edges, end_weight)
     verts = np.unique(edges)
-    verts = verts[dofs.unconstrained_vertices()[verts]]
+    verts = verts[dofs.unconstrained_nodes()[verts]]
     normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)
+    return verts, weight[verts], normal, (length, weighted_normal)
+
+
+def _midpoints(space, parts, edges, dofs, length, weighted_normal, mid_weight):
+    """(nodes, weights, normals, coordinates) of the Gamma_C edge midpoints that are contact points."""
+    mids = midpoint_edges(space, parts, dofs)
+    on_edge = {int(e): k for k, e in enumerate(edge_indices(space.mesh, edges))} if mids.size else {}
+    k_mid = np.array([on_edge[int(e)] for e in mids], dtype=np.int64)
+    normal = weighted_normal[k_mid] / length[k_mid, None]
+    coords = 0.5 * (space.mesh.vertices[edges[k_mid, 0]] + space.mesh.vertices[edges[k_mid, 1]])
+    return space.node_range("edge").start + mids, mid_weight * length[k_mid], normal, coords
+
+
+def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_points: int = 3) -> ContactBoundary:
+    """The contact points of the named boundary ``parts`` of ``space`` (module docstring); ``dofs``
+    must already carry the change of variables of the midpoints (``trace_nodes.midpoint_change``).
+    gap(x, y) -> array, or a FoundationLine."""
+    check_quadrature(space, quadrature)
+    mesh = space.mesh
+    edges = contact_edges(mesh, parts)
+    w_end, w_mid = rule_weights(space.element)
+    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end)
+    coords = mesh.vertices[verts]
+    if w_mid is not None:
+        mid, mid_w, mid_normal, mid_coords = _midpoints(space, parts, edges, dofs, length, weighted_normal, w_mid)
+        verts, weight = np.concatenate([verts, mid]), np.concatenate([weight, mid_w])
+        normal = np.concatenate([normal, mid_normal]).reshape(-1, 2)
+        coords = np.concatenate([coords, mid_coords]).reshape(-1, 2)
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
     free = dofs.free_index[verts]
-    coords = mesh.vertices[verts]
     g = _gap_values(gap, coords, normal)
-    contact_index = np.full(nv, -1, dtype=np.int64)
-    contact_index[verts] = np.arange(verts.size)
+    if w_mid is not None:  # the Gauss option needs linear traces: no edge data
+        return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2), weight, normal,
+                               tangent, g, coords, quadrature)
+    return _with_edges(ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight, normal, tangent, g,
+                                       coords, quadrature), mesh, edges, dofs, gap, length, weighted_normal, gauss_points)
+
+
+def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):
+    """The boundary with its Gamma_C edges (what the ``gauss`` quadrature of the normal term reads)."""
+    contact_index = np.full(mesh.n_vertices, -1, dtype=np.int64)
+    contact_index[cb.vertices] = np.arange(cb.vertices.size)
     edge_vertex = contact_index[edges]
     edge_coords = mesh.vertices[edges]
     edge_normal = weighted_normal / length[:, None]
-    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, g, edge_normal)
+    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, cb.gap, edge_normal)
     prescribed = np.einsum("eai,ei->ea", dofs.prescribed_displacement()[edges], edge_normal)
-    s, w = gauss_rule(gauss_points) if quadrature == "gauss" else (np.zeros(0), np.zeros(0))
-    return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight[verts], normal, tangent, g, coords,
-                           quadrature, edge_vertex, edge_normal, length, edge_gap, edge_coords,
-                           s, w, np.where(edge_vertex >= 0, 0.0, prescribed))
+    s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
+    return replace(cb, edge_vertex=edge_vertex, edge_normal=edge_normal, edge_length=length, edge_gap=edge_gap,
+                   edge_coords=edge_coords, gauss_points=s, gauss_weights=w,
+                   edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed))

@@ -1,34 +1,43 @@
-"""The assembled discrete problem (3.16): stiffness, load and contact boundary on the free dofs.
+"""The assembled discrete problem (3.16) of any element: stiffness, load and contact boundary on the free dofs.
 
-``discrete_problem`` takes plain ingredients (a mesh, Lamé parameters, boundary parts and
-callables for the data), so it knows nothing of scene files; ``scene_problem`` builds it from a scene.
+``discrete_problem`` takes plain ingredients (a mesh, the order k, Lamé parameters, boundary parts
+and callables for the data), so it knows nothing of scene files; ``scene_problem`` builds it from a
+scene. The ingredients come from the space (``vemkit.vem.space.VirtualElementSpace``):
+
+- stiffness: the element (3.9), clamped nodes eliminated, interior nodes (the k = 2 cell means)
+  condensed out cell by cell, other Dirichlet components held by symmetric elimination;
+- load: tractions and pressures integrated exactly on the traces, the body force through the
+  element's projection of the data (Section 3.3);
+- contact: the element's nodal rule at the trace nodes of Gamma_C (trapezoid or Simpson), the
+  Gamma_C edge unknowns of k = 2 changed from edge means to midpoint values
+  (``vemkit.contact.trace_nodes``), or Gauss points on Gamma_C edges (k = 1).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
-from vemkit.config.boundary_conditions import check_expressions_on_mesh, rigid_motion_error
+from vemkit.config.boundary_conditions import check_expressions_on_mesh, free_rigid_motion, rigid_motion_error
 from vemkit.config.expressions import vector_field
-from vemkit.exceptions import SceneError
-from vemkit.vem.assembly import DofMap, stiffness_matrix
-from vemkit.vem.constraints import apply_fixed_dofs, constrained_dofs, dirichlet_components, free_rigid_motion
-from vemkit.contact.boundary import ContactBoundary, FoundationLine, contact_boundary
+from vemkit.contact.boundary import ContactBoundary, FoundationLine, check_quadrature, contact_boundary
 from vemkit.contact.laws import ContactLaw
-from vemkit.vem.load import body_force_load, cell_averages, pressure_load, traction_load
+from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
+from vemkit.exceptions import SceneError
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.mesh import Mesh
+from vemkit.vem.condensation import condense_load, interior_load, recover_interior
+from vemkit.vem.dofs import DofMap, apply_fixed_dofs
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes
+from vemkit.vem.space import VirtualElementSpace
 
 
 @dataclass
 class DiscreteProblem:
-    mesh: Mesh
+    space: VirtualElementSpace
     dofs: DofMap
     stiffness: sp.csr_matrix
     load: np.ndarray
@@ -37,77 +46,114 @@ class DiscreteProblem:
     lam: float
     mu: float
     stabilization: str
+    interior_load: np.ndarray | None = None  # (M, 2) the load on condensed interior nodes (their recovery)
     info: dict = field(default_factory=dict)
 
     @property
+    def mesh(self) -> Mesh:
+        return self.space.mesh
+
+    @property
+    def order(self) -> int:
+        return self.space.order
+
+    @property
     def n_dofs(self) -> int:
+        """The unknowns (after elimination and condensation)."""
         return self.dofs.n_free
 
     @property
+    def n_space_dofs(self) -> int:
+        """Degrees of freedom of the space on the free nodes, condensed interior nodes included."""
+        condensed = self.space.node_range("cell") if self.dofs.condensed else slice(0, 0)
+        return self.n_dofs + 2 * (condensed.stop - condensed.start)
+
+    @property
     def near_nullspace(self) -> np.ndarray:
-        return rigid_body_modes(self.mesh.vertices[self.dofs.free_vertices])
+        """The rigid motions on the unknowns (their values at the free nodes' places)."""
+        return rigid_body_modes(self.space.node_coordinates[self.dofs.free_nodes])
+
+    def vertex_displacement(self, u) -> np.ndarray:
+        """(n_vertices, 2) the displacement at the mesh vertices."""
+        return self.dofs.expand(u)
+
+    def node_values(self, u) -> np.ndarray:
+        """(n_nodes, 2) the Section 3.1 degrees of freedom of every node (clamped nodes zero), the
+        condensed interior nodes recovered."""
+        values = self.dofs.node_values(u)
+        if self.interior_load is None:
+            return values
+        return recover_interior(self.space, self.lam, self.mu, self.stabilization, values, self.interior_load)
+
+    def projected(self, u):
+        """Pi u_h (3.8) on every cell."""
+        return self.space.project(self.node_values(u), self.lam, self.mu)
 
 
-def _no_force(x, y):
-    return np.zeros_like(x), np.zeros_like(x)
-
-
-def discrete_problem(
-    mesh: Mesh,
-    E: float,
-    nu: float,
-    *,
-    dirichlet=("right",),
-    neumann=None,
-    pressure=None,
-    contact=(),
-    gap=lambda x, y: np.zeros_like(x),
-    law: ContactLaw | None = None,
-    body_force=None,
-    stabilization: str = "dofi-2mu",
-    contact_quadrature: str = "nodal",
-    contact_gauss_points: int = 3,
-) -> DiscreteProblem:
-    """Assemble (3.16) without the contact terms plus the contact boundary data.
-
-    dirichlet: side names (u = 0) or {part: (u1, u2)}, each None (free), a number or a function
-    of (x, y) (see vemkit.vem.constraints); a rigid motion left free is a SceneError.
-    neumann: {part: traction(x, y) -> (f2_1, f2_2)}; pressure: {part: p(x, y)} (traction -p nu);
-    body_force(x, y) -> (f1_1, f1_2).
-    contact_quadrature: nodal or gauss (with contact_gauss_points per edge), see vemkit.contact.boundary.
-    """
-    for name in list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact):
+def check_parts(mesh: Mesh, names) -> None:
+    for name in names:
         if name not in mesh.boundary:
             raise SceneError(f"boundary part {name!r} is not in the mesh; parts: {', '.join(sorted(mesh.boundary))}",
                              key="boundary")
-    lam, mu = lame_parameters(E, nu)
-    prescribed, values = dirichlet_components(mesh, dirichlet)
-    motion = free_rigid_motion(mesh.vertices[np.any(prescribed, axis=1)], prescribed[np.any(prescribed, axis=1)])
+
+
+def constrained(space: VirtualElementSpace, dirichlet) -> DofMap:
+    """The dof map of the Dirichlet data; a rigid motion left free is a SceneError."""
+    prescribed, values = space.dirichlet_components(dirichlet)
+    nv = space.mesh.n_vertices
+    held = np.any(prescribed[:nv], axis=1)
+    motion = free_rigid_motion(space.mesh.vertices[held], prescribed[:nv][held])
     if motion is not None:
         raise rigid_motion_error(motion)
-    dofs = constrained_dofs(prescribed, values)
-    K = stiffness_matrix(mesh, lam, mu, stabilization, dofs)
-    f = _load(mesh, neumann, pressure, body_force)
-    K, load = apply_fixed_dofs(K, dofs.restrict(f), dofs)
-    cb = contact_boundary(mesh, contact, dofs, gap, contact_quadrature, contact_gauss_points)
-    return DiscreteProblem(
-        mesh, dofs, K, load, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization
-    )
+    return space.constrain(prescribed, values)
 
 
-def _load(mesh: Mesh, neumann, pressure, body_force) -> np.ndarray:
-    """(n_vertices, 2) load vector: tractions, normal pressures and the body force (3.16)."""
-    f = np.zeros((mesh.n_vertices, 2))
+def problem_load(space: VirtualElementSpace, neumann, pressure, body_force, projection: str, lam: float,
+                 mu: float) -> np.ndarray:
+    """(n_nodes, 2) load vector: tractions, normal pressures and the body force (3.16)."""
+    f = np.zeros((space.n_nodes, 2))
     for name, traction in (neumann or {}).items():
-        f += traction_load(mesh, mesh.boundary[name], traction)
+        f += space.traction_load(space.mesh.boundary[name], traction)
     for name, p in (pressure or {}).items():
-        f += pressure_load(mesh, mesh.boundary[name], p)
+        f += space.pressure_load(space.mesh.boundary[name], p)
     if body_force is not None:
-        from vemkit.mesh.triangulate import triangulate_cells
-
-        triangles, parent = triangulate_cells(mesh)
-        f += body_force_load(mesh, cell_averages(mesh, body_force, triangles, parent))
+        f += space.body_force_load(body_force, lam, mu, projection)
     return f
+
+
+def discrete_problem(
+    mesh: Mesh, E: float, nu: float, *, order: int = 1, dirichlet=("right",), neumann=None, pressure=None,
+    contact=(), gap=lambda x, y: np.zeros_like(x), law: ContactLaw | None = None, body_force=None,
+    stabilization: str = "dofi-2mu", contact_quadrature: str = "nodal", contact_gauss_points: int = 3,
+    body_force_projection: str = "p0",
+) -> DiscreteProblem:
+    """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
+    order ``order``.
+
+    dirichlet: side names (u = 0) or {part: (u1, u2)}, each None (free), a number or a function
+    of (x, y); a rigid motion left free is a SceneError.
+    neumann: {part: traction(x, y) -> (f2_1, f2_2)}; pressure: {part: p(x, y)} (traction -p nu);
+    body_force(x, y) -> (f1_1, f1_2), projected as ``body_force_projection`` (k = 2: "p0", the paper's
+    P_0 f1, or "p1"). contact_quadrature: nodal or gauss (with contact_gauss_points per edge).
+    """
+    check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
+    space = VirtualElementSpace(mesh, order)
+    check_quadrature(space, contact_quadrature)
+    lam, mu = lame_parameters(E, nu)
+    dofs = constrained(space, dirichlet)
+    K = space.stiffness_matrix(lam, mu, stabilization, dofs)
+    full_load = problem_load(space, neumann, pressure, body_force, body_force_projection, lam, mu)
+    if dofs.condensed:
+        f = condense_load(space, lam, mu, stabilization, dofs, full_load)
+        interior = interior_load(space, full_load)
+    else:
+        f, interior = dofs.restrict(full_load), None
+    dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
+    K, f = change_variables(K, f, dofs.change)
+    K, f = apply_fixed_dofs(K, f, dofs)
+    cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
+    return DiscreteProblem(space, dofs, K, f, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization,
+                           interior)
 
 
 def _scene_gap(scene):
@@ -119,30 +165,28 @@ def _scene_gap(scene):
 
 
 def scene_problem_data(scene) -> dict:
-    """The keyword arguments of ``discrete_problem`` (and its k = 2 twin) that a scene gives:
-    boundary conditions as callables, the gap or foundation, the contact law, the body force."""
+    """The keyword arguments of ``discrete_problem`` that a scene gives: the order, boundary
+    conditions as callables, the gap or foundation, the contact law, the body force and its projection."""
     body = None
     if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
         body = vector_field(scene.body_force)
     normal, friction = scene.normal_compliance, scene.friction_bound
     law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
     pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
-    return dict(dirichlet=scene.dirichlet, pressure=pressures, contact=scene.contact_sides, gap=_scene_gap(scene),
+    return dict(order=scene.order, dirichlet=scene.dirichlet, pressure=pressures, contact=scene.contact_sides,
+                gap=_scene_gap(scene), law=law, body_force=body, stabilization=scene.stabilization,
                 neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides
                          if side not in pressures},
-                law=law, body_force=body, stabilization=scene.stabilization,
-                contact_quadrature=scene.contact_quadrature)
+                contact_quadrature=scene.contact_quadrature, contact_gauss_points=scene.contact_gauss_points,
+                body_force_projection=scene.body_force_projection)
 
 
 def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
     """Assemble the discrete problem (3.16) of a scene, on its own mesh unless one is given."""
-    if scene.order == 2:  # k = 2 (vemkit.contact.problem_k2)
-        from vemkit.contact.problem_k2 import scene_problem_k2
-        return scene_problem_k2(scene, mesh)
     mesh = scene_mesh(scene) if mesh is None else mesh
     check_expressions_on_mesh(scene, mesh)  # a pole at a vertex: refused, not integrated around
     t0 = time.perf_counter()
-    problem = discrete_problem(mesh, scene.E, scene.nu, contact_gauss_points=scene.contact_gauss_points,
-                               **scene_problem_data(scene))
+    problem = discrete_problem(mesh, scene.E, scene.nu, **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
+    problem.info["order"] = scene.order
     return problem

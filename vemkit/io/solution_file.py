@@ -18,7 +18,7 @@ import xarray as xr
 import vemkit
 from vemkit.exceptions import ResultError
 from vemkit.io.output_files import atomic_outputs
-from vemkit.vem.projection import projected_solution, shear_energy_density, stress
+from vemkit.vem.projection import shear_energy_density, stress
 from vemkit.mesh.files import mesh_to_ugrid_dataset, read_ugrid
 
 STATE_MEANINGS = "separated stick slip"
@@ -29,16 +29,16 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
     from vemkit.solvers.solution import contact_state
 
     mesh = problem.mesh
-    element_order = getattr(problem, "order", 1)  # k of Section 3 (vemkit.contact.problem_k2 for k = 2)
-    u = problem.dofs.expand(solution.u)  # the displacement at the mesh vertices
-    strain = projected_solution(mesh, u).strain if element_order == 1 else problem.cell_mean_strain(solution.u)
+    element_order = problem.space.order  # k of Section 3
+    u = problem.vertex_displacement(solution.u)
+    strain = problem.projected(solution.u).cell_mean_strain()
     sig = stress(strain, problem.lam, problem.mu)
     ds = mesh_to_ugrid_dataset(mesh)
     node, face = "mesh2d_nNodes", "mesh2d_nFaces"
     ds["u1"] = (node, u[:, 0], {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
     ds["u2"] = (node, u[:, 1], {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
-    face_attrs = {"mesh": "mesh2d", "location": "face", "comment": "constant per cell: from the projection Pi_1 (3.8)"
-                  if element_order == 1 else "cell mean of the linear strain of the projection Pi_2 (3.8)"}
+    face_attrs = {"mesh": "mesh2d", "location": "face",
+                  "comment": f"cell mean of the strain of the projection Pi_{element_order} (3.8) (constant per cell for k = 1)"}
     for name, values, long_name, units in (
         ("strain_11", strain[:, 0], "strain eps11 of Pi u", "1"),
         ("strain_22", strain[:, 1], "strain eps22 of Pi u", "1"),
@@ -74,8 +74,8 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             c, np.asarray(st.state, dtype=np.int8)[order],
             {"long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
         )
-    if element_order == 2:
-        _add_order2_fields(ds, problem, solution)
+    if len(problem.space.element.layout) > 1:
+        _add_node_fields(ds, problem, solution)
     for key, values in solution.history.items():
         ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
     ds.attrs.update(
@@ -97,22 +97,26 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
     return ds
 
 
-def _add_order2_fields(ds: xr.Dataset, problem, solution) -> None:
-    """k = 2: the edge and cell means (the other degrees of freedom of Section 3.1) as edge and face
-    variables; contact points are vertices or edge midpoints (``contact_vertex`` / ``contact_edge``, -1
-    where the other applies)."""
+#: the solution file's dimension and name of the degrees of freedom on each kind of mesh entity
+ENTITY_VARIABLES = {"edge": ("mesh2d_nEdges", "edge_mean", "edge"), "cell": ("mesh2d_nFaces", "face_mean", "face")}
+
+
+def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
+    """The degrees of freedom on entities other than vertices (k = 2: the edge and cell means of
+    Section 3.1) as edge and face variables; contact points are vertices or edge midpoints
+    (``contact_vertex`` / ``contact_edge``, -1 where the other applies)."""
+    space = problem.space
     values = problem.node_values(solution.u)
-    nv, ne = problem.mesh.n_vertices, problem.mesh.edges.shape[0]
-    ds.attrs["n_space_dofs"] = int(problem.n_space_dofs)  # n_dofs: the unknowns after condensing the cell means
-    for c in (1, 2):
-        ds[f"u{c}_edge_mean"] = ("mesh2d_nEdges", values[nv:nv + ne, c - 1], {
-            "long_name": f"mean of u{c} over the edge (k = 2 degree of freedom)", "units": "mm", "mesh": "mesh2d",
-            "location": "edge"})
-        ds[f"u{c}_face_mean"] = ("mesh2d_nFaces", values[nv + ne:, c - 1], {
-            "long_name": f"mean of u{c} over the cell (k = 2 degree of freedom)", "units": "mm", "mesh": "mesh2d",
-            "location": "face"})
+    ds.attrs["n_space_dofs"] = int(problem.n_space_dofs)  # n_dofs: the unknowns after condensation
+    for entity in (e for e in space.element.layout if e != "vertex"):
+        dimension, suffix, location = ENTITY_VARIABLES[entity]
+        for c in (1, 2):
+            ds[f"u{c}_{suffix}"] = (dimension, values[space.node_range(entity), c - 1], {
+                "long_name": f"mean of u{c} over the {'cell' if entity == 'cell' else entity} "
+                             f"(k = {space.order} degree of freedom)", "units": "mm", "mesh": "mesh2d", "location": location})
     cb = problem.contact
-    if cb.size:
+    if cb.size and "edge" in space.element.layout:
+        nv = problem.mesh.n_vertices
         node = cb.vertices[np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))]
         ds["contact_vertex"] = ("contact_node", np.where(node < nv, node, -1), {
             "long_name": "mesh2d node index of the contact vertex (-1: an edge midpoint)"})

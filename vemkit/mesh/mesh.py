@@ -174,3 +174,18 @@ def tag_box_boundary(mesh: Mesh, lower=(0.0, 0.0), upper=(1.0, 1.0), tol=1e-12) 
         on = (np.abs(p[:, axis] - value) <= scale) & (np.abs(q[:, axis] - value) <= scale)
         parts[name] = be[on]
     return mesh.with_boundary(**parts)
+
+
+def edge_indices(mesh: Mesh, pairs) -> np.ndarray:
+    """Index in ``mesh.edges`` of every vertex pair (k, 2), in either orientation."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    nv = np.int64(mesh.n_vertices)
+    keys = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * nv + np.maximum(mesh.edges[:, 0], mesh.edges[:, 1])
+    order = np.argsort(keys)
+    want = np.minimum(pairs[:, 0], pairs[:, 1]) * nv + np.maximum(pairs[:, 0], pairs[:, 1])
+    pos = np.minimum(np.searchsorted(keys, want, sorter=order), keys.size - 1)
+    found = order[pos] if keys.size else np.zeros(0, dtype=np.int64)
+    if np.any(keys[found] != want):
+        bad = pairs[np.flatnonzero(keys[found] != want)[0]]
+        raise ValueError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
+    return found

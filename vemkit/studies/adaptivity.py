@@ -3,8 +3,8 @@
 Each step solves the scene's contact problem on the current mesh, checks the solution
 independently (as ``vemkit solve`` does), computes the indicators η_K of ``vemkit.vem.estimator``
 (with the contact traction of the solution as the Γ_C datum), stops when the relative estimate
-η ≤ ``target``, when the next mesh would have more than ``max_dofs`` unknowns (counted as 2 × its
-vertices, an upper bound: no mesh beyond the limit is ever assembled) or after
+η ≤ ``target``, when the next mesh would have more than ``max_dofs`` unknowns (counted as the
+degrees of freedom of its space, an upper bound: no mesh beyond the limit is ever assembled) or after
 ``max_steps`` solves, and otherwise refines the Dörfler-marked cells (``vemkit.mesh.refine``;
 new vertices on a circular hole or an arc of the scene's domain are placed on the curve).
 
@@ -38,7 +38,8 @@ from vemkit.solvers.solution import contact_state
 from vemkit.studies.convergence import RECORD_KEYS
 from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
-from vemkit.vem.load import cell_averages
+from vemkit.vem.space import VirtualElementSpace
+from vemkit.vem.quadrature import cell_averages
 
 
 @dataclass(frozen=True)
@@ -80,14 +81,14 @@ class AdaptiveRun:
 
 
 def contact_tractions(problem, solution) -> dict:
-    """{side: (N, 2) contact traction t_C = −p_ν ν + σ_τ τ at the Γ_C vertices} (2.6)–(2.9)."""
+    """{side: (n_nodes, 2) contact traction t_C = −p_ν ν + σ_τ τ at the contact points} (2.6)–(2.9)."""
     cb = problem.contact
     if cb.size == 0:
         return {}
     state = contact_state(problem, solution.u, solution.multiplier)
-    at_vertices = np.zeros((problem.mesh.n_vertices, 2))
-    at_vertices[cb.vertices] = -state.normal_pressure[:, None] * cb.normal + state.tangential_stress[:, None] * cb.tangent
-    return {side: at_vertices for side in problem.info.get("contact_sides", ())}
+    at_nodes = np.zeros((problem.space.n_nodes, 2))
+    at_nodes[cb.vertices] = -state.normal_pressure[:, None] * cb.normal + state.tangential_stress[:, None] * cb.tangent
+    return {side: at_nodes for side in problem.info.get("contact_sides", ())}
 
 
 def _pair(expressions):
@@ -104,8 +105,8 @@ def scene_indicators(scene, problem, solution) -> dict:
         body = cell_averages(mesh, _pair(scene.body_force), triangles, parent)
     neumann = {side: _pair(scene.traction(side)) for side in scene.neumann_sides}
     contact = contact_tractions(problem, solution)
-    return error_indicators(mesh, problem.dofs.expand(solution.u), problem.lam, problem.mu, problem.stabilization,
-                            body_force=body, neumann=neumann, contact=contact)
+    return error_indicators(problem.space, problem.node_values(solution.u), problem.lam, problem.mu,
+                            problem.stabilization, body_force=body, neumann=neumann, contact=contact)
 
 
 def curved_sides(domain_spec) -> dict:
@@ -125,16 +126,58 @@ def curved_sides(domain_spec) -> dict:
 
 
 def prolongated_start(refined, problem, solution, new_problem):
-    """(u0, λ0) on ``new_problem``: ``solution`` on ``problem`` prolongated by ``refined`` (a RefinedMesh)."""
-    P, dofs = refined.prolongation, new_problem.dofs
-    u0 = dofs.restrict(P @ problem.dofs.expand(solution.u))
+    """(u0, λ0) on ``new_problem``: ``solution`` on ``problem`` carried to the refined mesh (a RefinedMesh).
+
+    An element with vertex values only (k = 1) uses the refinement's prolongation (linear along split
+    edges, the vertex mean at new cell centres; the friction multiplier the same way along Γ_C);
+    otherwise the new degrees of freedom interpolate Π u_h of the coarse solution, and each new contact
+    point takes the multiplier of the nearest old one."""
+    dofs = new_problem.dofs
+    if len(new_problem.space.element.layout) == 1:
+        P = refined.prolongation
+        u0 = dofs.restrict(P @ problem.dofs.expand(solution.u))
+    else:
+        u0 = dofs.unknowns(new_problem.space.interpolate(_coarse_field(problem, solution)))
     u0[dofs.fixed_dofs] = dofs.fixed_values  # prescribed displacements at their exact values
-    multiplier, on_contact = np.zeros(problem.mesh.n_vertices), np.zeros(problem.mesh.n_vertices)
-    multiplier[problem.contact.vertices], on_contact[problem.contact.vertices] = solution.multiplier, 1.0
-    # a new Γ_C vertex next to a clamped end takes its contact neighbour's value, not half of it
-    weight = (P @ on_contact)[new_problem.contact.vertices]
-    lam0 = (P @ multiplier)[new_problem.contact.vertices] / np.where(weight > 0, weight, 1.0)
-    return u0, lam0
+    return u0, _prolongated_multiplier(refined, problem, solution, new_problem)
+
+
+def _coarse_field(problem, solution):
+    """Π u_h of a coarse solution as a field(x, y) -> (u1, u2) anywhere on its mesh."""
+    from vemkit.mesh.locate import locate_points
+
+    projection = problem.projected(solution.u)
+
+    def field(x, y):
+        points = np.stack([np.ravel(x), np.ravel(y)], axis=1)
+        cells = locate_points(problem.mesh, points)
+        cells[cells < 0] = _nearest_cells(problem.mesh, points[cells < 0])
+        values = projection.evaluate(cells, points)
+        return values[:, 0].reshape(np.shape(x)), values[:, 1].reshape(np.shape(x))
+    return field
+
+
+def _nearest_cells(mesh, points):
+    from scipy.spatial import cKDTree
+
+    centre = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
+    return cKDTree(centre).query(points)[1] if points.size else np.zeros(0, np.int64)
+
+
+def _prolongated_multiplier(refined, problem, solution, new_problem):
+    old, new = problem.contact, new_problem.contact
+    if len(new_problem.space.element.layout) == 1:
+        P = refined.prolongation
+        multiplier, on_contact = np.zeros(problem.mesh.n_vertices), np.zeros(problem.mesh.n_vertices)
+        multiplier[old.vertices], on_contact[old.vertices] = solution.multiplier, 1.0
+        # a new Γ_C vertex next to a clamped end takes its contact neighbour's value, not half of it
+        weight = (P @ on_contact)[new.vertices]
+        return (P @ multiplier)[new.vertices] / np.where(weight > 0, weight, 1.0)
+    if old.size == 0 or new.size == 0:
+        return np.zeros(new.size)
+    from scipy.spatial import cKDTree
+
+    return np.asarray(solution.multiplier, dtype=float)[cKDTree(old.coords).query(new.coords)[1]]
 
 
 def _checked(problem, solution, solver_options) -> dict:
@@ -166,15 +209,12 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
     """Run the loop from the scene's own mesh (module docstring). ``settings.theta = 1`` marks every
     cell: uniform refinement of the scene's mesh, the yardstick of the adaptive runs.
 
-    ``true_error(mesh, u_vertices) -> {"error_h1_semi": ..., "error_h1": ...}`` (relative errors; e.g.
+    ``true_error(problem, u) -> {"error_h1_semi": ..., "error_h1": ...}`` (relative errors of Π u_h; e.g.
     :func:`vemkit.studies.adaptivity_errors.scene_true_error`) is optional; ``progress(step, record)``
     is called after every step, ``observe(step, run)`` too with the AdaptiveRun so far (its problem,
     solution and indicators are the step's); ``warm_start=False`` starts every solve cold (to measure the gain);
     ``verify``: every solution must pass the independent check (VerificationError otherwise).
     """
-    if scene.order != 1:  # the estimator (vemkit.vem.estimator) and the warm start are written for k = 1
-        raise InputError(f"discretization.order = {scene.order}: vemkit adapt supports order 1 only; drop "
-                         "discretization.order or use vemkit solve", key="discretization.order")
     mesh = scene_mesh(scene)
     circles = curved_sides(scene.domain)
     run, previous = None, None
@@ -185,7 +225,7 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
         record["estimate"] = found["estimate"]
         if true_error is not None:
             measured = time.perf_counter()
-            errors = true_error(problem.mesh, problem.dofs.expand(solution.u))
+            errors = true_error(problem, solution.u)
             record["error_time"] = time.perf_counter() - measured
             start += record["error_time"]  # measuring is no cost of the loop
             record.update(true_error=errors["error_h1_semi"], true_error_h1=errors["error_h1"])
@@ -196,7 +236,7 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
             refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
-            if 2 * refined.mesh.n_vertices > settings.max_dofs:
+            if VirtualElementSpace(refined.mesh, problem.space.element).n_dofs > settings.max_dofs:
                 reason = "max_dofs"
             elif refined.refined.size == 0:
                 reason = "unrefinable"
@@ -230,8 +270,8 @@ STOP_REASONS = {
 }
 _STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop records
     ("estimate", "relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
-    ("true_error", "relative H1-seminorm error of Pi_1 u_h against the exact or reference solution", "1"),
-    ("true_error_h1", "relative full H1-norm error of Pi_1 u_h against the exact or reference solution", "1"),
+    ("true_error", "relative H1-seminorm error of Pi u_h against the exact or reference solution", "1"),
+    ("true_error_h1", "relative full H1-norm error of Pi u_h against the exact or reference solution", "1"),
     ("effectivity", "estimate / true_error", "1"),
     ("marked", "cells marked for refinement (0: the last step)", "1"),
     ("skipped", "marked cells that could not be split (no centre in their kernel)", "1"),

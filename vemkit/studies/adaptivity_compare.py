@@ -188,7 +188,7 @@ def tradeoff_records(scene, reference, *, theta: float, max_dofs: int, solvers, 
                 r, mesh = run.history[-1], run.problem.mesh
                 spent[0] += r["wall_time"]
                 edges = mesh.vertices[mesh.edges]
-                found = reference_errors(mesh, run.problem.dofs.expand(run.solution.u), reference)
+                found = reference_errors(mesh, run.problem.projected(run.solution.u), reference)
                 records.append({**base, "n_dofs": int(r["n_dofs"]), "n_cells": int(r["n_cells"]),
                                 "h_min": float(np.min(np.linalg.norm(edges[:, 1] - edges[:, 0], axis=1))),
                                 "iterations": int(r["iterations"]), "status": 0, "message": f"step {step + 1}",

@@ -28,8 +28,10 @@ from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.tradeoff import check_reference_scene
-from vemkit.vem.norms import locate_points, reference_quadrature, relative_exact_errors
-from vemkit.vem.projection import projected_solution
+from vemkit.mesh.locate import locate_points
+from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.norms import relative_exact_errors
+from vemkit.vem.quadrature import reference_quadrature
 
 
 def _common_quadrature(mesh, reference: ReferenceSolution):
@@ -61,16 +63,19 @@ def _nearest_cells(mesh, points):
     return np.where(distance <= mesh.cell_diameters[nearest], nearest, -1)
 
 
-def reference_errors(mesh, u_vertices, reference: ReferenceSolution) -> dict:
-    """{"error_h1", "error_h1_semi", "error_l2"}: Π_1 u_h on ``mesh`` against the reference (module docstring)."""
+def reference_errors(mesh, mine, reference: ReferenceSolution) -> dict:
+    """{"error_h1", "error_h1_semi", "error_l2"}: Π u_h (``mine``, a projection on ``mesh``; or the
+    vertex values of a k = 1 solution) against the reference (module docstring)."""
     points, weights, cells, ref_cells = _common_quadrature(mesh, reference)
-    mine, ref = projected_solution(mesh, u_vertices), reference.projected
+    mine = projected_solution(mesh, mine) if isinstance(mine, np.ndarray) else mine
+    ref = reference.projected
     ref_values = ref.evaluate(ref_cells, points)
+    ref_gradient = ref.gradient_at(ref_cells, points)
     diff = mine.evaluate(cells, points) - ref_values
-    grad = mine.gradient[cells] - ref.gradient[ref_cells]
+    grad = mine.gradient_at(cells, points) - ref_gradient
     l2, semi = np.sum(weights * np.sum(diff**2, axis=1)), np.sum(weights * np.sum(grad**2, axis=(1, 2)))
     ref_l2 = np.sum(weights * np.sum(ref_values**2, axis=1))
-    ref_semi = np.sum(weights * np.sum(ref.gradient[ref_cells] ** 2, axis=(1, 2)))
+    ref_semi = np.sum(weights * np.sum(ref_gradient ** 2, axis=(1, 2)))
     return {"error_h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
             "error_h1_semi": float(np.sqrt(semi / ref_semi)), "error_l2": float(np.sqrt(l2 / ref_l2))}
 
@@ -107,12 +112,13 @@ def load_reference(scene) -> ReferenceSolution | None:
 
 
 def scene_true_error(scene):
-    """``true_error(mesh, u_vertices) -> {"error_h1", "error_h1_semi", "error_l2"}`` for the adaptive
-    loop: against ``exact:`` if the scene has it, else against ``adaptivity.reference``; None without either."""
+    """``true_error(problem, u) -> {"error_h1", "error_h1_semi", "error_l2"}`` (Π u_h of the problem's
+    space) for the adaptive loop: against ``exact:`` if the scene has it, else against
+    ``adaptivity.reference``; None without either."""
     if scene.exact_displacement is not None:
         field = vector_field(scene.exact_displacement)
-        return lambda mesh, u: relative_exact_errors(mesh, u, field)
+        return lambda problem, u: relative_exact_errors(problem.mesh, problem.projected(u), field)
     reference = load_reference(scene)
     if reference is None:
         return None
-    return lambda mesh, u: reference_errors(mesh, u, reference)
+    return lambda problem, u: reference_errors(problem.mesh, problem.projected(u), reference)

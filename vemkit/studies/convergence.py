@@ -27,7 +27,8 @@ import xarray as xr
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import git_commit, package_versions
 from vemkit.io.solution_file import read_solution
-from vemkit.studies.solution_order import projected_k2, refuse_order2, require_order1, solution_order  # noqa: F401
+from vemkit.studies.solution_order import (projected_solution_file, refuse_order2, require_order1,  # noqa: F401
+                                          solution_order)
 
 
 #: keys of one error record, with their meaning and units
@@ -102,27 +103,28 @@ def study_scene(scene_path, overrides=(), family: str | None = None, options=Non
 
 
 # -- error records ------------------------------------------------------------------------------
-def _cached_projection(proj):
-    """``proj`` (a ProjectedSolution) whose gradient and point values are computed once: the
-    reference is evaluated at the same quadrature points for every coarse run."""
-    from vemkit.vem.projection import ProjectedSolution
+class CachedProjection:
+    """A projection (Pi u_ref) whose values and gradients at the quadrature points are computed once:
+    the reference is evaluated at the same points for every coarse run."""
 
-    class CachedProjection(ProjectedSolution):
-        @property
-        def gradient(self):
-            cache = self.__dict__.setdefault("_cache", {})
-            if "gradient" not in cache:
-                cache["gradient"] = ProjectedSolution.gradient.fget(self)
-            return cache["gradient"]
+    def __init__(self, projection):
+        self._projection = projection
+        self._cache = {}
 
-        def evaluate(self, cells, points):
-            cache = self.__dict__.setdefault("_cache", {})
-            hit = cache.get("values")
-            if hit is None or hit[0] is not cells or hit[1] is not points:
-                hit = cache["values"] = (cells, points, ProjectedSolution.evaluate(self, cells, points))
-            return hit[2]
+    def __getattr__(self, name):
+        return getattr(self._projection, name)
 
-    return CachedProjection(proj.center, proj.coef)
+    def _cached(self, key, cells, points, compute):
+        hit = self._cache.get(key)
+        if hit is None or hit[0] is not cells or hit[1] is not points:
+            hit = self._cache[key] = (cells, points, compute(cells, points))
+        return hit[2]
+
+    def evaluate(self, cells, points):
+        return self._cached("values", cells, points, self._projection.evaluate)
+
+    def gradient_at(self, cells, points):
+        return self._cached("gradients", cells, points, self._projection.gradient_at)
 
 
 class ReferenceSolution:
@@ -133,17 +135,14 @@ class ReferenceSolution:
     """
 
     def __init__(self, path, quadrature=None, solution=None):
-        from vemkit.vem.norms import reference_quadrature
+        from vemkit.vem.quadrature import reference_quadrature
 
         self.path = str(path)
         self.mesh, self.dataset = solution if solution is not None else read_solution(path)
         self.order = solution_order(self.dataset)
-        if self.order == 2:  # Pi_2 of every k = 2 degree of freedom; a degree-5 rule (quadratic projections)
-            self.projected = projected_k2(self.mesh, self.dataset)
-            self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh, degree=5)
-        else:
-            self.projected = _cached_projection(_projected(self.mesh, self.dataset))
-            self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh)
+        self.projected = CachedProjection(projected_solution_file(self.mesh, self.dataset))
+        # exact for the product of two projections of degree k: degree 2k (the degree-2 or degree-5 rule)
+        self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh, degree=2 * self.order)
         self.displacement = _displacement(self.dataset)
         self.areas = self.mesh.cell_areas
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
@@ -166,9 +165,7 @@ def _displacement(ds) -> np.ndarray:
 
 
 def _projected(mesh, ds):
-    from vemkit.vem.projection import projected_solution
-
-    return projected_solution(mesh, _displacement(ds))
+    return projected_solution_file(mesh, ds)
 
 
 def _same_mesh(a, b) -> bool:

@@ -65,12 +65,8 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
     attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
     if verify:
         attrs.update(verified(problem, solution, scene.solver_options))
-    if scene.exact_displacement is not None and scene.order == 2:  # Pi_2 u_h (vemkit.vem.norms_k2)
-        from vemkit.vem.norms_k2 import relative_exact_errors_k2
-        attrs.update(relative_exact_errors_k2(problem.mesh, problem.projected(solution.u),
-                                              vector_field(scene.exact_displacement)))
-    elif scene.exact_displacement is not None:  # SPEC §7: relative errors against the exact field
-        attrs.update(relative_exact_errors(problem.mesh, problem.dofs.expand(solution.u),
+    if scene.exact_displacement is not None:  # SPEC §7: relative errors of Pi u_h against the exact field
+        attrs.update(relative_exact_errors(problem.mesh, problem.projected(solution.u),
                                            vector_field(scene.exact_displacement)))
     try:
         with floating_point_errors_raise():

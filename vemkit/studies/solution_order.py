@@ -1,5 +1,5 @@
-"""The order k of a solution or scene, for the studies: Pi_2 of a k = 2 solution file, and the refusals of
-k = 2 where a study measures Pi_1 of vertex values (SPEC 5), which would mis-measure it."""
+"""The space of a solution file, for the studies: its order k, its degrees of freedom and Pi of them, and
+the refusals of k = 2 where a study measures Pi_1 of vertex values (SPEC 5), which would mis-measure it."""
 
 from __future__ import annotations
 
@@ -34,22 +34,34 @@ def require_order1(scene, what: str) -> None:
                          key="discretization.order")
 
 
-def solution_node_values(mesh, ds) -> np.ndarray:
-    """k = 1: (n_vertices, 2) vertex values; k = 2: (n_nodes, 2) vertex values, edge and cell means."""
-    u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
-    if solution_order(ds) == 1:
-        return u
-    if not np.array_equal(ds["mesh2d_edge_nodes"].values.astype(np.int64), mesh.edges):
-        raise ResultError("the solution file's edges are not the mesh's edge order: the edge means cannot be placed")
-    edge = np.stack([ds["u1_edge_mean"].values, ds["u2_edge_mean"].values], axis=1)
-    face = np.stack([ds["u1_face_mean"].values, ds["u2_face_mean"].values], axis=1)
-    return np.concatenate([u, edge, face])
+def solution_space(mesh, ds):
+    """The virtual element space a solution file was computed in (its ``order`` attribute)."""
+    from vemkit.vem.space import VirtualElementSpace
+
+    return VirtualElementSpace(mesh, solution_order(ds))
 
 
-def projected_k2(mesh, ds):
-    """Pi_2 u_h (3.8) of a k = 2 solution file (the projection depends on the scene's Lame parameters)."""
+def solution_node_values(space, ds) -> np.ndarray:
+    """(n_nodes, 2) the degrees of freedom of a solution file in ``space``: the vertex values ``u1``,
+    ``u2`` and, for the other entities of the element's layout, the means written beside them
+    (``vemkit.io.solution_file.ENTITY_VARIABLES``: k = 2 edge and cell means)."""
+    from vemkit.io.solution_file import ENTITY_VARIABLES
+
+    parts = [np.stack([ds["u1"].values, ds["u2"].values], axis=1)]
+    for entity in (e for e in space.element.layout if e != "vertex"):
+        if entity == "edge" and not np.array_equal(ds["mesh2d_edge_nodes"].values.astype(np.int64), space.mesh.edges):
+            raise ResultError("the solution file's edges are not the mesh's edge order: the edge means cannot be placed")
+        suffix = ENTITY_VARIABLES[entity][1]
+        parts.append(np.stack([ds[f"u1_{suffix}"].values, ds[f"u2_{suffix}"].values], axis=1))
+    return np.concatenate(parts)
+
+
+def projected_solution_file(mesh, ds):
+    """Pi u_h (3.8) of a solution file, in its own space (the projection of k >= 2 depends on the
+    scene's Lame parameters, read from its ``scene`` attribute)."""
     from vemkit.config.scene import scene_from_yaml
-    from vemkit.vem.norms_k2 import projected_solution_k2
 
-    lam, mu = scene_from_yaml(ds.attrs["scene"]).lame()
-    return projected_solution_k2(mesh, solution_node_values(mesh, ds), lam, mu)
+    space = solution_space(mesh, ds)
+    material = space.element.projection_uses_material and ds.attrs.get("scene")
+    lam, mu = scene_from_yaml(ds.attrs["scene"]).lame() if material else (None, None)
+    return space.project(solution_node_values(space, ds), lam, mu)

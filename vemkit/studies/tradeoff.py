@@ -10,9 +10,9 @@ Every run solves the scene on one mesh with one configuration and measures
   kernels), and the number of free unknowns (DOFs). Mesh generation is recorded apart
   (``mesh_time``): a mesh is built once and reused.
 
-A family may set ``order: 2`` (k = 2 virtual elements, ``vemkit.contact.problem_k2``). Its error is
+A family may set ``order: 2`` (k = 2 virtual elements, ``vemkit.vem.elements.k2``). Its error is
 that of Pi_2 u_h (3.8, the projection of every k = 2 degree of freedom, cell means recovered)
-against the reference's projection (``vemkit.vem.norms_k2.projection_error_k2``, degree-5 rule on
+against the reference's projection (``vemkit.vem.norms.projection_error``, degree-5 rule on
 the reference cells: exact for nested meshes), never Pi_1 of its vertex values; its DOFs count the
 whole k = 2 space (vertex values, edge and cell means: ``n_dofs``; the condensed system the solver
 sees: ``n_unknowns``), and its cost includes the condensation. The reference is the k = 1 2^-8
@@ -81,7 +81,11 @@ def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tol
 
     order = family_order(spec)
     records = []
-    stabs = list(stabilizations)[:1] if spec["family"] == "triangle" and order == 1 else list(stabilizations)
+    from vemkit.vem.elements import element_for
+
+    # on triangles an element equal to its polynomial space (k = 1: P1) has no stabilization: one is enough
+    exact = spec["family"] == "triangle" and element_for(order).polynomial_on_triangles
+    stabs = list(stabilizations)[:1] if exact else list(stabilizations)
     order_override = [f"discretization.order={order}"] if order != 1 else []
     _warm_up(scene.with_overrides(order_override), spec, stabs, solvers)
     measure = _ErrorMeasure(reference)
@@ -141,29 +145,26 @@ def _best_solve(problem, options, repeats, time_budget):
 
 
 class _ErrorMeasure:
-    """error_h1, error_h1_semi, error_l2 of a converged run against ``reference``: Pi_1 u_h of a k = 1
-    run (``vemkit.vem.norms.projection_error``, as before k = 2 existed), Pi_2 u_h of a k = 2 run
-    (``projection_error_k2`` with a degree-5 rule on the reference cells, built on first use)."""
+    """error_h1, error_h1_semi, error_l2 of a converged run against ``reference``: Pi u_h of the run's
+    own space against the reference's projection (``vemkit.vem.norms.projection_error``), with a rule
+    exact for the two projections' product (degree 2 for two k = 1 projections, the reference's own
+    quadrature; degree 5 with a k = 2 one, built on first use)."""
 
     def __init__(self, reference):
         self.reference = reference
-        self._quadrature5 = None
+        self._quadrature = {}
 
     def __call__(self, problem, outcome) -> dict:
-        from vemkit.vem.norms import projection_error, reference_quadrature
-        from vemkit.vem.norms_k2 import projection_error_k2
-        from vemkit.vem.projection import projected_solution
+        from vemkit.vem.norms import projection_error
+        from vemkit.vem.quadrature import reference_quadrature
 
-        ref, mesh = self.reference, problem.mesh
-        if getattr(problem, "order", 1) == 1 and getattr(ref, "order", 1) == 1:
-            err = projection_error(mesh, projected_solution(mesh, problem.dofs.expand(outcome.solution.u)),
-                                   ref.mesh, ref.projected, ref.quadrature)
+        ref = self.reference
+        degree = 2 * max(problem.order, getattr(ref, "order", 1))
+        if degree == 2 * getattr(ref, "order", 1):
+            quadrature = ref.quadrature
         else:
-            if self._quadrature5 is None:
-                self._quadrature5 = reference_quadrature(ref.mesh, degree=5)
-            mine = problem.projected(outcome.solution.u) if getattr(problem, "order", 1) == 2 else \
-                projected_solution(mesh, problem.dofs.expand(outcome.solution.u))
-            err = projection_error_k2(mesh, mine, ref.mesh, ref.projected, self._quadrature5)
+            quadrature = self._quadrature.setdefault(degree, reference_quadrature(ref.mesh, degree=degree))
+        err = projection_error(problem.mesh, problem.projected(outcome.solution.u), ref.mesh, ref.projected, quadrature)
         return {"error_h1": err["h1"], "error_h1_semi": err["h1_semi"], "error_l2": err["l2"]}
 
 
@@ -204,7 +205,7 @@ def pareto_front(cost, error) -> np.ndarray:
 def describe(ds, i) -> str:
     """One run as "family[ (k = 2)], solver, tol, stabilization, n"."""
     order = int(ds["order"].values[i]) if "order" in ds else 1
-    return (f"{ds['family'].values[i]}{' (k = 2)' if order == 2 else ''}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
+    return (f"{ds['family'].values[i]}{f' (k = {order})' if order != 1 else ''}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
             f"{ds['stabilization'].values[i]}, n = {int(ds['n'].values[i])}")
 
 

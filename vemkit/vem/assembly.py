@@ -1,212 +1,61 @@
-"""Global stiffness matrix: element kernels of ``vemkit.vem.element`` scattered straight into CSR.
+"""One assembly for every element: local stiffness matrices (3.9) scattered straight into CSR.
 
-Clamped vertices (Dirichlet, u = 0, (2.4)) are eliminated while assembling: the matrix lives on
-the free vertices only, dof = 2 * free_index + component. The sparsity pattern is built once
-from vertex adjacency (vertices sharing a cell) and every entry is added in place, so no COO
-triplets are ever formed.
+The matrix lives on the free dofs of a :class:`~vemkit.vem.dofs.DofMap` (dof = 2 * free_index +
+component); clamped nodes are eliminated while assembling, and with ``dofs.condensed`` each cell's
+interior nodes (its last ``Element.condensed_nodes``, the k = 2 cell mean) are condensed out cell by
+cell (the Schur complement, ``condense_interior``). The sparsity pattern (``vemkit.vem.pattern``) is
+built once and every entry added in place: no COO triplets are ever formed.
+
+The element is a parameter: the Numba functions below marked *template* are written once and
+specialized per element (``specialized``), their calls ``workspace`` and ``cell_matrix`` bound to
+that element's kernels (compiled and cached on disk per element, as any ``cache=True`` kernel).
+The rows are split into contiguous chunks, one thread each; a thread computes the cells that touch
+its rows and writes only those rows, so no two threads write the same entry (cells straddling two
+chunks are computed twice) and the sums are the same whatever the number of threads.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import types
 
 import numba
 import numpy as np
 import scipy.sparse as sp
 
-from vemkit.mesh.mesh import Mesh
-from vemkit.vem.element import element_stiffness, stabilization_code
+from vemkit.vem.elements import Element, stabilization_code
+from vemkit.vem.pattern import ROW_CHUNKS, chunk_rows, dof_pattern, node_cells
+
+_SPECIALIZED: dict = {}
 
 
-@dataclass(frozen=True)
-class DofMap:
-    """Which vertices carry unknowns. ``free_index[v]`` is -1 for a clamped vertex (u = 0, eliminated).
-
-    ``fixed_dofs``: dofs of kept vertices whose value is prescribed (a roller's component, a
-    nonzero prescribed displacement), held at ``fixed_values`` by identity rows
-    (:mod:`vemkit.vem.constraints`); the unknown vector carries these values.
-    """
-
-    free_vertices: np.ndarray
-    free_index: np.ndarray
-    fixed_dofs: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    fixed_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
-
-    @property
-    def n_free(self) -> int:
-        return 2 * self.free_vertices.size
-
-    def unconstrained_vertices(self) -> np.ndarray:
-        """(n_vertices,) bool: both components of the vertex are unknowns (no Dirichlet data)."""
-        free = self.free_index >= 0
-        held = np.unique(self.fixed_dofs // 2)
-        free[self.free_vertices[held]] = False
-        return free
-
-    def prescribed_displacement(self) -> np.ndarray:
-        """(n_vertices, 2) the Dirichlet displacement: the fixed values, zero elsewhere."""
-        u = np.zeros((self.free_index.size, 2))
-        u.reshape(-1)[2 * self.free_vertices[self.fixed_dofs // 2] + self.fixed_dofs % 2] = self.fixed_values
-        return u
-
-    @classmethod
-    def from_clamped(cls, n_vertices: int, clamped_vertices) -> "DofMap":
-        free = np.ones(n_vertices, dtype=bool)
-        free[np.asarray(clamped_vertices, dtype=np.int64)] = False
-        free_vertices = np.flatnonzero(free)
-        free_index = np.full(n_vertices, -1, dtype=np.int64)
-        free_index[free_vertices] = np.arange(free_vertices.size)
-        return cls(free_vertices, free_index)
-
-    def expand(self, u_free: np.ndarray) -> np.ndarray:
-        """Free-dof vector -> (n_vertices, 2) displacement, zero at clamped vertices."""
-        u = np.zeros((self.free_index.size, 2))
-        u[self.free_vertices] = np.asarray(u_free).reshape(-1, 2)
-        return u
-
-    def restrict(self, u_vertices: np.ndarray) -> np.ndarray:
-        """(n_vertices, 2) -> free-dof vector."""
-        return np.ascontiguousarray(np.asarray(u_vertices)[self.free_vertices]).ravel()
+def specialized(template, element: Element, parallel: bool = False, **calls):
+    """The Numba function of a template (a plain function of this module or another) for one
+    element: the names ``workspace`` and ``cell_matrix`` in its body (and any in ``calls``) are that
+    element's. Cached on disk per element under the name ``<template>_<element>``."""
+    key = (template.__module__, template.__name__, element.name)
+    if key not in _SPECIALIZED:
+        namespace = dict(template.__globals__, workspace=element.workspace, cell_matrix=element.cell_matrix, **calls)
+        function = types.FunctionType(template.__code__, namespace, f"{template.__name__}_{element.name}",
+                                      template.__defaults__)
+        function.__qualname__ = function.__name__
+        function.__module__ = template.__module__
+        function.__doc__ = template.__doc__
+        _SPECIALIZED[key] = numba.njit(cache=True, parallel=parallel)(function)
+    return _SPECIALIZED[key]
 
 
 @numba.njit(cache=True)
-def vertex_cells(offsets, cell_vertices, n_vertices):
-    """CSR (ptr, cells) of the cells around every vertex."""
-    n_cells = offsets.shape[0] - 1
-    ptr = np.zeros(n_vertices + 1, dtype=np.int64)
-    for p in range(cell_vertices.shape[0]):
-        ptr[cell_vertices[p] + 1] += 1
-    for v in range(n_vertices):
-        ptr[v + 1] += ptr[v]
-    cells = np.empty(cell_vertices.shape[0], dtype=np.int64)
-    fill = ptr[:-1].copy()
-    for c in range(n_cells):
-        for p in range(offsets[c], offsets[c + 1]):
-            v = cell_vertices[p]
-            cells[fill[v]] = c
-            fill[v] += 1
-    return ptr, cells
-
-
-@numba.njit(cache=True)
-def sort_prefix(buf, k):
-    """Sort buf[:k] in place (insertion sort: the rows of a sparsity pattern hold a few dozen columns)."""
-    for i in range(1, k):
-        x = buf[i]
-        j = i - 1
-        while j >= 0 and buf[j] > x:
-            buf[j + 1] = buf[j]
-            j -= 1
-        buf[j + 1] = x
-
-
-@numba.njit(cache=True)
-def _neighbours(v, offsets, cell_vertices, vc_ptr, vc, free_index, buf):
-    """Sorted unique free neighbours of vertex v (itself included) into buf; returns their count."""
-    k = 0
-    for t in range(vc_ptr[v], vc_ptr[v + 1]):
-        c = vc[t]
-        for p in range(offsets[c], offsets[c + 1]):
-            col = free_index[cell_vertices[p]]
-            if col >= 0:
-                buf[k] = col
-                k += 1
-    if k == 0:
-        return 0
-    sort_prefix(buf, k)  # k is small (sum of the cell sizes around v)
-    u = 1
-    for i in range(1, k):
-        if buf[i] != buf[u - 1]:
-            buf[u] = buf[i]
-            u += 1
-    return u
-
-
-@numba.njit(cache=True, parallel=True)
-def vertex_adjacency(offsets, cell_vertices, vc_ptr, vc, free_vertices):
-    """CSR pattern (sorted columns) of free vertices that share a cell, diagonal included."""
-    n_free = free_vertices.shape[0]
-    n_vertices = vc_ptr.shape[0] - 1
-    free_index = np.full(n_vertices, -1, dtype=np.int64)
-    for r in range(n_free):
-        free_index[free_vertices[r]] = r
-    maxbuf = 0
-    for v in range(n_vertices):
-        size = 0
-        for t in range(vc_ptr[v], vc_ptr[v + 1]):
-            size += offsets[vc[t] + 1] - offsets[vc[t]]
-        maxbuf = max(maxbuf, size)
-    n_chunks = 64
-    indptr = np.zeros(n_free + 1, dtype=np.int64)
-    for chunk in numba.prange(n_chunks):
-        buf = np.empty(maxbuf, dtype=np.int64)
-        for r in range(chunk * n_free // n_chunks, (chunk + 1) * n_free // n_chunks):
-            indptr[r + 1] = _neighbours(free_vertices[r], offsets, cell_vertices, vc_ptr, vc, free_index, buf)
-    for r in range(n_free):
-        indptr[r + 1] += indptr[r]
-    indices = np.empty(indptr[n_free], dtype=np.int64)
-    for chunk in numba.prange(n_chunks):
-        buf = np.empty(maxbuf, dtype=np.int64)
-        for r in range(chunk * n_free // n_chunks, (chunk + 1) * n_free // n_chunks):
-            k = _neighbours(free_vertices[r], offsets, cell_vertices, vc_ptr, vc, free_index, buf)
-            indices[indptr[r] : indptr[r] + k] = buf[:k]
-    return indptr, indices
-
-
-@numba.njit(cache=True, parallel=True)
-def dof_pattern(vindptr, vindices):
-    """Expand the vertex pattern to 2 x 2 blocks: row 2r + a holds (2c, 2c + 1) for each c."""
-    n = vindptr.shape[0] - 1
-    indptr = np.empty(2 * n + 1, dtype=np.int64)
-    indptr[0] = 0
-    for r in range(n):
-        deg = vindptr[r + 1] - vindptr[r]
-        indptr[2 * r + 1] = indptr[2 * r] + 2 * deg
-        indptr[2 * r + 2] = indptr[2 * r + 1] + 2 * deg
-    indices = np.empty(indptr[2 * n], dtype=np.int32)
-    for r in numba.prange(n):
-        for a in range(2):
-            k = indptr[2 * r + a]
-            for t in range(vindptr[r], vindptr[r + 1]):
-                indices[k] = 2 * vindices[t]
-                indices[k + 1] = 2 * vindices[t] + 1
-                k += 2
-    return indptr, indices
-
-
-@numba.njit(cache=True)
-def _find(vindices, lo, hi, col):
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if vindices[mid] < col:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
-ROW_CHUNKS = 8  # threads' shares of the rows in the parallel assembly
-
-
-@numba.njit(cache=True)
-def chunk_rows(chunk, n_rows):
-    """The rows [lo, hi) of one of the ROW_CHUNKS contiguous shares."""
-    return chunk * n_rows // ROW_CHUNKS, (chunk + 1) * n_rows // ROW_CHUNKS
-
-
-@numba.njit(cache=True, inline="always")
-def add_block(data, p0, p1, K, i, j):
-    """The 2 x 2 block (vertex or node i, j) of an element matrix K into the CSR data of the two
-    scalar rows of i, at positions p0 (first component's row) and p1 (second's)."""
-    data[p0] += K[2 * i, 2 * j]
-    data[p0 + 1] += K[2 * i, 2 * j + 1]
-    data[p1] += K[2 * i + 1, 2 * j]
-    data[p1 + 1] += K[2 * i + 1, 2 * j + 1]
+def largest_cell(offsets):
+    """The most nodes of a cell in a CSR list of cell nodes."""
+    size = 0
+    for c in range(offsets.shape[0] - 1):
+        size = max(size, offsets[c + 1] - offsets[c])
+    return size
 
 
 @numba.njit(cache=True)
 def cells_of_rows(row_lo, row_hi, free_items, item_ptr, item_cells, offsets, ids, free_index):
-    """The cells touching the rows [row_lo, row_hi) (rows: free vertices or nodes ``free_items``;
+    """The cells touching the rows [row_lo, row_hi) (rows: free nodes ``free_items``;
     ``item_ptr``/``item_cells`` the cells around each), each once: at its first row in the range, in
     the order of the rows. A thread that owns these rows computes exactly these cells."""
     out = []
@@ -224,56 +73,89 @@ def cells_of_rows(row_lo, row_hi, free_items, item_ptr, item_cells, offsets, ids
     return out
 
 
+@numba.njit(cache=True, inline="always")
+def add_block(data, p0, p1, K, i, j):
+    """The 2 x 2 block (node i, j) of an element matrix K into the CSR data of the two scalar rows
+    of i, at positions p0 (first component's row) and p1 (second's)."""
+    data[p0] += K[2 * i, 2 * j]
+    data[p0 + 1] += K[2 * i, 2 * j + 1]
+    data[p1] += K[2 * i + 1, 2 * j]
+    data[p1 + 1] += K[2 * i + 1, 2 * j + 1]
+
+
 @numba.njit(cache=True)
-def _scatter_rows(row_lo, row_hi, vertices, offsets, cell_vertices, free_index, free_vertices, vc_ptr, vc, vindptr, vindices, lam, mu, stab, nmax, data):
-    """Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
-    K = np.empty((2 * nmax, 2 * nmax))
-    B = np.empty((3, 2 * nmax))
-    P = np.empty((6, 2 * nmax))
-    R = np.empty((2 * nmax, 2 * nmax))
-    px = np.empty(nmax)
-    py = np.empty(nmax)
-    rows = np.empty(nmax, dtype=np.int64)
-    for c in cells_of_rows(row_lo, row_hi, free_vertices, vc_ptr, vc, offsets, cell_vertices, free_index):
+def condense_interior(K, size):
+    """Static condensation of a cell's last node (its interior node, scalars c0 = 2 (size - 1) and
+    c0 + 1) in the element matrix K: K_bb -= K_bc K_cc^-1 K_cb on the boundary scalars."""
+    c = 2 * (size - 1)
+    a, b, d, e = K[c, c], K[c, c + 1], K[c + 1, c], K[c + 1, c + 1]
+    det = a * e - b * d
+    for i in range(c):
+        w0 = (K[i, c] * e - K[i, c + 1] * d) / det  # (K_bc K_cc^-1)[i, :]
+        w1 = (K[i, c + 1] * a - K[i, c] * b) / det
+        for j in range(c):
+            K[i, j] -= w0 * K[c, j] + w1 * K[c + 1, j]
+
+
+@numba.njit(cache=True)
+def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
+    """data += the rows of K whose node rows lie in [row_lo, row_hi): the cell's free columns are
+    sorted once, then each CSR row is found by one merge walk along its sorted column list (the
+    even entries 2c of the scalar row 2r)."""
+    count = 0
+    for j in range(size):  # insertion sort of the free local columns by global row
+        if rows[j] < 0:
+            continue
+        t = count
+        while t > 0 and rows[order[t - 1]] > rows[j]:
+            order[t] = order[t - 1]
+            t -= 1
+        order[t] = j
+        count += 1
+    for i in range(size):
+        r = rows[i]
+        if r < row_lo or r >= row_hi:
+            continue
+        q = indptr[2 * r]
+        deg2 = indptr[2 * r + 1] - q
+        for s in range(count):
+            j = order[s]
+            while indices[q] < 2 * rows[j]:
+                q += 2
+            add_block(data, q, q + deg2, K, i, j)
+
+
+def scatter_rows(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam,
+                 mu, stab, condense, max_nodes, data):
+    """*Template.* Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
+    work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
+    rows = np.empty(max_nodes, dtype=np.int64)
+    order = np.empty(max_nodes, dtype=np.int64)
+    for c in cells_of_rows(row_lo, row_hi, free_nodes, nc_ptr, nc, offsets, nodes, free_index):
         start = offsets[c]
-        n = offsets[c + 1] - start
-        for i in range(n):
-            rows[i] = free_index[cell_vertices[start + i]]
-            px[i] = vertices[cell_vertices[start + i], 0]
-            py[i] = vertices[cell_vertices[start + i], 1]
-        m = 2 * n
-        element_stiffness(px[:n], py[:n], lam, mu, stab, K[:m, :m], B[:, :m], P[:, :m], R[:m, :m])
-        for i in range(n):
-            r = rows[i]
-            if r < row_lo or r >= row_hi:
-                continue
-            lo = vindptr[r]
-            hi = vindptr[r + 1]
-            deg2 = 2 * (hi - lo)
-            base = 4 * lo
-            for j in range(n):
-                col = rows[j]
-                if col < 0:
-                    continue
-                k = _find(vindices, lo, hi, col) - lo
-                add_block(data, base + 2 * k, base + deg2 + 2 * k, K, i, j)
+        size = offsets[c + 1] - start
+        for i in range(size):
+            rows[i] = free_index[nodes[start + i]]
+        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        if condense:
+            condense_interior(K, size)
+        _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)
 
 
-@numba.njit(cache=True, parallel=True)
-def scatter_stiffness(vertices, offsets, cell_vertices, free_index, free_vertices, vc_ptr, vc, vindptr, vindices, lam, mu, stab, data):
-    """Add every element stiffness (3.9) into the CSR ``data`` of ``dof_pattern``.
-
-    The rows are split into contiguous chunks, one thread each; a thread computes the cells that
-    touch its rows and writes only those rows, so no two threads write the same entry (cells
-    straddling two chunks are computed twice).
-    """
-    nmax = 0
-    for c in range(offsets.shape[0] - 1):
-        nmax = max(nmax, offsets[c + 1] - offsets[c])
+def scatter_stiffness(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab,
+                      condense, data):
+    """*Template* (parallel). Every element stiffness (3.9) added into the CSR ``data`` (zeroed)."""
+    max_nodes = largest_cell(offsets)
     for chunk in numba.prange(ROW_CHUNKS):
-        lo, hi = chunk_rows(chunk, free_vertices.shape[0])
-        _scatter_rows(lo, hi, vertices, offsets, cell_vertices, free_index, free_vertices, vc_ptr, vc, vindptr,
-                      vindices, lam, mu, stab, nmax, data)
+        lo, hi = chunk_rows(chunk, free_nodes.shape[0])
+        scatter_rows(lo, hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices,  # noqa: F821
+                     lam, mu, stab, condense, max_nodes, data)
+
+
+def scatter_kernel(element: Element):
+    """The parallel scatter of ``element`` (``scatter_stiffness`` specialized)."""
+    rows = specialized(scatter_rows, element)
+    return specialized(scatter_stiffness, element, parallel=True, scatter_rows=rows)
 
 
 def sorted_csr(data, indices, indptr, n: int) -> sp.csr_matrix:
@@ -285,18 +167,57 @@ def sorted_csr(data, indices, indptr, n: int) -> sp.csr_matrix:
     return A
 
 
-def stiffness_matrix(mesh: Mesh, lam: float, mu: float, stabilization: str, dofs: DofMap | None = None):
-    """The global VEM stiffness matrix on the free dofs (CSR, symmetric positive definite when
-    at least one vertex set is clamped so that rigid motions are excluded)."""
-    if dofs is None:
-        dofs = DofMap.from_clamped(mesh.n_vertices, [])
-    stab = stabilization_code(stabilization)
-    vc_ptr, vc = vertex_cells(mesh.cell_offsets, mesh.cell_vertices, mesh.n_vertices)
-    vindptr, vindices = vertex_adjacency(mesh.cell_offsets, mesh.cell_vertices, vc_ptr, vc, dofs.free_vertices)
-    indptr, indices = dof_pattern(vindptr, vindices)
-    data = np.zeros(indices.shape[0])
-    scatter_stiffness(
-        mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, dofs.free_index,
-        dofs.free_vertices, vc_ptr, vc, vindptr, vindices, float(lam), float(mu), stab, data,
-    )
+def stiffness_matrix(space, lam: float, mu: float, stabilization: str, dofs=None) -> sp.csr_matrix:
+    """The global VEM stiffness matrix of ``space`` (a :class:`~vemkit.vem.space.VirtualElementSpace`)
+    on the free dofs of ``dofs`` (default: every node free, ``space.numbering()``), in their order;
+    with ``dofs.condensed`` the Schur complement on the non-interior dofs. Symmetric positive
+    definite when the constraints exclude the rigid motions."""
+    dofs = space.numbering() if dofs is None else dofs
+    offsets, nodes = space.cell_nodes
+    nc_ptr, nc = node_cells(offsets, nodes, dofs.n_nodes)
+    indptr, indices = dof_pattern(offsets, nodes, nc_ptr, nc, dofs.free_nodes, dofs.free_index)
+    data = np.zeros(indices.shape[0])  # fresh zero pages from the system: no zeroing pass
+    scatter_kernel(space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index, dofs.free_nodes, nc_ptr, nc,
+                                  indptr, indices, float(lam), float(mu), stabilization_code(stabilization),
+                                  dofs.condensed, data)
     return sorted_csr(data, indices, indptr, dofs.n_free)
+
+
+def lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, condense, out):
+    """*Template.* out[free] -= K_fc u_c over the cells that touch a clamped node with a non-zero value."""
+    work = workspace(largest_cell(offsets))  # noqa: F821
+    for c in range(offsets.shape[0] - 1):
+        start = offsets[c]
+        size = offsets[c + 1] - start
+        touched = False
+        for i in range(size):
+            g = nodes[start + i]
+            if free_index[g] < 0 and (values[g, 0] != 0.0 or values[g, 1] != 0.0):
+                touched = True
+        if not touched:
+            continue
+        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        if condense:
+            condense_interior(K, size)
+        for i in range(size):
+            r = free_index[nodes[start + i]]
+            if r < 0:
+                continue
+            for j in range(size):
+                g = nodes[start + j]
+                if free_index[g] >= 0:
+                    continue
+                for a in range(2):
+                    for b in range(2):
+                        out[2 * r + a] -= K[2 * i + a, 2 * j + b] * values[g, b]
+
+
+def dirichlet_lift(space, lam: float, mu: float, stabilization: str, dofs, values) -> np.ndarray:
+    """-K_fc u_c on the free dofs: add it to the load when the clamped nodes carry the values
+    ``values`` (n_nodes, 2) (e.g. ``space.interpolate`` of the prescribed displacement) instead of 0."""
+    offsets, nodes = space.cell_nodes
+    out = np.zeros(dofs.n_free)
+    vals = np.ascontiguousarray(values, dtype=float).reshape(dofs.n_nodes, 2)
+    specialized(lift, space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index, vals, float(lam), float(mu),
+                                     stabilization_code(stabilization), dofs.condensed, out)
+    return out

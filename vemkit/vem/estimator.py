@@ -1,17 +1,20 @@
-"""A posteriori error indicators η_K of the k = 1 VEM solution of the contact problem (SPEC §9).
+"""A posteriori error indicators η_K of the VEM solution of the contact problem, for any element (SPEC §9).
 
 Computable from u_h and the data only. With σ_K = C ε(Π u_h) on cell K (constant for k = 1, so
-div σ_K = 0), f_K the cell average of the body force, and n_e the outward unit normal of edge e:
+div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of the body force, and n_e
+the outward unit normal of edge e:
 
-    η_K² = (1 / 2μ) [ h_K² |f_K|² |K|                                   volume residual
+    η_K² = (1 / 2μ) [ h_K² |f_K + div σ_K|² |K|                         volume residual
                     + ½ Σ_{e ⊂ ∂K interior} |e| ‖[σ n_e]‖²_e           jumps of the projected traction
                     + Σ_{e ⊂ ∂K ∩ Γ_F} |e| ‖f2 − σ_K n_e‖²_e           mismatch on Neumann sides
                     + Σ_{e ⊂ ∂K ∩ Γ_C} |e| ‖t_C − σ_K n_e‖²_e ]        mismatch with the contact traction
            + α_K S_K((I − Π) u_h, (I − Π) u_h)                            the VEM stabilization term (3.9)
 
-where [σ n_e] = (σ_K − σ_K') n_e is constant on an interior edge, and t_C = −p_ν(u_ν − g) ν + σ_τ τ
-is the contact traction of (2.6)–(2.9) at the Γ_C vertices, interpolated linearly along the edge
-(σ_τ = −p_τ λ with the friction multiplier λ); the edge integrals use 3-point Gauss rules. The
+where [σ n_e] = (σ_K − σ_K') n_e (constant on an interior edge for k = 1: the closed form; linear for
+k = 2: 3-point Gauss, exact), and t_C = −p_ν(u_ν − g) ν + σ_τ τ is the contact traction of
+(2.6)–(2.9) at the contact points (Γ_C vertices; and edge midpoints for k = 2), interpolated along
+the edge as the space's trace (σ_τ = −p_τ λ with the friction multiplier λ); the edge integrals use
+3-point Gauss rules. The
 residual terms are those of the residual estimator for the VEM of Beirão da Veiga & Manzini
 (IMA J. Numer. Anal. 35, 2015) and Cangiani, Georgoulis, Pryer & Sutton (Numer. Math. 137, 2017),
 with the boundary residual of the contact problem taking the contact traction as its Neumann datum
@@ -20,6 +23,10 @@ with the boundary residual of the contact problem taking the contact traction as
 so that η² estimates the energy norm a(u − u_h, u − u_h) of the error. The relative estimate is
 
     η = (Σ_K η_K²)^½ / a_h(u_h, u_h)^½.
+
+The energies per cell come from the element: for k = 1 the kernel ``local_energies`` (which pins
+the consistency part |K| ε:Cε); otherwise a_h^K(u, u) from the element's local stiffness and the
+consistency part ∫_K σ(Π u):ε(Π u) by a degree-2 rule on the cell's triangles (exact: linear σ).
 
 Imports from vemkit: ``mesh`` and this layer; the caller (``vemkit.studies.adaptivity``) turns the
 scene's data and the contact solution into the plain arrays and callables taken here.
@@ -31,8 +38,12 @@ import numba
 import numpy as np
 
 from vemkit.mesh.mesh import Mesh
-from vemkit.vem.element import cell_coordinates, element_stiffness, stabilization_code
-from vemkit.vem.projection import projected_solution, stress
+from vemkit.vem.assembly import largest_cell, specialized
+from vemkit.vem.elements import stabilization_code
+from vemkit.vem.elements.k1_kernel import cell_coordinates, element_stiffness
+from vemkit.vem.projection import stress
+from vemkit.vem.quadrature import reference_quadrature
+from vemkit.vem.space import VirtualElementSpace
 
 GAUSS3 = (np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)]), np.array([5.0, 8.0, 5.0]) / 18.0)
 
@@ -74,6 +85,60 @@ def local_energies(vertices, offsets, cell_vertices, u, lam, mu, stab):
     return total, consistency
 
 
+def cell_energies(vertices, offsets, nodes, u, lam, mu, stab, total):
+    """*Template.* total[c] = a_h^K(u, u) (3.9) from the element's local stiffness."""
+    work = workspace(largest_cell(offsets))  # noqa: F821 (bound by ``specialized``)
+    for c in range(offsets.shape[0] - 1):
+        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        start = offsets[c]
+        m = 2 * (offsets[c + 1] - start)
+        energy = 0.0
+        for i in range(m):
+            ui = u[nodes[start + i // 2], i % 2]
+            for j in range(m):
+                energy += ui * K[i, j] * u[nodes[start + j // 2], j % 2]
+        total[c] = energy
+
+
+def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, stabilization: str, projection):
+    """(a_h^K(u, u), a_K(Π u, Π u)) per cell, for any element (module docstring)."""
+    mesh, u = space.mesh, np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, 2)
+    if space.element.stress_degree == 0:  # constant strain: the k = 1 kernel (exact products)
+        return local_energies(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu,
+                              stabilization_code(stabilization))
+    offsets, nodes = space.cell_nodes
+    total = np.zeros(mesh.n_cells)
+    specialized(cell_energies, space.element)(mesh.vertices, offsets, nodes, u, float(lam), float(mu),
+                                              stabilization_code(stabilization), total)
+    points, weights, cells = reference_quadrature(mesh, degree=2)
+    g = projection.gradient_at(cells, points)
+    strain = np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1)
+    sig = stress(strain, lam, mu)
+    density = sig[:, 0] * strain[:, 0] + sig[:, 1] * strain[:, 1] + 2.0 * sig[:, 2] * strain[:, 2]
+    return total, np.bincount(cells, weights * density, mesh.n_cells)
+
+
+def stress_at(projection, cells, points, lam, mu) -> np.ndarray:
+    """(P, 3) σ11, σ22, σ12 of C ε(Π u) at points, each in the given cell."""
+    g = projection.gradient_at(cells, points)
+    return stress(np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1), lam, mu)
+
+
+def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarray:
+    """(M, 2) div σ(Π u) per cell for a linear σ (k = 2): central differences of σ about the cell
+    centre, exact for a linear field."""
+    cells = np.arange(mesh.n_cells)
+    centre = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
+    step = np.sqrt(np.abs(mesh.cell_areas))[:, None]
+    d = {}
+    for axis in (0, 1):
+        shift = np.zeros_like(centre)
+        shift[:, axis] = step[:, 0]
+        d[axis] = (stress_at(projection, cells, centre + shift, lam, mu)
+                   - stress_at(projection, cells, centre - shift, lam, mu)) / (2.0 * step)
+    return np.stack([d[0][:, 0] + d[1][:, 2], d[0][:, 2] + d[1][:, 1]], axis=1)
+
+
 def _edge_normals(points_a, points_b):
     """Outward unit normals (for a counter-clockwise cell) and lengths of the edges a -> b."""
     d = points_b - points_a
@@ -87,14 +152,38 @@ def _traction(sig: np.ndarray, normal: np.ndarray) -> np.ndarray:
                      sig[:, 2] * normal[:, 0] + sig[:, 1] * normal[:, 1]], axis=1)
 
 
-def _jump_terms(mesh: Mesh, sig: np.ndarray) -> np.ndarray:
-    """½ |e|² |[σ n]|² added to each of the two cells of every interior edge."""
+class _Stress:
+    """σ(Π u_h) per cell: ``constant`` (M, 3) when the element's stress is constant per cell (k = 1),
+    else evaluated at points from the projection."""
+
+    def __init__(self, space, projection, lam, mu):
+        self.projection, self.lam, self.mu = projection, lam, mu
+        self.constant = stress(projection.strain, lam, mu) if space.element.stress_degree == 0 else None
+
+    def at(self, cells, points):
+        if self.constant is not None:
+            return self.constant[cells]
+        return stress_at(self.projection, cells, points, self.lam, self.mu)
+
+
+def _jump_terms(mesh: Mesh, sig: _Stress) -> np.ndarray:
+    """½ |e|² ∫_e |[σ n]|² / |e| added to each of the two cells of every interior edge (the jump is
+    constant along the edge for k = 1: no quadrature)."""
     edges, cells = mesh.edges, mesh.edge_cells
     inner = cells[:, 1] >= 0
     e, c = edges[inner], cells[inner]
     normal, length = _edge_normals(mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]])
-    jump = _traction(sig[c[:, 0]] - sig[c[:, 1]], normal)
-    term = 0.5 * length**2 * np.sum(jump**2, axis=1)
+    if sig.constant is not None:
+        jump = _traction(sig.constant[c[:, 0]] - sig.constant[c[:, 1]], normal)
+        term = 0.5 * length**2 * np.sum(jump**2, axis=1)
+    else:
+        t, w = GAUSS3
+        a, b = mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]]
+        term = np.zeros(e.shape[0])
+        for tq, wq in zip(t, w):
+            p = a + tq * (b - a)
+            jump = _traction(sig.at(c[:, 0], p) - sig.at(c[:, 1], p), normal)
+            term += wq * 0.5 * length**2 * np.sum(jump**2, axis=1)
     out = np.zeros(mesh.n_cells)
     np.add.at(out, c[:, 0], term)
     np.add.at(out, c[:, 1], term)
@@ -109,7 +198,7 @@ def _boundary_cells(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     return mesh.edge_cells[order[np.searchsorted(key[order], wanted)], 0]
 
 
-def _boundary_terms(mesh: Mesh, sig: np.ndarray, edges: np.ndarray, datum) -> np.ndarray:
+def _boundary_terms(mesh: Mesh, sig: _Stress, edges: np.ndarray, datum) -> np.ndarray:
     """|e| ∫_e |datum − σ_K n|² per cell, ``datum(points (Q, E, 2), t (Q,)) -> (Q, E, 2)``."""
     out = np.zeros(mesh.n_cells)
     if edges.size == 0:
@@ -117,42 +206,57 @@ def _boundary_terms(mesh: Mesh, sig: np.ndarray, edges: np.ndarray, datum) -> np
     cells = _boundary_cells(mesh, edges)
     a, b = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
     normal, length = _edge_normals(a, b)
-    own = _traction(sig[cells], normal)
     t, w = GAUSS3
     points = a[None] + t[:, None, None] * (b - a)[None]
-    misfit = datum(points, t) - own[None]
+    if sig.constant is not None:
+        own = _traction(sig.constant[cells], normal)[None]
+    else:
+        own = np.stack([_traction(sig.at(cells, p), normal) for p in points])
+    misfit = datum(points, t) - own
     np.add.at(out, cells, length**2 * np.einsum("q,qe->e", w, np.sum(misfit**2, axis=2)))
     return out
 
 
-def error_indicators(mesh: Mesh, u_vertices, lam: float, mu: float, stabilization: str, *,
+def error_indicators(space, u_nodes, lam: float, mu: float, stabilization: str, *,
                      body_force=None, neumann=None, contact=None) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
-    body_force: (M, 2) cell averages f_K or None; neumann: {side: traction(x, y) -> (t1, t2)};
-    contact: {side: (N, 2) contact traction t_C at every vertex (only Γ_C vertices are read)}.
-    Returns {"indicator" (M,) η_K, "volume", "jump", "neumann", "contact", "stabilization" (M,) the
-    squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
+    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a Mesh: k = 1); u_nodes its degrees
+    of freedom (n_nodes, 2). body_force: (M, 2) cell averages f_K or None; neumann: {side:
+    traction(x, y) -> (t1, t2)}; contact: {side: (n_nodes, 2) contact traction t_C at every node
+    (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
+    "contact", "stabilization" (M,) the squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
     """
-    u = np.ascontiguousarray(u_vertices, dtype=float).reshape(mesh.n_vertices, 2)
-    sig = stress(projected_solution(mesh, u).strain, lam, mu)
-    total, consistency = local_energies(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu,
-                                        stabilization_code(stabilization))
-    terms = {"volume": np.zeros(mesh.n_cells), "jump": _jump_terms(mesh, sig),
+    space = VirtualElementSpace(space, 1) if isinstance(space, Mesh) else space
+    mesh = space.mesh
+    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, 2)
+    projection = space.project(u, lam, mu)
+    sig = _Stress(space, projection, lam, mu)
+    total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
+    terms = {"volume": _volume_terms(mesh, sig, body_force), "jump": _jump_terms(mesh, sig),
              "neumann": np.zeros(mesh.n_cells), "contact": np.zeros(mesh.n_cells)}
-    if body_force is not None:
-        terms["volume"] = mesh.cell_diameters**2 * np.sum(np.asarray(body_force) ** 2, axis=1) * mesh.cell_areas
     for side, traction in (neumann or {}).items():
         terms["neumann"] += _boundary_terms(mesh, sig, mesh.boundary[side], _sampled(traction))
-    for side, at_vertices in (contact or {}).items():
+    for side, at_nodes in (contact or {}).items():
         edges = mesh.boundary[side]
-        terms["contact"] += _boundary_terms(mesh, sig, edges, _linear_along(np.asarray(at_vertices), edges))
+        terms["contact"] += _boundary_terms(mesh, sig, edges, _trace_along(space, np.asarray(at_nodes), edges))
     residual = sum(terms.values()) / (2.0 * mu)
     terms["stabilization"] = np.maximum(total - consistency, 0.0)
     squared = residual + terms["stabilization"]
     energy = float(total.sum())
     return {"indicator": np.sqrt(squared), **terms, "estimate": float(np.sqrt(squared.sum() / energy)) if energy > 0
             else 0.0, "energy": energy}
+
+
+def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
+    """h_K² |f_K + div σ_K|² |K| (div σ_K = 0 for a constant stress)."""
+    residual = None if body_force is None else np.asarray(body_force, dtype=float)
+    if sig.constant is None:
+        divergence = stress_divergence(sig.projection, mesh, sig.lam, sig.mu)
+        residual = divergence if residual is None else residual + divergence
+    if residual is None:
+        return np.zeros(mesh.n_cells)
+    return mesh.cell_diameters**2 * np.sum(residual**2, axis=1) * mesh.cell_areas
 
 
 def _sampled(traction):
@@ -162,11 +266,20 @@ def _sampled(traction):
     return datum
 
 
-def _linear_along(at_vertices: np.ndarray, edges: np.ndarray):
-    ta, tb = at_vertices[edges[:, 0]], at_vertices[edges[:, 1]]
+def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
+    """The datum of values at the trace nodes of ``edges``, interpolated as the space's trace
+    (linear between the ends for k = 1)."""
+    nodes = space.edge_nodes(edges)
+    if nodes.shape[1] == 2:
+        ta, tb = at_nodes[nodes[:, 0]], at_nodes[nodes[:, 1]]
+
+        def datum(_points, t):
+            return ta[None] + t[:, None, None] * (tb - ta)[None]
+        return datum
+    values = at_nodes[nodes]  # (E, k + 1, 2)
 
     def datum(_points, t):
-        return ta[None] + t[:, None, None] * (tb - ta)[None]
+        return np.einsum("qn,enc->qec", space.element.edge_trace(t), values)
     return datum
 
 

@@ -38,8 +38,9 @@ import numba
 import numpy as np
 
 from vemkit.mesh.geometry import turn
+from vemkit.mesh.locate import locate_points
 from vemkit.mesh.mesh import Mesh
-from vemkit.vem.element import cell_coordinates
+from vemkit.vem.elements.k1_kernel import cell_coordinates
 
 WACHSPRESS = 0
 MEAN_VALUE = 1
@@ -167,9 +168,7 @@ def interpolate(mesh: Mesh, values: np.ndarray, points: np.ndarray, cells: np.nd
                 kinds: np.ndarray | None = None) -> np.ndarray:
     """Values (P, k) at ``points`` of the generalized barycentric interpolant of the vertex
     ``values`` (N, k) or (N,) on ``mesh``. ``cells``: a cell containing each point (default:
-    located with ``vemkit.vem.norms.locate_points``); ``kinds``: from :func:`cell_kinds`."""
-    from vemkit.vem.norms import locate_points
-
+    located with ``vemkit.mesh.locate.locate_points``); ``kinds``: from :func:`cell_kinds`."""
     points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
     vals = np.asarray(values, dtype=float)
     flat = vals.ndim == 1

@@ -1,144 +1,64 @@
-"""The error measures of Table 1 (SPEC §5) and errors against exact solutions.
+"""Error measures, for every element: Table 1's (SPEC §5), against exact solutions (SPEC §7) and on Gamma_C.
 
-Three measures between a coarse solution u_h and the reference u_ref (the 2^-8 square mesh):
+Between a coarse solution u_h and the reference u_ref (the 2^-8 square mesh):
 
-- ``projection_error``: ||Pi_1 (u_h - u_ref)||_{H1} / ||Pi_1 u_ref||_{H1} (full H1 norm, and the
-  H1 seminorm), Pi_1 the elementwise projection (3.8) of each solution on its own mesh, the broken
-  norm taken over the reference mesh. The integrals use a degree-2 rule on a triangulation of
-  every reference cell, every quadrature point located in the coarse mesh: exact when each
-  reference cell lies in one coarse cell (nested square meshes); for non-nested meshes the
-  quadrature resolves the coarse cell boundaries to the reference mesh size.
-- ``paper_error``, the paper's own measure (the one its Table 1 prints):
+- ``projection_error``: ||Pi (u_h - u_ref)||_{H1} / ||Pi u_ref||_{H1} (full H1 norm, and the H1
+  seminorm), Pi the elementwise projection (3.8) of each solution on its own mesh (Pi_1 or Pi_2,
+  any object with ``evaluate`` and ``gradient_at``), the broken norm taken over the reference mesh.
+  The integrals use a rule on a triangulation of every reference cell (degree 2 by default, 5 for
+  quadratic projections), every quadrature point located in the coarse mesh: exact when each
+  reference cell lies in one coarse cell (nested square meshes). ``regions`` adds the share of the
+  squared seminorm error inside given masks.
+- ``paper_error``, the paper's own measure (the one its Table 1 prints, k = 1):
   e_h = |Pi_1^ref (I_ref u_h - u_ref)|_{H1} / |Pi_1^ref u_ref|_{H1}, I_ref u_h the interpolant of
   the coarse vertex values at the reference vertices (bilinear on square meshes, generalized
   barycentric on the other families: ``vemkit.vem.interpolation``), Pi_1^ref the projection (3.8)
-  on the reference cells, the H1 seminorm broken over the reference cells (Pi_1 has a constant
-  gradient per cell, so the integral is exact).
+  on the reference cells, the H1 seminorm broken over the reference cells.
+
+Against an exact solution: ``exact_errors`` (absolute) and ``relative_exact_errors`` (the solution
+file's ``error_l2``, ``error_h1_semi``, ``error_h1``), degree-5 rule on a cell triangulation. On
+Gamma_C: ``trace_error`` (against a reference) and ``trace_errors`` (against a field, with the
+interpolation error ||u - I_h u|| of the paper's estimate), through the space's trace.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
-from vemkit.vem.interpolation import interpolate
-from vemkit.vem.projection import ProjectedSolution, projected_solution
-from vemkit.mesh.geometry import bin_boxes
+from vemkit.mesh.locate import locate_points
 from vemkit.mesh.mesh import Mesh
+from vemkit.vem.elements.k1_fields import ProjectedSolution, projected_solution
+from vemkit.vem.interpolation import interpolate
+from vemkit.vem.quadrature import edge_quadrature, reference_quadrature
 
-# degree-2 rule on triangles (barycentric coordinates, weights summing to 1)
-_DEGREE2 = np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
-_DEGREE2_WEIGHTS = np.full(3, 1 / 3)
-
-
-@numba.njit(cache=True)
-def _cell_bin_boxes(vertices, offsets, cell_vertices, lo, inv, nb):
-    """(M, 4) bins (i0, i1, j0, j1) covered by the bounding box of every cell."""
-    n_cells = offsets.shape[0] - 1
-    boxes = np.empty((n_cells, 4), dtype=np.int64)
-    for c in range(n_cells):
-        x0 = 1e300
-        x1 = -1e300
-        y0 = 1e300
-        y1 = -1e300
-        for p in range(offsets[c], offsets[c + 1]):
-            v = cell_vertices[p]
-            x0 = min(x0, vertices[v, 0])
-            x1 = max(x1, vertices[v, 0])
-            y0 = min(y0, vertices[v, 1])
-            y1 = max(y1, vertices[v, 1])
-        boxes[c, 0] = min(nb - 1, max(0, int((x0 - lo[0]) * inv[0])))
-        boxes[c, 1] = min(nb - 1, max(0, int((x1 - lo[0]) * inv[0])))
-        boxes[c, 2] = min(nb - 1, max(0, int((y0 - lo[1]) * inv[1])))
-        boxes[c, 3] = min(nb - 1, max(0, int((y1 - lo[1]) * inv[1])))
-    return boxes
+__all__ = ["difference_gradient", "exact_errors", "nesting_subdivisions", "paper_error", "projection_error",
+           "relative_exact_errors", "seminorm_squared", "trace_error", "trace_errors"]
 
 
-@numba.njit(cache=True)
-def _winding_inside(vertices, offsets, cell_vertices, c, x, y):
-    """Crossing-number point-in-polygon test (points on an edge count as inside)."""
-    s = offsets[c]
-    n = offsets[c + 1] - s
-    inside = False
-    for i in range(n):
-        a = cell_vertices[s + i]
-        b = cell_vertices[s + (i + 1) % n]
-        xa, ya = vertices[a, 0], vertices[a, 1]
-        xb, yb = vertices[b, 0], vertices[b, 1]
-        cross = (xb - xa) * (y - ya) - (yb - ya) * (x - xa)
-        if abs(cross) <= 1e-14 * (abs(xb - xa) + abs(yb - ya)) and min(xa, xb) - 1e-14 <= x <= max(xa, xb) + 1e-14 and min(ya, yb) - 1e-14 <= y <= max(ya, yb) + 1e-14:
-            return True
-        if (ya > y) != (yb > y):
-            xi = xa + (y - ya) * (xb - xa) / (yb - ya)
-            if x < xi:
-                inside = not inside
-    return inside
+def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=None, regions=None) -> dict:
+    """Relative errors of Pi u_h against Pi u_ref over the reference mesh (SPEC §5).
 
-
-@numba.njit(cache=True)
-def _locate(vertices, offsets, cell_vertices, lo, inv, nb, count, members, points, out):
-    for p in range(points.shape[0]):
-        x, y = points[p, 0], points[p, 1]
-        i = min(nb - 1, max(0, int((x - lo[0]) * inv[0])))
-        j = min(nb - 1, max(0, int((y - lo[1]) * inv[1])))
-        b = j * nb + i
-        out[p] = -1
-        for t in range(count[b], count[b + 1]):
-            c = members[t]
-            if _winding_inside(vertices, offsets, cell_vertices, c, x, y):
-                out[p] = c
-                break
-
-
-def locate_points(mesh: Mesh, points: np.ndarray) -> np.ndarray:
-    """Index of a cell containing each point (-1 outside the mesh)."""
-    points = np.ascontiguousarray(points, dtype=float)
-    lo = mesh.vertices.min(axis=0)
-    hi = mesh.vertices.max(axis=0)
-    nb = max(1, int(np.sqrt(mesh.n_cells)))
-    inv = nb / np.maximum(hi - lo, 1e-300) * (1 - 1e-12)
-    count, members = bin_boxes(_cell_bin_boxes(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb), nb)
-    out = np.empty(points.shape[0], dtype=np.int64)
-    _locate(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb, count, members, points, out)
-    return out
-
-
-def reference_quadrature(mesh: Mesh, degree: int = 2):
-    """Quadrature (degree 2 or 5) on a triangulation of the cells: points (P, 2), weights (P,), cell (P,)."""
-    from vemkit.vem.load import TRIANGLE_RULE
-    from vemkit.mesh.triangulate import triangulate_cells
-
-    bary, w = (_DEGREE2, _DEGREE2_WEIGHTS) if degree <= 2 else (TRIANGLE_RULE[:, :3], TRIANGLE_RULE[:, 3])
-    tri, parent = triangulate_cells(mesh)
-    p = mesh.vertices[tri]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
-    points = np.einsum("qk,tkc->tqc", bary, p).reshape(-1, 2)
-    weights = (area[:, None] * w[None, :]).ravel()
-    cells = np.repeat(parent, bary.shape[0])
-    return points, weights, cells
-
-
-def projection_error(coarse_mesh: Mesh, coarse: ProjectedSolution, ref_mesh: Mesh, ref: ProjectedSolution, quadrature=None):
-    """Relative errors of Pi_1 u_h against Pi_1 u_ref over the reference mesh (SPEC §5).
-
-    Returns {"h1": full H1 norm ratio, "h1_semi": seminorm ratio, "l2": L2 ratio}.
-    ``quadrature`` (from ``reference_quadrature(ref_mesh)``) may be passed to reuse it.
+    Returns {"h1": full H1 norm ratio, "h1_semi": seminorm ratio, "l2": L2 ratio} and, for every
+    ``regions`` entry name -> mask(points) -> bool array, "share_<name>": the part of the squared
+    H1-seminorm error inside it. ``quadrature`` (from ``reference_quadrature(ref_mesh)``) may be
+    passed to reuse it (degree 2 by default: exact for two linear projections).
     """
     points, weights, ref_cells = quadrature if quadrature is not None else reference_quadrature(ref_mesh)
     coarse_cells = locate_points(coarse_mesh, points)
     if np.any(coarse_cells < 0):
         raise ValueError("the reference mesh is not covered by the coarse mesh (different domains?)")
-    diff = coarse.evaluate(coarse_cells, points) - ref.evaluate(ref_cells, points)
-    grad = coarse.gradient[coarse_cells] - ref.gradient[ref_cells]
-    l2 = np.sum(weights * np.sum(diff**2, axis=1))
-    semi = np.sum(weights * np.sum(grad**2, axis=(1, 2)))
-    ref_l2 = np.sum(weights * np.sum(ref.evaluate(ref_cells, points) ** 2, axis=1))
-    ref_semi = np.sum(weights * np.sum(ref.gradient[ref_cells] ** 2, axis=(1, 2)))
-    return {
-        "h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
-        "h1_semi": float(np.sqrt(semi / ref_semi)),
-        "l2": float(np.sqrt(l2 / ref_l2)),
-    }
+    value_h, grad_h = coarse.evaluate(coarse_cells, points), coarse.gradient_at(coarse_cells, points)
+    value_ref, grad_ref = ref.evaluate(ref_cells, points), ref.gradient_at(ref_cells, points)
+    l2 = np.sum(weights * np.sum((value_h - value_ref) ** 2, axis=1))
+    density = weights * np.sum((grad_h - grad_ref) ** 2, axis=(1, 2))
+    semi = np.sum(density)
+    ref_l2 = np.sum(weights * np.sum(value_ref**2, axis=1))
+    ref_semi = np.sum(weights * np.sum(grad_ref**2, axis=(1, 2)))
+    out = {"h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))), "h1_semi": float(np.sqrt(semi / ref_semi)),
+           "l2": float(np.sqrt(l2 / ref_l2))}
+    for name, mask in (regions or {}).items():
+        out[f"share_{name}"] = float(np.sum(density[mask(points)]) / semi) if semi > 0 else 0.0
+    return out
 
 
 def seminorm_squared(areas: np.ndarray, gradient: np.ndarray) -> float:
@@ -161,18 +81,17 @@ def paper_error(coarse_mesh: Mesh, u_coarse: np.ndarray, ref_mesh: Mesh, u_ref: 
     return float(np.sqrt(seminorm_squared(areas, difference) / seminorm_squared(areas, ref_projected.gradient)))
 
 
-def exact_errors(mesh: Mesh, proj: ProjectedSolution, u_exact, grad_exact, quadrature=None):
-    """Absolute L2 and H1-seminorm errors of Pi_1 u_h against an exact solution.
+def exact_errors(mesh: Mesh, proj, u_exact, grad_exact, quadrature=None) -> dict:
+    """Absolute L2 and H1-seminorm errors of Pi u_h (any projection) against an exact solution.
 
     u_exact(x, y) -> (u1, u2); grad_exact(x, y) -> ((du1/dx, du1/dy), (du2/dx, du2/dy)).
     A degree-5 rule on a triangulation of each cell is used unless ``quadrature`` is given.
     """
     points, weights, cells = quadrature if quadrature is not None else reference_quadrature(mesh, degree=5)
-    ue = np.stack(u_exact(points[:, 0], points[:, 1]), axis=1)
-    ge = np.asarray(grad_exact(points[:, 0], points[:, 1]), dtype=float)  # (2, 2, P)
-    ge = np.moveaxis(ge, -1, 0)
+    ue = np.stack(np.broadcast_arrays(*u_exact(points[:, 0], points[:, 1])), axis=1)
+    ge = np.moveaxis(np.asarray(grad_exact(points[:, 0], points[:, 1]), dtype=float), -1, 0)
     diff = proj.evaluate(cells, points) - ue
-    grad = proj.gradient[cells] - ge
+    grad = proj.gradient_at(cells, points) - ge
     return {
         "l2": float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)))),
         "h1_semi": float(np.sqrt(np.sum(weights * np.sum(grad**2, axis=(1, 2))))),
@@ -192,17 +111,103 @@ def difference_gradient(field, step: float):
     return grad
 
 
-def relative_exact_errors(mesh: Mesh, u_vertices: np.ndarray, u_exact) -> dict:
-    """SPEC §7: relative errors of Pi_1 u_h against u_exact(x, y) -> (u1, u2): ``error_l2`` =
-    ||Pi u_h - u|| / ||u||, ``error_h1_semi`` = |.|_1 / |u|_1, ``error_h1`` with the full H1 norm;
-    a degree-5 rule on a triangulation of every cell, the gradient of u by :func:`difference_gradient`
-    with a step of 1e-3 times the body's size."""
+def relative_exact_errors(mesh: Mesh, proj, u_exact) -> dict:
+    """SPEC §7: relative errors of Pi u_h (``proj``, any element's projection) against
+    u_exact(x, y) -> (u1, u2): ``error_l2`` = ||Pi u_h - u|| / ||u||, ``error_h1_semi`` = |.|_1 / |u|_1,
+    ``error_h1`` with the full H1 norm; a degree-5 rule on a triangulation of every cell, the
+    gradient of u by :func:`difference_gradient` with a step of 1e-3 times the body's size."""
     quadrature = reference_quadrature(mesh, degree=5)
     step = 1e-3 * float(np.ptp(mesh.vertices, axis=0).max())
     grad = difference_gradient(u_exact, step)
-    absolute = exact_errors(mesh, projected_solution(mesh, u_vertices), u_exact, grad, quadrature)
-    zero = exact_errors(mesh, projected_solution(mesh, np.zeros_like(u_vertices)), u_exact, grad, quadrature)
+    absolute = exact_errors(mesh, proj, u_exact, grad, quadrature)
+    zero = exact_errors(mesh, _Zero(), u_exact, grad, quadrature)
     tiny = np.finfo(float).tiny
     return {"error_l2": absolute["l2"] / max(zero["l2"], tiny),
             "error_h1_semi": absolute["h1_semi"] / max(zero["h1_semi"], tiny),
             "error_h1": float(np.hypot(absolute["l2"], absolute["h1_semi"]) / max(np.hypot(zero["l2"], zero["h1_semi"]), tiny))}
+
+
+class _Zero:
+    """The zero field as a projection: the norms of the exact solution itself."""
+
+    def evaluate(self, cells, points):
+        return np.zeros((points.shape[0], 2))
+
+    def gradient_at(self, cells, points):
+        return np.zeros((points.shape[0], 2, 2))
+
+
+# --------------------------------------------------------------------------------------------
+# on boundary sides (Gamma_C): the trace of the space
+# --------------------------------------------------------------------------------------------
+def _part_edges(mesh: Mesh, parts) -> np.ndarray:
+    parts = [parts] if isinstance(parts, str) else list(parts)
+    return np.concatenate([np.asarray(mesh.boundary[p], dtype=np.int64).reshape(-1, 2) for p in parts])
+
+
+def boundary_trace(space, parts, node_values: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(P, 2) the trace of a discrete displacement (``node_values`` (n_nodes, 2) of ``space``) on the
+    boundary ``parts`` (a name or names) at ``points`` (P, 2) lying on them (linear between the
+    vertex values for k = 1; the quadratic of Section 3.1 for k = 2). Each point is placed on the
+    nearest edge (O(points x edges) work)."""
+    edges = _part_edges(space.mesh, parts)
+    a, b = space.mesh.vertices[edges[:, 0]], space.mesh.vertices[edges[:, 1]]
+    d = b - a
+    t = np.einsum("pek,ek->pe", points[:, None, :] - a[None], d) / np.sum(d * d, axis=1)[None]
+    t = np.clip(t, 0.0, 1.0)
+    gap = np.linalg.norm(a[None] + t[..., None] * d[None] - points[:, None, :], axis=2)
+    e = np.argmin(gap, axis=1)
+    return space.boundary_trace(edges[e], node_values, t[np.arange(points.shape[0]), e])
+
+
+def trace_error(coarse_space, coarse_values, ref_space, ref_values, parts, points: int = 5) -> float:
+    """||u_h - u_ref||_{L2(parts)} / ||u_ref||_{L2(parts)}: the traces (``boundary_trace``) compared at
+    ``points`` Gauss points on every edge of the reference mesh's ``parts`` (exact for nested meshes)."""
+    edges = _part_edges(ref_space.mesh, parts)
+    s, w = edge_quadrature(points)
+    a, b = ref_space.mesh.vertices[edges[:, 0]], ref_space.mesh.vertices[edges[:, 1]]
+    x = (a[:, None, :] * (1 - s)[None, :, None] + b[:, None, :] * s[None, :, None]).reshape(-1, 2)
+    weights = (np.linalg.norm(b - a, axis=1)[:, None] * w[None, :]).ravel()
+    ref = boundary_trace(ref_space, parts, ref_values, x)
+    diff = boundary_trace(coarse_space, parts, coarse_values, x) - ref
+    return float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)) / np.sum(weights * np.sum(ref**2, axis=1))))
+
+
+def trace_errors(space, parts, node_values, field, subdivisions: int = 4, points: int = 5) -> dict:
+    """The errors on the boundary ``parts`` against a field known everywhere on them, relative to
+    ||u||_{L2(parts)}: ``contact_l2`` = ||u - u_h|| (the discrete trace, ``boundary_trace``) and
+    ``interpolation_contact_l2`` = ||u - I_h u||, I_h u the trace of the interpolant of the space
+    (k = 1: linear between the vertex values; k = 2: the quadratic with the vertex values and the
+    edge mean, Section 3.1) -- the term ||u - u_I||_{L2(Gamma_C)} of the paper's a priori estimate,
+    whose square root gives its O(h^{k/2 + 1/2}) = O(h^{3/2}) claim for k = 2.
+
+    ``field(points (P, 2)) -> (P, 2)``. Every edge is cut into ``subdivisions`` equal pieces with a
+    ``points``-point Gauss rule each (exact for a piecewise quadratic field whose pieces nest)."""
+    edges = _part_edges(space.mesh, parts)
+    s, w = edge_quadrature(points)
+    t = ((np.arange(subdivisions)[:, None] + s[None, :]) / subdivisions).ravel()
+    weights = np.tile(w, subdivisions) / subdivisions
+    a, b = space.mesh.vertices[edges[:, 0]], space.mesh.vertices[edges[:, 1]]
+    x = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]  # (E, Q, 2)
+    lengths = np.linalg.norm(b - a, axis=1)
+    exact = np.asarray(field(x.reshape(-1, 2)), dtype=float).reshape(x.shape)
+    discrete = boundary_trace(space, parts, node_values, x.reshape(-1, 2)).reshape(x.shape)
+    ends = [np.asarray(field(a), dtype=float), np.asarray(field(b), dtype=float)]
+    means = [np.einsum("q,eqk->ek", weights, exact)] * (space.edge_nodes(edges[:1]).shape[1] - 2)
+    trace_weights = space.element.edge_trace(t)  # (Q, k + 1): the interpolant's dofs are end values and means
+    interpolant = sum(trace_weights[None, :, k, None] * dof[:, None] for k, dof in enumerate(ends + means))
+    dx = lengths[:, None] * weights[None, :]
+    norm = np.sqrt(np.sum(dx * np.sum(exact**2, axis=2)))
+    return {"contact_l2": float(np.sqrt(np.sum(dx * np.sum((discrete - exact) ** 2, axis=2))) / norm),
+            "interpolation_contact_l2": float(np.sqrt(np.sum(dx * np.sum((interpolant - exact) ** 2, axis=2))) / norm)}
+
+
+def nesting_subdivisions(mesh: Mesh, ref_mesh: Mesh, parts) -> int:
+    """The power of two m such that 1/m of the longest edge of ``mesh`` on ``parts`` is at most the
+    shortest reference edge there: with nested dyadic meshes, each piece then lies in one reference edge."""
+    def lengths(m):
+        edges = _part_edges(m, parts)
+        return np.linalg.norm(m.vertices[edges[:, 1]] - m.vertices[edges[:, 0]], axis=1)
+
+    ratio = lengths(mesh).max() / lengths(ref_mesh).min()
+    return int(2 ** max(0, int(np.ceil(np.log2(ratio) - 1e-9))))

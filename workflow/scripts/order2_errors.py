@@ -1,7 +1,7 @@
 """Rule order2_errors: the errors of one case of the Section 4 study at every level.
 
 Against the k = 2 reference: Pi_k u_h - Pi_2 u_ref in H1 (full and seminorm) and L2 over the reference
-cells (``vemkit.vem.norms_k2.projection_error_k2``), the trace errors on Gamma_C
+cells (``vemkit.vem.norms.projection_error``), the trace errors on Gamma_C
 (``trace_error``: ||u_h - u_ref||; ``trace_errors``: ||u_ref - I_h u_ref||, the interpolant of order k
 of the reference, the term of the paper's a priori estimate), and where the squared H1-seminorm error sits: within ``region_radius`` of each
 corner of the body and of the contact-zone boundary (the points of Gamma_C where the reference's
@@ -14,17 +14,6 @@ import json
 from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
-
-
-def projected(mesh, ds, values):
-    from vemkit.config.scene import scene_from_yaml
-    from vemkit.vem.norms_k2 import projected_solution_k2
-    from vemkit.vem.projection import projected_solution
-
-    if int(ds.attrs.get("order", 1)) == 1:
-        return projected_solution(mesh, values)
-    lam, mu = scene_from_yaml(ds.attrs["scene"]).lame()
-    return projected_solution_k2(mesh, values, lam, mu)
 
 
 def regions(mesh, ds, radius):
@@ -47,15 +36,17 @@ def regions(mesh, ds, radius):
 with logged(smk):
     from vemkit.config.scene import scene_from_yaml
     from vemkit.io.solution_file import read_solution
-    from vemkit.studies.solution_order import solution_node_values
-    from vemkit.vem.norms import paper_error, reference_quadrature
-    from vemkit.vem.norms_k2 import boundary_trace, nesting_subdivisions, projection_error_k2, trace_error, trace_errors
+    from vemkit.studies.solution_order import projected_solution_file, solution_node_values, solution_space
+    from vemkit.vem.norms import (boundary_trace, nesting_subdivisions, paper_error, projection_error, trace_error,
+                                  trace_errors)
+    from vemkit.vem.quadrature import reference_quadrature
 
     s = smk.params.settings
     case = s["cases"][smk.wildcards.case]
     ref_mesh, ref_ds = read_solution(smk.input.reference)
-    ref_values = solution_node_values(ref_mesh, ref_ds)
-    ref_proj = projected(ref_mesh, ref_ds, ref_values)
+    ref_space = solution_space(ref_mesh, ref_ds)
+    ref_values = solution_node_values(ref_space, ref_ds)
+    ref_proj = projected_solution_file(ref_mesh, ref_ds)
     quadrature = reference_quadrature(ref_mesh, degree=5)
     masks, zone_boundary = regions(ref_mesh, ref_ds, s["region_radius"])
     contact_sides = scene_from_yaml(ref_ds.attrs["scene"]).contact_sides
@@ -63,19 +54,20 @@ with logged(smk):
     paper_mesh = paper_values = None
     if case["order"] == 1:
         paper_mesh, paper_ds = read_solution(smk.input.paper_reference)
-        paper_values = solution_node_values(paper_mesh, paper_ds)
+        paper_values = solution_node_values(solution_space(paper_mesh, paper_ds), paper_ds)
     records = []
     for n, path in zip(case["levels"], smk.input.solutions, strict=True):
         mesh, ds = read_solution(path)
-        values = solution_node_values(mesh, ds)
-        err = projection_error_k2(mesh, projected(mesh, ds, values), ref_mesh, ref_proj, quadrature, masks)
-        interpolation = trace_errors(mesh, contact_sides, values,
-                                     lambda p: boundary_trace(ref_mesh, contact_sides, ref_values, p),
+        space = solution_space(mesh, ds)
+        values = solution_node_values(space, ds)
+        err = projection_error(mesh, projected_solution_file(mesh, ds), ref_mesh, ref_proj, quadrature, masks)
+        interpolation = trace_errors(space, contact_sides, values,
+                                     lambda p: boundary_trace(ref_space, contact_sides, ref_values, p),
                                      nesting_subdivisions(mesh, ref_mesh, contact_sides))
         record = {"study": "paper", "case": smk.wildcards.case, "family": case["family"], "order": case["order"], "n": n,
                   "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])), "n_unknowns": int(ds.attrs["n_dofs"]),
                   "n_cells": int(mesh.n_cells), "error_h1": err["h1"], "error_h1_semi": err["h1_semi"],
-                  "error_l2": err["l2"], "error_contact_l2": trace_error(mesh, values, ref_mesh, ref_values, contact_sides),
+                  "error_l2": err["l2"], "error_contact_l2": trace_error(space, values, ref_space, ref_values, contact_sides),
                   "error_interpolation_contact_l2": interpolation["interpolation_contact_l2"],
                   "error_paper": float(paper_error(mesh, values, paper_mesh, paper_values)) if paper_mesh else float("nan"),
                   "iterations": int(ds.attrs["iterations"]), "wall_time": float(ds.attrs["wall_time"]),

@@ -2,7 +2,7 @@
 contact solution, at every level, against the exact u of the scene (``exact:``).
 
 H1, H1-seminorm and L2 errors of Pi_k u_h are the solve's own attributes (SPEC §7, relative); on
-Gamma_C, ``vemkit.vem.norms_k2.trace_errors`` gives ||u - u_h|| and ||u - I_h u|| (the interpolant of
+Gamma_C, ``vemkit.vem.norms.trace_errors`` gives ||u - u_h|| and ||u - I_h u|| (the interpolant of
 the same order: the term of the paper's a priori estimate). Where the discrete solution changes
 between separated and in contact is recorded (the exact one separates at x0 = 3/5 in ``separation``).
 """
@@ -37,8 +37,8 @@ def contact_zone_boundary(ds):
 with logged(smk):
     from vemkit.config.scene import scene_from_yaml
     from vemkit.io.solution_file import read_solution
-    from vemkit.studies.solution_order import solution_node_values
-    from vemkit.vem.norms_k2 import trace_errors
+    from vemkit.studies.solution_order import solution_node_values, solution_space
+    from vemkit.vem.norms import trace_errors
 
     s = smk.params.settings
     case = s["cases"][smk.wildcards.case]
@@ -46,7 +46,8 @@ with logged(smk):
     for n, path in zip(case["levels"], smk.input.solutions, strict=True):
         mesh, ds = read_solution(path)
         scene = scene_from_yaml(ds.attrs["scene"])
-        trace = trace_errors(mesh, scene.contact_sides, solution_node_values(mesh, ds), exact_trace(scene))
+        space = solution_space(mesh, ds)
+        trace = trace_errors(space, scene.contact_sides, solution_node_values(space, ds), exact_trace(scene))
         record = {"study": smk.wildcards.scene, "case": smk.wildcards.case, "family": case["family"],
                   "order": case["order"], "n": n, "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])),
                   "n_unknowns": int(ds.attrs["n_dofs"]), "n_cells": int(mesh.n_cells),

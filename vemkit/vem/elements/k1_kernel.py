@@ -13,9 +13,9 @@ mean of Pi v equals that of v, and the vertex mean of x x Pi v equals that of x 
 The local form (3.9) is a_h^K = |K| B^T D B + alpha_K (I - Pi)^T (I - Pi), with the dofi-dofi
 stabilization S_K of the paper and the scaling alpha_K named by ``stabilization``.
 
-Two implementations: the Numba kernel ``element_stiffness`` used by the assembly, and
-``element_stiffness_reference``, a plain numpy twin that solves (3.8) literally with boundary
-integrals and a 6 x 6 system, used by the tests to pin the kernel.
+The Numba kernel ``element_stiffness`` is used by the assembly; its plain-numpy twin, which solves
+(3.8) literally with boundary integrals and a 6 x 6 system, is ``k1_reference.element_stiffness_reference``
+(the tests pin the kernel against it).
 """
 
 from __future__ import annotations
@@ -23,23 +23,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from vemkit.mesh.geometry import polygon_area, polygon_areas
+from vemkit.mesh.geometry import polygon_area
 
-STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
-
-
-def stabilization_code(name: str) -> int:
-    try:
-        return STABILIZATIONS.index(name)
-    except ValueError:
-        raise ValueError(
-            f"stabilization {name!r} is unknown; use one of {', '.join(STABILIZATIONS)}"
-        ) from None
-
-
-# --------------------------------------------------------------------------------------------
-# Numba kernel
-# --------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
 def polygon_coordinates(vertices, ids, start, n):
     """(px, py) of the n vertices ids[start:start + n]."""
@@ -178,68 +163,26 @@ def element_stiffness(px, py, lam, mu, stab, K, B, P, R):
 
 
 # --------------------------------------------------------------------------------------------
-# numpy twin: the projection (3.8) solved literally
+# the element's hooks for the one assembly of ``vemkit.vem.assembly`` (``vemkit.vem.elements``)
 # --------------------------------------------------------------------------------------------
-def _p1_basis(xb, yb):
-    """[P1]^2 basis: two translations, a rotation, three strain modes; each as (A, c): q(x) = A x + c."""
-    mats = [
-        np.zeros((2, 2)),
-        np.zeros((2, 2)),
-        np.array([[0.0, -1.0], [1.0, 0.0]]),
-        np.array([[1.0, 0.0], [0.0, 0.0]]),
-        np.array([[0.0, 0.0], [0.0, 1.0]]),
-        np.array([[0.0, 1.0], [1.0, 0.0]]),
-    ]
-    consts = [np.array([1.0, 0.0]), np.array([0.0, 1.0])] + [-(A @ [xb, yb]) for A in mats[2:]]
-    return mats, consts
+@numba.njit(cache=True)
+def workspace(max_nodes):
+    """(K, B, P, R, px, py): the work arrays of ``cell_matrix`` for cells of up to max_nodes vertices."""
+    m = 2 * max_nodes
+    return (np.empty((m, m)), np.empty((3, m)), np.empty((6, m)), np.empty((m, m)), np.empty(max_nodes),
+            np.empty(max_nodes))
 
 
-def element_stiffness_reference(coords, lam, mu, stabilization="dofi-2mu"):
-    """Local stiffness by solving (3.8) with the paper's constraints; returns (K, Pi_D)."""
-    coords = np.asarray(coords, float)
-    n = coords.shape[0]
-    x, y = coords[:, 0], coords[:, 1]
-    area = float(polygon_areas(coords, [0, n])[0])
-    xb, yb = coords.mean(axis=0)
-    mats, consts = _p1_basis(xb, yb)
-    C = lambda e: lam * np.trace(e) * np.eye(2) + 2 * mu * e  # noqa: E731  (SPEC §1)
-    sym = lambda A: 0.5 * (A + A.T)  # noqa: E731
-    stress = [C(sym(A)) for A in mats]
-    # a_K(phi_j, q) = int_dK (C eps(q) n) . phi_j ds, phi_j linear on each edge (trapezoid exact)
-    rhs_strain = np.zeros((3, 2 * n))
-    for e in range(n):
-        a, b = e, (e + 1) % n
-        t = coords[b] - coords[a]
-        normal_len = np.array([t[1], -t[0]])  # |e| * outward normal (CCW polygon)
-        for beta in range(3):
-            traction = stress[3 + beta] @ normal_len
-            for v in (a, b):
-                rhs_strain[beta, 2 * v : 2 * v + 2] += 0.5 * traction
-    G = np.array([[area * np.tensordot(sym(mats[a]), stress[b]) for b in range(6)] for a in range(6)])
-    # constraint rows: vertex means of the two components, vertex mean of x x q
-    def vertex_values(alpha):
-        return coords @ mats[alpha].T + consts[alpha]
-
-    system = np.zeros((6, 6))
-    rhs = np.zeros((6, 2 * n))
-    for alpha in range(6):
-        vals = vertex_values(alpha)
-        system[0, alpha] = vals[:, 0].mean()
-        system[1, alpha] = vals[:, 1].mean()
-        system[2, alpha] = np.mean(x * vals[:, 1] - y * vals[:, 0])
-        system[3:, alpha] = G[3:, alpha]
+@numba.njit(cache=True)
+def cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work):
+    """The local stiffness (3.9) of cell c in its vertex order, in the leading 2n x 2n block of the
+    returned work matrix."""
+    K, B, P, R, px, py = work
+    start = offsets[c]
+    n = offsets[c + 1] - start
     for i in range(n):
-        rhs[0, 2 * i] = 1.0 / n
-        rhs[1, 2 * i + 1] = 1.0 / n
-        rhs[2, 2 * i] = -y[i] / n
-        rhs[2, 2 * i + 1] = x[i] / n
-    rhs[3:] = rhs_strain
-    coef = np.linalg.solve(system, rhs)  # (6, 2n): Pi phi_j in the basis
-    D = np.zeros((2 * n, 6))
-    for alpha in range(6):
-        D[:, alpha] = vertex_values(alpha).ravel()
-    Pi = D @ coef
-    K_consistency = coef.T @ G @ coef
-    alpha_K = {"dofi": 1.0, "dofi-2mu": 2 * mu, "trace": np.trace(K_consistency) / (2 * n)}[stabilization]
-    R = np.eye(2 * n) - Pi
-    return K_consistency + alpha_K * R.T @ R, Pi
+        px[i] = vertices[nodes[start + i], 0]
+        py[i] = vertices[nodes[start + i], 1]
+    m = 2 * n
+    element_stiffness(px[:n], py[:n], lam, mu, stab, K[:m, :m], B[:, :m], P[:, :m], R[:m, :m])
+    return K

@@ -1,4 +1,4 @@
-"""Plain-numpy twin of the k = 2 element (``vemkit.vem.element_k2``): the projection (3.8) solved literally.
+"""Plain-numpy twin of the k = 2 element (``vemkit.vem.elements.k2_kernel``): the projection (3.8) solved literally.
 
 Independent of the kernel on purpose: scaled monomials about the vertex mean with h = diam(K),
 integrals over K by a degree-5 rule on the signed triangles (vertex mean, x_i, x_{i+1}) (exact for
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.vem.load import TRIANGLE_RULE
+from vemkit.vem.quadrature import TRIANGLE_RULE
 
 EXPONENTS = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]
 

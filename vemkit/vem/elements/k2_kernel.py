@@ -31,7 +31,7 @@ The kernel works in the basis of [P2]^2 made of the rigid motions (1,0), (0,1), 
 non-rigid fields (xi, 0), (0, eta), (eta, xi), (xi^2, 0), (xi eta, 0), (eta^2, 0), (0, xi^2),
 (0, xi eta), (0, eta^2), with (xi, eta) = (x - x_K) / h, x_K the centroid and h the largest
 centroid-vertex distance. The local stiffness (3.9) built on this projection is in
-``vemkit.vem.stiffness_k2``. The plain-numpy twin ``element_k2_reference`` solves (3.8) and the
+``vemkit.vem.elements.k2_stiffness``. The plain-numpy twin ``vemkit.vem.elements.k2_reference`` solves (3.8) and the
 constraints literally as one saddle-point system; the tests pin the kernels against it.
 """
 
@@ -42,7 +42,7 @@ import math
 import numba
 import numpy as np
 
-from vemkit.vem.element import polygon_coordinates
+from vemkit.vem.elements.k1_kernel import polygon_coordinates
 
 N_BASIS = 12
 # strain of the 9 non-rigid fields times h: STRAIN[b, (eps11, eps22, eps12), (1, xi, eta)]

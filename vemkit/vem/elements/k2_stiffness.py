@@ -1,4 +1,4 @@
-"""The local k = 2 stiffness (3.9) from the projection of ``vemkit.vem.element_k2``, in low-rank form.
+"""The local k = 2 stiffness (3.9) from the projection of ``vemkit.vem.elements.k2_kernel``, in low-rank form.
 
 A[k, j] = dof k of Pi phi_j = E_k . C_j, with C_j the monomial coefficients of the two components
 of Pi phi_j and E_k the dofs of the monomials (1, xi, eta, xi^2, xi eta, eta^2) at the place of
@@ -12,7 +12,7 @@ Q = sum_k E_k E_k^T = L L^T (6 x 6 per component), Y = L_G^-1 rhs and F_k = L^-1
 So K_ij = W_i . W_j + alpha (delta_ij - H_ij), W_j = (Y_j, sqrt(alpha) V_j) (21 numbers) and
 H_ij = F_i . F_j the hat matrix of the monomials' dofs (zero between the two components): one short
 dot product per entry, no m x m x m product, no per-cell allocation. The tests pin the result
-against the plain-numpy twin ``element_k2_reference`` (the dense (I - Pi)^T (I - Pi) of (3.9)).
+against the plain-numpy twin ``vemkit.vem.elements.k2_reference`` (the dense (I - Pi)^T (I - Pi) of (3.9)).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import math
 import numba
 import numpy as np
 
-from vemkit.vem.element import stabilization_code
-from vemkit.vem.element_k2 import cholesky_factor, projection_system
+from vemkit.vem.elements.base import stabilization_code
+from vemkit.vem.elements.k2_kernel import cholesky_factor, projection_system
 
 N_ENERGY = 24  # length of the energy vectors W: Y (9), V (2 x 6), zero padding (3: three vector lanes)
 
@@ -221,4 +221,31 @@ def element_stiffness_k2_matrix(coords, lam, mu, stabilization="dofi-2mu"):
     K = np.empty((m, m))
     element_stiffness_k2(c[:, 0].copy(), c[:, 1].copy(), float(lam), float(mu), stabilization_code(stabilization),
                          K, stiffness_workspace(n))
+    return K
+
+
+# --------------------------------------------------------------------------------------------
+# the element's hooks for the one assembly of ``vemkit.vem.assembly`` (``vemkit.vem.elements``)
+# --------------------------------------------------------------------------------------------
+@numba.njit(cache=True)
+def workspace(max_nodes):
+    """(K, stiffness work, px, py): the work arrays of ``cell_matrix`` for cells of up to max_nodes
+    nodes (2n + 1 for n vertices)."""
+    nmax = (max_nodes - 1) // 2
+    mmax = 4 * nmax + 2
+    return np.empty((mmax, mmax)), stiffness_workspace(nmax), np.empty(nmax), np.empty(nmax)
+
+
+@numba.njit(cache=True)
+def cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work):
+    """The local stiffness (3.9) of cell c in its node order (vertices, edges, the cell), in the
+    leading (4n + 2) x (4n + 2) block of the returned work matrix."""
+    K, stiffness_work, px, py = work
+    start = offsets[c]
+    n = (offsets[c + 1] - start - 1) // 2
+    for i in range(n):
+        px[i] = vertices[nodes[start + i], 0]
+        py[i] = vertices[nodes[start + i], 1]
+    # the work arrays are passed whole (C-contiguous, faster loops); the kernel uses their leading part
+    element_stiffness_k2(px[:n], py[:n], lam, mu, stab, K, stiffness_work)
     return K

@@ -1,11 +1,11 @@
-"""Sparsity pattern of the global k = 2 matrix (``vemkit.vem.assembly_k2``), straight at the dof level.
+"""Sparsity pattern of the global matrix of any element, straight at the dof level.
 
-Free node r couples with every free node of the cells around it. The k = 1 builders
-(``vemkit.vem.assembly.vertex_adjacency`` then ``dof_pattern``) sort each candidate list with its
-duplicates and write a node pattern before expanding it; at k = 2 a vertex row has 4 x 9 candidates
-on quadrilaterals and the matrix 7 times the entries of k = 1 per node, so here the duplicates are
-dropped by a sparse set as they come, only the distinct columns are sorted, and the int32 dof
-indices (2 x 2 blocks) are written directly, by numpy-allocated memory (huge pages).
+Free node r couples with every free node of the cells around it (the cells' node lists of
+``Element.cell_nodes``). A row's candidates hold each neighbour once per shared cell (a vertex row of
+a k = 2 quadrilateral mesh has 4 x 9 of them), so the duplicates are dropped by a sparse set as they
+come, only the distinct columns are sorted, and the int32 dof indices (2 x 2 blocks) are written
+directly, by numpy-allocated memory (huge pages). The rows are split into ``ROW_CHUNKS`` contiguous
+shares, one thread each (the same shares as the parallel assembly of ``vemkit.vem.assembly``).
 """
 
 from __future__ import annotations
@@ -13,7 +13,44 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from vemkit.vem.assembly import ROW_CHUNKS, chunk_rows, sort_prefix
+ROW_CHUNKS = 8  # threads' shares of the rows in the parallel pattern and assembly
+
+
+@numba.njit(cache=True)
+def chunk_rows(chunk, n_rows):
+    """The rows [lo, hi) of one of the ROW_CHUNKS contiguous shares."""
+    return chunk * n_rows // ROW_CHUNKS, (chunk + 1) * n_rows // ROW_CHUNKS
+
+
+@numba.njit(cache=True)
+def sort_prefix(buf, k):
+    """Sort buf[:k] in place (insertion sort: the rows of a sparsity pattern hold a few dozen columns)."""
+    for i in range(1, k):
+        x = buf[i]
+        j = i - 1
+        while j >= 0 and buf[j] > x:
+            buf[j + 1] = buf[j]
+            j -= 1
+        buf[j + 1] = x
+
+
+@numba.njit(cache=True)
+def node_cells(offsets, nodes, n_nodes):
+    """CSR (ptr, cells) of the cells around every node (cells in increasing order)."""
+    n_cells = offsets.shape[0] - 1
+    ptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    for p in range(nodes.shape[0]):
+        ptr[nodes[p] + 1] += 1
+    for v in range(n_nodes):
+        ptr[v + 1] += ptr[v]
+    cells = np.empty(nodes.shape[0], dtype=np.int64)
+    fill = ptr[:-1].copy()
+    for c in range(n_cells):
+        for p in range(offsets[c], offsets[c + 1]):
+            v = nodes[p]
+            cells[fill[v]] = c
+            fill[v] += 1
+    return ptr, cells
 
 
 @numba.njit(cache=True)
@@ -66,7 +103,7 @@ def _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, bu
 
 @numba.njit(cache=True, parallel=True)
 def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
-    """indptr of ``dof_pattern_k2``: the number of distinct free nodes around each free node, doubled."""
+    """indptr of ``dof_pattern``: the number of distinct free nodes around each free node, doubled."""
     n_free = free_nodes.shape[0]
     degree = np.empty(n_free, dtype=np.int64)
     for chunk in numba.prange(ROW_CHUNKS):
@@ -84,7 +121,7 @@ def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
 
 @numba.njit(cache=True, parallel=True)
 def _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices):
-    """The sorted columns of ``dof_pattern_k2`` into indices, each thread its own contiguous rows."""
+    """The sorted columns of ``dof_pattern`` into indices, each thread its own contiguous rows."""
     n_free = free_nodes.shape[0]
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, n_free)
@@ -93,8 +130,8 @@ def _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr,
             _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices)
 
 
-def dof_pattern_k2(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
-    """CSR pattern (indptr, int32 indices, sorted) of the k = 2 matrix: scalar rows 2r + a hold
+def dof_pattern(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
+    """CSR pattern (indptr, int32 indices, sorted) of the global matrix: scalar rows 2r + a hold
     (2c, 2c + 1) for every free node c sharing a cell with the free node r. The indices are
     allocated here, by numpy (large arrays on huge pages: fewer page faults when first written)."""
     indptr = _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index)

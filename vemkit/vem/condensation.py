@@ -1,0 +1,103 @@
+"""Static condensation of the interior nodes: the condensed load and the recovery of the eliminated dofs.
+
+An element's interior node (the k = 2 cell mean, Section 3.1: its interior moment; the last of the
+cell's nodes, ``Element.condensed_nodes``) couples only with the nodes of its own cell, so it can be
+eliminated cell by cell, exactly: with b the other scalars of a cell and c its interior scalars,
+
+    K_bb u_b + K_bc u_c = f_b,   K_cb u_b + K_cc u_c = f_c
+    =>  (K_bb - K_bc K_cc^-1 K_cb) u_b = f_b - K_bc K_cc^-1 f_c,   u_c = K_cc^-1 (f_c - K_cb u_b).
+
+The Schur complement is summed element by element while assembling (``DofMap.condensed``,
+``vemkit.vem.assembly.condense_interior``); :func:`condense_load` gives the right-hand side, and
+:func:`recover_interior` the eliminated values from the solution. The contact terms act on Gamma_C
+nodes only, so they commute with the elimination. For k = 2 the condensed system has a quarter fewer
+unknowns and, measured on the paper scene at 131 584 dofs, needs half the AMG-CG iterations of the
+full one (the cell means are poorly represented by aggregation of the rigid modes).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from vemkit.vem.assembly import largest_cell, specialized
+from vemkit.vem.elements import stabilization_code
+
+CELL_CHUNKS = 8  # threads' shares of the cells in the recovery
+
+
+@numba.njit(cache=True)
+def interior_solve(K, size, r0, r1):
+    """K_cc^-1 (r0, r1) for the interior node (the last of ``size``) of an element matrix."""
+    c = 2 * (size - 1)
+    a, b, d, e = K[c, c], K[c, c + 1], K[c + 1, c], K[c + 1, c + 1]
+    det = a * e - b * d
+    return (e * r0 - b * r1) / det, (a * r1 - d * r0) / det
+
+
+def condense(vertices, offsets, nodes, free_index, interior_load, lam, mu, stab, out):
+    """*Template.* out[free b] -= K_bc K_cc^-1 f_c over the cells with a non-zero interior load f_c (M, 2)."""
+    work = workspace(largest_cell(offsets))  # noqa: F821 (bound by ``specialized``)
+    for c in range(offsets.shape[0] - 1):
+        if interior_load[c, 0] == 0.0 and interior_load[c, 1] == 0.0:
+            continue
+        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        start = offsets[c]
+        size = offsets[c + 1] - start
+        z0, z1 = interior_solve(K, size, interior_load[c, 0], interior_load[c, 1])
+        ci = 2 * (size - 1)
+        for i in range(size - 1):
+            r = free_index[nodes[start + i]]
+            if r < 0:
+                continue
+            for a in range(2):
+                out[2 * r + a] -= K[2 * i + a, ci] * z0 + K[2 * i + a, ci + 1] * z1
+
+
+def recover(vertices, offsets, nodes, u, interior_load, lam, mu, stab):
+    """*Template* (parallel). u[interior node] = K_cc^-1 (f_c - K_cb u_b) for every cell (u: (n_nodes, 2))."""
+    n_cells = offsets.shape[0] - 1
+    max_nodes = largest_cell(offsets)
+    for chunk in numba.prange(CELL_CHUNKS):
+        work = workspace(max_nodes)  # noqa: F821
+        for c in range(chunk * n_cells // CELL_CHUNKS, (chunk + 1) * n_cells // CELL_CHUNKS):
+            K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+            start = offsets[c]
+            size = offsets[c + 1] - start
+            ci = 2 * (size - 1)
+            r0, r1 = interior_load[c, 0], interior_load[c, 1]
+            for j in range(size - 1):
+                g = nodes[start + j]
+                r0 -= K[ci, 2 * j] * u[g, 0] + K[ci, 2 * j + 1] * u[g, 1]
+                r1 -= K[ci + 1, 2 * j] * u[g, 0] + K[ci + 1, 2 * j + 1] * u[g, 1]
+            u[nodes[start + size - 1], 0], u[nodes[start + size - 1], 1] = interior_solve(K, size, r0, r1)
+
+
+def interior_load(space, load_nodes) -> np.ndarray:
+    """(M, 2) the part of a full load (n_nodes, 2) on the interior (cell) nodes: what recovery needs."""
+    first = space.element.first_node(space.mesh, "cell")
+    return np.ascontiguousarray(np.asarray(load_nodes, dtype=float).reshape(-1, 2)[first:])
+
+
+def condense_load(space, lam: float, mu: float, stabilization: str, dofs, load_nodes) -> np.ndarray:
+    """The condensed load f_b - K_bc K_cc^-1 f_c on the free dofs of a condensed ``dofs``, from the
+    full load ``load_nodes`` (n_nodes, 2)."""
+    if not dofs.condensed:
+        raise ValueError("condense_load needs a condensed DofMap (VirtualElementSpace.numbering(condensed=True))")
+    offsets, nodes = space.cell_nodes
+    out = dofs.restrict(load_nodes)
+    specialized(condense, space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index,
+                                         interior_load(space, load_nodes), float(lam), float(mu),
+                                         stabilization_code(stabilization), out)
+    return out
+
+
+def recover_interior(space, lam: float, mu: float, stabilization: str, node_values, interior_loads) -> np.ndarray:
+    """(n_nodes, 2) ``node_values`` with its interior nodes recomputed from the other nodes of their cell
+    and the load on the interior nodes ``interior_loads`` (M, 2): u_c = K_cc^-1 (f_c - K_cb u_b)."""
+    offsets, nodes = space.cell_nodes
+    u = np.array(node_values, dtype=float).reshape(-1, 2)
+    specialized(recover, space.element, parallel=True)(
+        space.mesh.vertices, offsets, nodes, u, np.ascontiguousarray(interior_loads, dtype=float).reshape(-1, 2),
+        float(lam), float(mu), stabilization_code(stabilization))
+    return u

@@ -1,0 +1,94 @@
+"""The element interface: what one virtual element tells the space, the assembly and the solvers.
+
+An element is a plug-in (scikit-fem's design): it declares its degrees of freedom per mesh entity
+and its local kernels, while one numbering (``vemkit.vem.dofs``), one space
+(``vemkit.vem.space.VirtualElementSpace``) and one assembly (``vemkit.vem.assembly``) serve every
+element. A *node* is a place that carries one displacement vector (``dimension`` scalars): a
+vertex value, an edge mean, a cell mean. Global node numbers run over the entities in the order
+vertices, edges, cells (``layout``). Each element module provides:
+
+``order``, ``dimension``, ``layout``
+    k of Section 3, d, and the nodes per entity: {"vertex": 1} for k = 1; {"vertex": 1, "edge": 1,
+    "cell": 1} for k = 2 (the moments of Section 3.1 scaled as means).
+``condensed_nodes``
+    how many of a cell's local nodes (its last ones) are interior: they couple only within the cell
+    and are eliminated cell by cell (static condensation).
+``numbering``
+    "mesh": free nodes numbered in the mesh's order; "cells": in the order of their first appearance
+    along a Morton curve of the cells (locality when a cell has edge and cell nodes).
+``cell_nodes(mesh)``
+    CSR (offsets, nodes) of every cell's nodes in the kernel's local order.
+``workspace(max_nodes)``, ``cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)``
+    Numba functions: work arrays, and the local stiffness (3.9) of cell c (consistency plus the
+    stabilization S_K scaled by ``stab``) in the leading block of the matrix returned.
+``traction_load(mesh, edges, traction)``, ``body_force_load(mesh, field, lam, mu, projection)``
+    the load vector of Section 3.3, (n_nodes, d).
+``project(mesh, node_values, lam, mu)``
+    Pi u_h (3.8) on every cell: an object with ``evaluate(cells, points)``,
+    ``gradient_at(cells, points)`` and ``cell_mean_strain()``; ``projection_uses_material``: whether
+    Pi depends on the Lame parameters (the energy projection of k >= 2 does; k = 1's is geometric).
+``interpolate(mesh, field)``, ``dirichlet_components(mesh, dirichlet)``, ``node_coordinates(mesh)``
+    the degrees of freedom of a field, of Dirichlet data, and where the nodes are.
+``edge_trace(s)``
+    (P, k + 1) the weights of the trace on an edge at parameters s in [0, 1] on the edge's nodes
+    (its two vertices, then its edge nodes).
+``contact_rule``
+    the nodal quadrature on Gamma_C: (parameter, weight) per trace node of an edge -- the
+    trapezoid for k = 1, Simpson's rule for k = 2 (``vemkit.contact.boundary``).
+"""
+
+from __future__ import annotations
+
+STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
+
+
+def stabilization_code(name: str) -> int:
+    """The kernels' code of a stabilization scaling alpha_K (SPEC §3): 0 dofi, 1 dofi-2mu, 2 trace."""
+    try:
+        return STABILIZATIONS.index(name)
+    except ValueError:
+        raise ValueError(
+            f"stabilization {name!r} is unknown; use one of {', '.join(STABILIZATIONS)}"
+        ) from None
+
+
+ENTITIES = ("vertex", "edge", "cell")  # the order of global node numbers
+
+
+class Element:
+    """The interface (module docstring); the elements are the subclasses in ``k1`` and ``k2``."""
+
+    name: str
+    order: int
+    dimension: int = 2
+    layout: dict
+    condensed_nodes: int = 0
+    numbering: str = "mesh"
+    projection_uses_material: bool = True
+    stress_degree: int = 1  # degree of sigma(Pi u_h) on a cell: k - 1
+    polynomial_on_triangles: bool = False  # V_h^K = [P_k]^2 on triangles: Pi = I, the stabilization vanishes
+    contact_rule: tuple  # ((s, weight), ...) per trace node of an edge, in ``edge_trace`` order
+
+    def __repr__(self) -> str:
+        return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"
+
+    def n_nodes(self, mesh) -> int:
+        counts = {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
+                  "cell": mesh.n_cells}
+        return sum(self.layout.get(entity, 0) * counts[entity] for entity in ENTITIES)
+
+    def first_node(self, mesh, entity: str) -> int:
+        """The global number of the first node on ``entity`` (nodes run vertices, edges, cells)."""
+        total = 0
+        for other in ENTITIES:
+            if other == entity:
+                return total
+            count = {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
+                     "cell": mesh.n_cells}[other]
+            total += self.layout.get(other, 0) * count
+        raise ValueError(entity)
+
+    def count_dofs(self, vertices: int, edges: int, cells: int) -> int:
+        """Scalar degrees of freedom of the space on a mesh with these entity counts (resource checks)."""
+        counts = {"vertex": vertices, "edge": edges, "cell": cells}
+        return self.dimension * sum(self.layout.get(e, 0) * counts[e] for e in ENTITIES)
