@@ -117,7 +117,8 @@ class _Parser:
             return Node("neg", (operand,)) if isinstance(node.op, ast.USub) else operand
         if isinstance(node, (ast.BinOp, ast.UnaryOp)):
             symbol = _SYMBOLS.get(type(node.op), "?")
-            where = " (they combine conditions inside where(...))" if symbol in ("&", "|", "not") else ""
+            where = (f" (it joins conditions in where(...): write (x < 1) {symbol} (y < 1))" if symbol in ("&", "|")
+                     else " (it negates a condition in where(...))" if symbol == "not" else "")
             raise self.fail(f"operator {symbol!r} is not allowed in an expression{where}")
         if isinstance(node, ast.Call):
             return self.call(node, depth)
