@@ -218,24 +218,54 @@ def _operation(op: str):
     return function
 
 
+def _program(node: Node, steps: list, slots: dict):
+    """Append the steps computing ``node`` once (a subtree shared by several parents, as derivatives
+    share them, is computed once); returns its slot index or its folded constant (np.float64)."""
+    key = id(node)
+    if key in slots:
+        return slots[key]
+    if node.op == "num":
+        result = np.float64(node.value)
+    elif node.op == "var":
+        result = VARIABLES.index(node.value)  # slots 0, 1, 2 hold x, y, z
+    else:
+        operator = _operation(node.op)
+        arguments = [_program(arg, steps, slots) for arg in node.args]
+        if all(isinstance(a, np.float64) for a in arguments):
+            with np.errstate(all="ignore"):
+                result = np.float64(operator(*arguments))
+        else:
+            steps.append((operator, arguments))
+            result = len(VARIABLES) + len(steps) - 1
+    slots[key] = result  # id() is safe: every node stays referenced by the tree while this runs
+    return result
+
+
 def evaluator(node: Node):
     """``("const", float)`` or ``("func", f(x, y, z))`` evaluating ``node`` with numpy in float64
-    (conditions as 1.0/0.0); constant subtrees are folded. Non-finite values are not checked here."""
-    if node.op == "num":
-        return ("const", float(node.value))
-    if node.op == "var":
-        index = VARIABLES.index(node.value)
-        return ("func", (lambda x, y, z: x, lambda x, y, z: y, lambda x, y, z: z)[index])
-    operator = _operation(node.op)
-    arguments = [evaluator(arg) for arg in node.args]
-    if all(kind == "const" for kind, _ in arguments):
-        with np.errstate(all="ignore"):
-            return ("const", float(operator(*[np.float64(v) for _, v in arguments])))
-    parts = [(lambda x, y, z, v=np.float64(v): v) if kind == "const" else v for kind, v in arguments]
-    if len(parts) == 1:
-        (part,) = parts
-        return ("func", lambda x, y, z: operator(part(x, y, z)))
-    if len(parts) == 2:
-        first, second = parts
-        return ("func", lambda x, y, z: operator(first(x, y, z), second(x, y, z)))
-    return ("func", lambda x, y, z: operator(*[part(x, y, z) for part in parts]))
+    (conditions as 1.0/0.0) in time linear in the number of distinct subtrees; constant subtrees are
+    folded. Non-finite values are not checked here."""
+    steps: list = []
+    result = _program(node, steps, {})
+    if isinstance(result, np.float64):
+        return ("const", float(result))
+    if not steps:  # a bare variable
+        return ("func", lambda *points: points[result])
+    last_use = {}
+    for index, (_, arguments) in enumerate(steps):
+        for a in arguments:
+            if not isinstance(a, np.float64):
+                last_use[a] = index
+    plan = [(operator, arguments, {a for a in arguments if not isinstance(a, np.float64)
+                                   and a >= len(VARIABLES) and last_use[a] == index})
+            for index, (operator, arguments) in enumerate(steps)]
+
+    def run(x, y, z):
+        values = [x, y, z] + [None] * len(plan)
+        for index, (operator, arguments, done) in enumerate(plan, start=len(VARIABLES)):
+            values[index] = operator(*[a if isinstance(a, np.float64) else values[a] for a in arguments])
+            for a in done:  # free intermediate arrays after their last use
+                values[a] = None
+        return values[-1]
+
+    return ("func", run)
