@@ -87,3 +87,20 @@ def test_derivatives_and_fields_survive_pickling():
     derivative = pickle.loads(pickle.dumps(field.components[0].derivative("y")))
     assert derivative.name == "d/dy of u1"
     np.testing.assert_allclose(derivative(2.0, 1.0), 2.0 / 5.0, rtol=1e-15)
+
+
+def test_the_derivative_of_a_deep_chain_is_the_chain_rule_product_in_linear_time():
+    """d/dx of sin(sin(...sin(x))) (99 deep) = the product of cos of every inner value; its tree
+    shares the inner values, so it is evaluated at 1e5 points in well under 3 s (2 shared cores)."""
+    import time
+
+    points = np.linspace(0.1, 0.9, 100_000)
+    started = time.perf_counter()
+    mine = compile_expression("sin(" * 99 + "x" + ")" * 99, name="u").derivative("x")(points, 0.0)
+    elapsed = time.perf_counter() - started
+    inner, product = points, np.ones_like(points)
+    for _ in range(99):
+        product *= np.cos(inner)
+        inner = np.sin(inner)
+    np.testing.assert_allclose(mine, product, rtol=1e-12)
+    assert elapsed < 3.0, elapsed
