@@ -111,3 +111,24 @@ def test_bad_text_is_refused_naming_the_key_and_the_fix(text):
     assert "\n" not in message and message.startswith("contact.gap = ")
     assert REFUSED[text] in message
     assert "where(condition, a, b)" in ALLOWED and "atan2" in ALLOWED
+
+
+@pytest.mark.parametrize("override, key", [
+    ("body_force=[0, 'z']", "body_force[1]"),
+    ("contact.gap=0.1+z", "contact.gap"),
+    ("boundary.neumann.top.traction=['sin(z)', 0]", "boundary.neumann.top.traction[0]"),
+    ("boundary.dirichlet={right: [0, 'z*y']}", "boundary.dirichlet.right[1]"),
+    ("exact={displacement: [x, 'x*z']}", "exact.displacement[1]"),
+])
+def test_a_2d_scene_refuses_z_naming_the_key(override, key):
+    from pathlib import Path
+
+    from vemkit.config.scene import load_scene
+    from vemkit.exceptions import SceneError
+
+    paper = load_scene(Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml")
+    with pytest.raises(SceneError) as caught:
+        paper.with_overrides([override])
+    message = str(caught.value)
+    assert message.startswith(f"{key} = ") and "uses z, but this scene is 2D" in message and "\n" not in message
+    assert caught.value.key == key
