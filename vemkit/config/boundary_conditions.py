@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.config.domain import Domain
+from vemkit.config.expression_tree import shorten
 from vemkit.config.expressions import Expression, compile_expression
 from vemkit.exceptions import ExpressionError, SceneError
 
@@ -58,10 +59,15 @@ def inside_points(domain: Domain):
 
 
 def compile_checked(key: str, value) -> Expression:
+    """The expression of scene key ``key``; a 2D scene's expressions take x and y only (SPEC §10)."""
     try:
-        return compile_expression(value, name=key)
+        expression = compile_expression(value, name=key)
     except ExpressionError as error:
-        raise SceneError(str(error)) from None
+        raise SceneError(str(error), key=key) from None
+    if "z" in expression.variables:
+        raise SceneError(f"{key} = {shorten(expression.text)!r}: uses z, but this scene is 2D (its expressions take "
+                         "x and y); remove z", key=key)
+    return expression
 
 
 def evaluate_checked(expression: Expression, points) -> np.ndarray:
