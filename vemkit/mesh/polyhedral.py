@@ -1,0 +1,170 @@
+"""The polyhedral mesh (SPEC §10): plain arrays, as the polygonal :class:`~vemkit.mesh.mesh.Mesh`.
+
+A 3D mesh is
+- ``vertices``: ``(N, 3)`` float64 coordinates;
+- ``face_offsets`` ``(F + 1,)`` and ``face_vertices``: the polygonal faces (CSR), each listed once;
+  its vertex order gives its normal by the right-hand rule;
+- ``cell_offsets`` ``(M + 1,)`` and ``cell_faces``: the faces of every cell (CSR), signed: ``f >= 0``
+  is face f as stored, ``-(f + 1)`` face f reversed; taken with their signs the faces of a cell
+  point OUT of it (the solution file's ``mesh3d_volume_faces`` convention). A hanging node is a
+  vertex of the faces around it; a refined neighbour's face is several faces of the coarse cell;
+- ``boundary``: named boundary parts, each a ``(k,)`` int64 array of boundary faces (stored
+  outward);
+- ``meta``: how the mesh was made.
+
+Derived topology and geometry are computed on demand and cached.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class PolyhedralMesh:
+    vertices: np.ndarray
+    face_offsets: np.ndarray
+    face_vertices: np.ndarray
+    cell_offsets: np.ndarray
+    cell_faces: np.ndarray
+    boundary: dict = field(default_factory=dict)
+    meta: dict = field(default_factory=dict)
+
+    dimension = 3
+
+    def __post_init__(self):
+        for name, dtype in (("vertices", np.float64), ("face_offsets", np.int64), ("face_vertices", np.int64),
+                            ("cell_offsets", np.int64), ("cell_faces", np.int64)):
+            object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=dtype))
+        object.__setattr__(self, "boundary", {str(k): np.asarray(v, dtype=np.int64).ravel()
+                                              for k, v in self.boundary.items()})
+
+    # -- sizes -----------------------------------------------------------------------------
+    @property
+    def n_vertices(self) -> int:
+        return self.vertices.shape[0]
+
+    @property
+    def n_faces(self) -> int:
+        return self.face_offsets.shape[0] - 1
+
+    @property
+    def n_cells(self) -> int:
+        return self.cell_offsets.shape[0] - 1
+
+    def face(self, f: int) -> np.ndarray:
+        return self.face_vertices[self.face_offsets[f]:self.face_offsets[f + 1]]
+
+    def cell_face_list(self, c: int) -> np.ndarray:
+        """The signed faces of cell c."""
+        return self.cell_faces[self.cell_offsets[c]:self.cell_offsets[c + 1]]
+
+    # -- derived topology --------------------------------------------------------------------
+    @cached_property
+    def face_cells(self) -> np.ndarray:
+        """``(F, 2)``: column 0 the cell for which face f as stored points out, column 1 the cell for
+        which it points in; ``-1`` where there is none (a boundary face has one of the two)."""
+        out = np.full((self.n_faces, 2), -1, dtype=np.int64)
+        cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))
+        forward = self.cell_faces >= 0
+        out[self.cell_faces[forward], 0] = cells[forward]
+        out[-self.cell_faces[~forward] - 1, 1] = cells[~forward]
+        return out
+
+    @cached_property
+    def boundary_faces(self) -> np.ndarray:
+        """Faces that belong to one cell only."""
+        return np.flatnonzero((self.face_cells[:, 0] < 0) | (self.face_cells[:, 1] < 0))
+
+    @cached_property
+    def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (offsets, vertices): the distinct vertices of every cell, in order of first appearance
+        along its faces."""
+        offsets, flat = [0], []
+        for c in range(self.n_cells):
+            faces = np.where(self.cell_face_list(c) >= 0, self.cell_face_list(c), -self.cell_face_list(c) - 1)
+            ids = np.concatenate([self.face(f) for f in faces])
+            _, first = np.unique(ids, return_index=True)
+            flat.append(ids[np.sort(first)])
+            offsets.append(offsets[-1] + flat[-1].size)
+        return np.asarray(offsets, dtype=np.int64), (np.concatenate(flat) if flat else np.zeros(0, np.int64))
+
+    # -- geometry -------------------------------------------------------------------------
+    @cached_property
+    def face_vector_areas(self) -> np.ndarray:
+        """``(F, 3)``: |F| n_F of every face as stored (half the sum of cross products about its vertex mean)."""
+        out = np.zeros((self.n_faces, 3))
+        for f in range(self.n_faces):
+            p = self.vertices[self.face(f)]
+            q = p - p.mean(axis=0)
+            out[f] = 0.5 * np.cross(q, np.roll(q, -1, axis=0)).sum(axis=0)
+        return out
+
+    @cached_property
+    def face_centroids(self) -> np.ndarray:
+        """``(F, 3)`` area centroids of the faces (fan triangles from the vertex mean)."""
+        out = np.zeros((self.n_faces, 3))
+        for f in range(self.n_faces):
+            p = self.vertices[self.face(f)]
+            m = p.mean(axis=0)
+            a = np.linalg.norm(np.cross(p - m, np.roll(p, -1, axis=0) - m), axis=1)
+            centres = (p + np.roll(p, -1, axis=0) + m) / 3.0
+            out[f] = centres.T @ a / a.sum() if a.sum() > 0 else m
+        return out
+
+    @cached_property
+    def cell_volumes(self) -> np.ndarray:
+        """Signed volumes by the divergence theorem: sum over the cell's outward faces of x_F . (|F| n_F) / 3."""
+        sign = np.where(self.cell_faces >= 0, 1.0, -1.0)
+        faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
+        flux = sign * np.einsum("ij,ij->i", self.face_centroids[faces], self.face_vector_areas[faces]) / 3.0
+        return np.add.reduceat(flux, self.cell_offsets[:-1]) if self.n_cells else np.zeros(0)
+
+    @cached_property
+    def cell_diameters(self) -> np.ndarray:
+        offsets, ids = self.cell_vertex_lists
+        out = np.zeros(self.n_cells)
+        for c in range(self.n_cells):
+            p = self.vertices[ids[offsets[c]:offsets[c + 1]]]
+            out[c] = np.max(np.linalg.norm(p[:, None] - p[None], axis=2))
+        return out
+
+    @property
+    def h(self) -> float:
+        return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+
+def from_polyhedra(vertices, cells, boundary=None, meta=None) -> PolyhedralMesh:
+    """Build a mesh from cells given as lists of outward polygonal faces (vertex-index sequences):
+    faces shared by two cells (the same vertex set) are stored once. ``boundary``: {side: list of
+    faces as vertex sequences}, matched to the stored faces by their vertex sets."""
+    key_of = {}
+    face_lists, offsets = [], [0]
+    cell_faces = []
+    for faces in cells:
+        for face in faces:
+            face = [int(v) for v in face]
+            key = tuple(sorted(face))
+            if key in key_of:
+                stored = key_of[key]
+                cell_faces.append(-(stored + 1) if _same_orientation(face, face_lists[stored]) is False else stored)
+            else:
+                key_of[key] = len(face_lists)
+                face_lists.append(face)
+                cell_faces.append(key_of[key])
+        offsets.append(len(cell_faces))
+    face_offsets = np.concatenate([[0], np.cumsum([len(f) for f in face_lists])])
+    parts = {side: [key_of[tuple(sorted(int(v) for v in face))] for face in faces]
+             for side, faces in (boundary or {}).items()}
+    flat = np.concatenate([np.asarray(f, dtype=np.int64) for f in face_lists]) if face_lists else np.zeros(0, np.int64)
+    return PolyhedralMesh(np.asarray(vertices, float), face_offsets, flat, np.asarray(offsets), np.asarray(cell_faces),
+                          parts, meta or {})
+
+
+def _same_orientation(face, stored) -> bool:
+    """Whether two vertex cycles of one face run the same way."""
+    i = stored.index(face[0])
+    return stored[(i + 1) % len(stored)] == face[1]
