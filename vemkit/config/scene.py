@@ -24,6 +24,7 @@ import yaml
 from vemkit.config.boundary_conditions import (boundary_expressions, check_contact,
                                                check_mesh_size, check_rigid_motions, check_sides,
                                                compile_checked, evaluate_checked, inside_points)
+from vemkit.config.material import lame_parameters
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
 from vemkit.config.expressions import Expression
 from vemkit.config.mesh_resolution import check_mesh_resolution
@@ -335,6 +336,7 @@ class Scene:
 
     name = _field("name")
     domain = _field("domain")
+    model = _field("model", doc="the mechanical model: plane_stress (the paper's) or plane_strain (SPEC §10)")
     E = _field("material", "E", doc="Young's modulus")
     nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
     dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
@@ -367,8 +369,9 @@ class Scene:
         return UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
 
     def lame(self) -> tuple[float, float]:
-        """``(lambda_star, mu)`` of the paper's plane-stress C: Eν/(1−ν²), E/(2(1+ν)) (SPEC §1)."""
-        return self.E * self.nu / (1.0 - self.nu**2), self.E / (2.0 * (1.0 + self.nu))
+        """``(lambda, mu)`` of C for the scene's model (``vemkit.config.material``; plane stress: the
+        paper's Eν/(1−ν²), E/(2(1+ν)), SPEC §1)."""
+        return lame_parameters(self.E, self.nu, self.model)
 
     def traction(self, side: str) -> tuple[Expression, Expression]:
         """The prescribed traction f2 on a Neumann side; KeyError for other sides (and pressure sides)."""

@@ -48,6 +48,7 @@ class DiscreteProblem:
     stabilization: str
     interior_load: np.ndarray | None = None  # (M, 2) the load on condensed interior nodes (their recovery)
     info: dict = field(default_factory=dict)
+    model: str = "plane_stress"  # the material law (vemkit.config.material)
 
     @property
     def mesh(self) -> Mesh:
@@ -125,7 +126,7 @@ def discrete_problem(
     mesh: Mesh, E: float, nu: float, *, order: int = 1, dirichlet=("right",), neumann=None, pressure=None,
     contact=(), gap=lambda x, y: np.zeros_like(x), law: ContactLaw | None = None, body_force=None,
     stabilization: str = "dofi-2mu", contact_quadrature: str = "nodal", contact_gauss_points: int = 3,
-    body_force_projection: str = "p0",
+    body_force_projection: str = "p0", model: str = "plane_stress",
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -135,11 +136,12 @@ def discrete_problem(
     neumann: {part: traction(x, y) -> (f2_1, f2_2)}; pressure: {part: p(x, y)} (traction -p nu);
     body_force(x, y) -> (f1_1, f1_2), projected as ``body_force_projection`` (k = 2: "p0", the paper's
     P_0 f1, or "p1"). contact_quadrature: nodal or gauss (with contact_gauss_points per edge).
+    model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     space = VirtualElementSpace(mesh, order)
     check_quadrature(space, contact_quadrature)
-    lam, mu = lame_parameters(E, nu)
+    lam, mu = lame_parameters(E, nu, model)
     dofs = constrained(space, dirichlet)
     K = space.stiffness_matrix(lam, mu, stabilization, dofs)
     full_load = problem_load(space, neumann, pressure, body_force, body_force_projection, lam, mu)
@@ -153,7 +155,7 @@ def discrete_problem(
     K, f = apply_fixed_dofs(K, f, dofs)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
     return DiscreteProblem(space, dofs, K, f, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization,
-                           interior)
+                           interior, model=model)
 
 
 def _scene_gap(scene):
@@ -178,7 +180,7 @@ def scene_problem_data(scene) -> dict:
                 neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides
                          if side not in pressures},
                 contact_quadrature=scene.contact_quadrature, contact_gauss_points=scene.contact_gauss_points,
-                body_force_projection=scene.body_force_projection)
+                body_force_projection=scene.body_force_projection, model=scene.model)
 
 
 def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:

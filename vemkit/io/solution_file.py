@@ -46,7 +46,8 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
         ("stress_11", sig[:, 0], "stress sigma11 = C eps(Pi u)", "daN/mm2"),
         ("stress_22", sig[:, 1], "stress sigma22", "daN/mm2"),
         ("stress_12", sig[:, 2], "stress sigma12", "daN/mm2"),
-        ("shear_energy_density", shear_energy_density(sig, problem.lam, problem.mu), "|dev sigma|^2/(4 mu) (Fig. 6)", "daN/mm2"),
+        ("shear_energy_density", shear_energy_density(sig, problem.lam, problem.mu, problem.model),
+         "|dev sigma|^2/(4 mu) (Fig. 6)", "daN/mm2"),
     ):
         ds[name] = (face, values, dict(face_attrs, long_name=long_name, units=units))
 
@@ -90,6 +91,7 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             "n_dofs": int(problem.n_dofs),
             "stabilization": problem.stabilization,
             "order": int(element_order),
+            "model": str(problem.model),
             "vemkit_version": vemkit.__version__,
         }
     )

@@ -1,13 +1,10 @@
-"""The material law of the paper (SPEC §1) and the rigid-body motions it leaves free."""
+"""The material law (SPEC §1, §10: ``vemkit.config.material``) and the rigid-body motions it leaves free."""
 
 from __future__ import annotations
 
 import numpy as np
 
-
-def lame_parameters(E: float, nu: float):
-    """(lambda*, mu) of the paper's (plane stress) C: lambda* = E nu / (1 - nu^2), mu = E / (2 (1 + nu))."""
-    return E * nu / (1.0 - nu * nu), E / (2.0 * (1.0 + nu))
+from vemkit.config.material import lame_parameters  # noqa: F401  (the formulas' one home; re-exported)
 
 
 def elasticity_matrix(lam: float, mu: float) -> np.ndarray:
