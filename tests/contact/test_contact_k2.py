@@ -1,4 +1,4 @@
-"""Contact with k = 2 virtual elements (vemkit.contact.problem_k2), pinned by exact solutions.
+"""Contact with k = 2 virtual elements (vemkit.contact.problem, order = 2), pinned by exact solutions.
 
 - A uniform penetration (a uniaxial strain state pressed onto the foundation) is reproduced to
   round-off on every family, and the total normal force is k_nu t |Gamma_C| (Simpson's weights sum
@@ -22,18 +22,16 @@ from manufactured import X, elasticity_solution
 from vemkit.config.scene import load_scene, scene_from_dict
 from vemkit.contact.laws import ContactLaw
 from vemkit.contact.problem import discrete_problem, scene_problem
-from vemkit.contact.problem_k2 import discrete_problem_k2, node_coordinates
 from vemkit.exceptions import SceneError
 from vemkit.mesh.families import build_mesh
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.verification import verify_solution
 from vemkit.studies.scene_solve import solve_scene
-from vemkit.vem.assembly_k2 import NodeMapK2, stiffness_matrix_k2
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.load_k2 import traction_load_k2
+from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.elements.k2_fields import traction_load_k2
 from vemkit.vem.norms import exact_errors
-from vemkit.vem.norms_k2 import exact_errors_k2
-from vemkit.vem.projection import projected_solution
+from vemkit.vem.space import VirtualElementSpace
 
 E, NU = 2000.0, 0.4
 LAM, MU = lame_parameters(E, NU)
@@ -46,11 +44,11 @@ def _uniform_penetration(family, k_nu=50.0, depth=0.3, gap=0.1):
     eps22 = -k_nu * (depth - gap) / (LAM + 2 * MU + k_nu)
     s11 = LAM * eps22
     mesh = build_mesh(family, 4)
-    problem = discrete_problem_k2(
-        mesh, E, NU, dirichlet={"top": (0.0, -depth)},
+    problem = discrete_problem(
+        mesh, E, NU, order=2, dirichlet={"top": (0.0, -depth)},
         neumann={"left": lambda x, y: (-s11 + 0 * x, 0 * x), "right": lambda x, y: (s11 + 0 * x, 0 * x)},
         contact=["bottom"], gap=lambda x, y: np.full_like(x, gap), law=ContactLaw(k_nu, 1.0, 450.0, 0.0))
-    y = node_coordinates(mesh)[:, 1]
+    y = VirtualElementSpace(mesh, 2).node_coordinates[:, 1]
     exact = np.stack([0 * y, eps22 * (y - 1) - depth], axis=1)
     return problem, exact, depth + eps22 - gap
 
@@ -85,12 +83,13 @@ def test_the_change_of_variables_gives_the_plain_k2_solution():
     of the untransformed k = 2 system (clamped right side, traction on the left)."""
     mesh = build_mesh("voronoi", 5, seed=2)
     traction = lambda x, y: (200 * (5 - y), -200 + 0 * y)  # noqa: E731
-    problem = discrete_problem_k2(mesh, E, NU, dirichlet=("right",), neumann={"left": traction},
-                                  contact=["bottom"], law=ContactLaw(0.0, 1.0, 0.0, 0.0))
+    problem = discrete_problem(mesh, E, NU, order=2, dirichlet=("right",), neumann={"left": traction},
+                               contact=["bottom"], law=ContactLaw(0.0, 1.0, 0.0, 0.0))
     assert problem.dofs.change.nnz > 0
-    nodes = NodeMapK2.from_sides(mesh, ["right"])
-    K = stiffness_matrix_k2(mesh, LAM, MU, "dofi-2mu", nodes)
-    plain = nodes.expand(spla.spsolve(K.tocsc(), nodes.restrict(traction_load_k2(mesh, mesh.boundary["left"], traction))))
+    space = VirtualElementSpace(mesh, 2)
+    nodes = space.numbering(space.clamped_on(mesh.boundary["right"]))
+    K = space.stiffness_matrix(LAM, MU, "dofi-2mu", nodes)
+    plain = nodes.node_values(spla.spsolve(K.tocsc(), nodes.restrict(traction_load_k2(mesh, mesh.boundary["left"], traction))))
     solution = solve(problem, {"method": "ssn", "tol": 1e-12, "linear": "direct"})
     np.testing.assert_allclose(problem.node_values(solution.u), plain, atol=1e-12 * np.abs(plain).max())
 
@@ -142,7 +141,7 @@ def manufactured_problem(case, mesh, order):
         neumann={"left": traction((-1, 0)), "top": traction((0, 1)), "bottom": extra}, contact=["bottom"],
         gap=lambda x, y: -u(x, 0 * x)[1] - np.broadcast_to(t(x), np.shape(x)), law=LAW,
         body_force=lambda x, y: tuple(np.broadcast_to(v, np.shape(x)) for v in force(x, y)))
-    problem = (discrete_problem_k2 if order == 2 else discrete_problem)(mesh, E, NU, **kwargs)
+    problem = discrete_problem(mesh, E, NU, order=order, **kwargs)
     return problem, exact, multiplier
 
 
@@ -154,8 +153,7 @@ def manufactured_errors(case, order, ns=(4, 8, 16)):
         problem, exact, multiplier = manufactured_problem(case, mesh, order)
         solution = solve(problem, {"method": "ssn", "tol": 1e-12})
         proj = problem.projected(solution.u) if order == 2 else projected_solution(mesh, problem.dofs.expand(solution.u))
-        measure = exact_errors_k2 if order == 2 else exact_errors
-        errors.append(measure(mesh, proj, exact["u"], exact["grad"])["h1_semi"])
+        errors.append(exact_errors(mesh, proj, exact["u"], exact["grad"])["h1_semi"])
     return np.array(errors), problem, solution, multiplier
 
 
@@ -271,11 +269,14 @@ def test_order_2_through_the_cli_writes_a_k2_solution_file(tmp_path):
     assert ds.attrs["n_space_dofs"] == ds.attrs["n_dofs"] + 2 * mesh.n_cells
 
 
-def test_adapt_refuses_order_2():
-    from vemkit.exceptions import InputError
+def test_adapt_runs_at_order_2():
+    """``vemkit adapt`` once refused order 2 (its estimator and warm start were k = 1 only); both now
+    run through the space (tests/studies/test_adaptivity_k2.py measures the rates): a k = 2 scene
+    adapts in the k = 2 space, every step's solution passing the independent check."""
     from vemkit.studies.adaptivity import AdaptivitySettings, adapt
 
     scene = load_scene(PAPER, ["discretization.order=2", "discretization.mesh.n=2"])
-    with pytest.raises(InputError, match="order = 2") as error:
-        adapt(scene, AdaptivitySettings.from_scene(scene))
-    assert error.value.key == "discretization.order"
+    run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-9, max_steps=2), verify=True)
+    assert run.reason == "max_steps" and len(run.history) == 2 and run.problem.order == 2
+    assert run.history[0]["n_dofs"] < run.history[1]["n_dofs"] == run.problem.n_dofs
+    assert verify_solution(run.problem, run.solution.u, run.solution.multiplier)["passed"]

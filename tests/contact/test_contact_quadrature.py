@@ -12,8 +12,8 @@ from vemkit.solvers.solution import contact_force_vector
 from vemkit.solvers.ssn import solve_ssn
 from vemkit.solvers.uzawa import solve_uzawa
 from vemkit.solvers.verification import verify_solution
+from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import projection_error
-from vemkit.vem.projection import projected_solution
 
 TRACTIONS = {"left": lambda x, y: (200 * (5 - y), -200 + 0 * y), "top": lambda x, y: (0 * x, 0 * x)}
 
@@ -27,7 +27,7 @@ def problem(n, quadrature, law=PAPER["law"], points=3, dirichlet=("right",), neu
 
 def pushed_down(pb, penetration):
     """Free-dof u pushing every free vertex down so that u_nu - g = penetration(x) on the bottom."""
-    xy = pb.mesh.vertices[pb.dofs.free_vertices]
+    xy = pb.mesh.vertices[pb.dofs.free_nodes]
     u = np.zeros((xy.shape[0], 2))
     u[:, 1] = -(0.1 + penetration(xy[:, 0]))
     return u.ravel()
@@ -58,7 +58,7 @@ def test_gauss_integrates_a_linear_penetration_exactly_and_differs_from_nodal():
     pbs = {q: problem(n, q, law, points=p, dirichlet=("top",), neumann={}) for q, p in (("gauss", 2), ("nodal", 3))}
     u = pushed_down(pbs["gauss"], lambda x: a + b * x)
     force = {q: -contact_force_vector(pb, u, np.zeros(pb.contact.size))[1::2] for q, pb in pbs.items()}
-    xy = pbs["gauss"].mesh.vertices[pbs["gauss"].dofs.free_vertices]
+    xy = pbs["gauss"].mesh.vertices[pbs["gauss"].dofs.free_nodes]
     exact = np.zeros(xy.shape[0])
     for i, (x, y) in enumerate(xy):
         if y != 0.0:

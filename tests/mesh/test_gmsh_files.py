@@ -107,10 +107,10 @@ def test_clockwise_cells_are_turned_and_untagged_edges_kept(tmp_path):
 
 
 def test_a_file_mesh_passes_the_patch_test(tmp_path):
-    from vemkit.vem.assembly import stiffness_matrix
+    from vemkit.vem.space import VirtualElementSpace
 
     mesh = read_mesh(write(tmp_path, gmsh_v4(MIXED)))
-    K = stiffness_matrix(mesh, 1.0, 0.5, "dofi-2mu")
+    K = VirtualElementSpace(mesh, 1).stiffness_matrix(1.0, 0.5, "dofi-2mu")
     u = (mesh.vertices @ np.array([[0.3, -1.2], [0.7, 0.25]]).T).ravel()
     interior = [int(np.flatnonzero((mesh.vertices == p).all(axis=1))[0]) for p in ([1, 1], [2, 1])]
     assert np.abs((K @ u).reshape(-1, 2)[interior]).max() < 1e-12

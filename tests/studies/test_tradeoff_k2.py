@@ -13,8 +13,9 @@ from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.tradeoff import family_order, run_family, tradeoff_dataset, tradeoff_markdown
 from vemkit.exceptions import InputError
-from vemkit.vem.norms_k2 import projection_error_k2
-from vemkit.vem.projection import projected_solution
+from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.norms import projection_error
+from vemkit.vem.quadrature import reference_quadrature
 
 ROOT = Path(__file__).resolve().parents[2]
 PAPER = ROOT / "config/scenes/paper.yaml"
@@ -42,7 +43,8 @@ def test_a_k2_run_is_measured_with_pi2_on_its_own_reference(k2_reference):
     assert record["error_h1"] < 1e-8 and record["error_l2"] < 1e-8
     assert record["n_dofs"] == record["n_unknowns"] + 2 * record["n_cells"]  # the condensed cell means count
     vertex = ref.displacement  # the wrong measure: Pi_1 of the k = 2 solution's vertex values
-    wrong = projection_error_k2(ref.mesh, projected_solution(ref.mesh, vertex), ref.mesh, ref.projected)
+    wrong = projection_error(ref.mesh, projected_solution(ref.mesh, vertex), ref.mesh, ref.projected,
+                             reference_quadrature(ref.mesh, degree=5))
     assert wrong["h1"] > 1e-2
     (k1,) = run_family(scene, "square", {"family": "square"}, ref, levels=[8], reference_n=8, **RUN)
     assert k1["order"] == 1 and k1["error_h1"] > 1e-2

@@ -6,8 +6,9 @@ import pytest
 from conftest import FAMILY_CASES, family_mesh
 from vemkit.mesh.families import build_mesh
 from vemkit.vem.interpolation import MEAN_VALUE, WACHSPRESS, cell_kinds, coordinates, interpolate
-from vemkit.vem.norms import locate_points, paper_error, projection_error
-from vemkit.vem.projection import projected_solution
+from vemkit.mesh.locate import locate_points
+from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.norms import paper_error, projection_error
 
 
 def linear_field(x):

@@ -12,10 +12,11 @@ import pytest
 import scipy.sparse.linalg as spla
 
 from conftest import FAMILY_CASES, family_mesh
-from vemkit.vem.assembly_k2 import NodeMapK2, dirichlet_lift, interpolate_k2, stiffness_matrix_k2
+from vemkit.vem.assembly import dirichlet_lift
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.load_k2 import body_force_k2, body_force_p1_k2
-from vemkit.vem.norms_k2 import exact_errors_k2, projected_solution_k2
+from vemkit.vem.elements.k2_fields import body_force_k2, body_force_p1_k2, projected_solution_k2
+from vemkit.vem.norms import exact_errors
+from vemkit.vem.space import VirtualElementSpace
 
 LAM, MU = lame_parameters(2000.0, 0.4)
 SIDES = ("left", "right", "bottom", "top")
@@ -40,14 +41,15 @@ def body_force(x, y):
 
 def manufactured_errors(mesh, stab="dofi-2mu"):
     """{load: (H1-seminorm error, L2 error)} of Pi_2 u_h for both loads."""
-    nodes = NodeMapK2.from_sides(mesh, SIDES)
-    K = spla.splu(stiffness_matrix_k2(mesh, LAM, MU, stab, nodes).tocsc())
-    exact = interpolate_k2(mesh, exact_u)
-    lift = dirichlet_lift(mesh, LAM, MU, stab, nodes, exact)
+    space = VirtualElementSpace(mesh, 2)
+    nodes = space.numbering(space.clamped_on(np.concatenate([mesh.boundary[s] for s in SIDES])))
+    K = spla.splu(space.stiffness_matrix(LAM, MU, stab, nodes).tocsc())
+    exact = space.interpolate(exact_u)
+    lift = dirichlet_lift(space, LAM, MU, stab, nodes, exact)
     out = {}
     for name, load in (("p0", body_force_k2(mesh, body_force)), ("p1", body_force_p1_k2(mesh, body_force, LAM, MU))):
-        u = nodes.expand(K.solve(nodes.restrict(load) + lift), exact)
-        e = exact_errors_k2(mesh, projected_solution_k2(mesh, u, LAM, MU), exact_u, exact_grad)
+        u = nodes.node_values(K.solve(nodes.restrict(load) + lift), exact)
+        e = exact_errors(mesh, projected_solution_k2(mesh, u, LAM, MU), exact_u, exact_grad)
         out[name] = (e["h1_semi"], e["l2"])
     return out
 

@@ -7,12 +7,13 @@ import scipy.sparse.linalg as spla
 
 from conftest import FAMILY_CASES, family_mesh
 from conftest import POLYGONS, nonconvex_mesh
-from vemkit.vem.assembly_k2 import NodeMapK2, dirichlet_lift, interpolate_k2, stiffness_matrix_k2
+from vemkit.vem.assembly import dirichlet_lift
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.element import STABILIZATIONS
-from vemkit.vem.stiffness_k2 import element_stiffness_k2_matrix
-from vemkit.vem.element_k2_reference import element_stiffness_k2_reference, field_dofs
-from vemkit.vem.load_k2 import body_force_k2, traction_load_k2
+from vemkit.vem.elements import STABILIZATIONS
+from vemkit.vem.elements.k2_stiffness import element_stiffness_k2_matrix
+from vemkit.vem.elements.k2_reference import element_stiffness_k2_reference, field_dofs
+from vemkit.vem.elements.k2_fields import body_force_k2, traction_load_k2
+from vemkit.vem.space import VirtualElementSpace
 
 LAM, MU = lame_parameters(2000.0, 0.4)
 SHAPES = dict(POLYGONS, voronoi_like=[[0, 0], [1.1, -0.2], [1.9, 0.4], [2.0, 1.3], [1.2, 2.0], [0.1, 1.6], [-0.4, 0.8]])
@@ -46,6 +47,11 @@ def quadratic_body_force(A=QUADRATIC):
     grad_div = np.array([2 * a[3] + b[4], a[4] + 2 * b[5]])
     laplacian = np.array([2 * a[3] + 2 * a[5], 2 * b[3] + 2 * b[5]])
     return -((LAM + MU) * grad_div + MU * laplacian)
+
+
+def clamped_sides(space, sides):
+    """The k = 2 numbering with the named boundary parts clamped (as ``dirichlet: [side]``)."""
+    return space.numbering(space.clamped_on(np.concatenate([space.mesh.boundary[s] for s in sides])))
 
 
 def shape(name):
@@ -110,13 +116,14 @@ def test_patch_test_quadratic_displacement_is_reproduced(case, stab):
     """Dirichlet data of a quadratic u on the whole boundary, body force -div sigma(u) (constant):
     the discrete solution is the interpolant of u, every degree of freedom to round-off."""
     mesh = patch_mesh(case)
-    nodes = NodeMapK2.from_sides(mesh, SIDES)
-    exact = interpolate_k2(mesh, quadratic)
+    space = VirtualElementSpace(mesh, 2)
+    nodes = clamped_sides(space, SIDES)
+    exact = space.interpolate(quadratic)
     f = quadratic_body_force()
     load = nodes.restrict(body_force_k2(mesh, lambda x, y: (f[0] + 0 * x, f[1] + 0 * x)))
-    load += dirichlet_lift(mesh, LAM, MU, stab, nodes, exact)
-    K = stiffness_matrix_k2(mesh, LAM, MU, stab, nodes)
-    u = nodes.expand(spla.spsolve(K.tocsc(), load), exact)
+    load += dirichlet_lift(space, LAM, MU, stab, nodes, exact)
+    K = space.stiffness_matrix(LAM, MU, stab, nodes)
+    u = nodes.node_values(spla.spsolve(K.tocsc(), load), exact)
     assert np.abs(u - exact).max() < 1e-10 * np.abs(exact).max()
 
 
@@ -125,7 +132,8 @@ def test_stiffness_times_quadratic_is_its_load(case):
     """K u_I = <f, phi> + int_dOmega (sigma n) . phi for quadratic u, no Dirichlet part (tractions
     integrated on the quadratic traces): the consistency (3.6) on a whole mesh."""
     mesh = patch_mesh(case)
-    K = stiffness_matrix_k2(mesh, LAM, MU, "dofi-2mu")
+    space = VirtualElementSpace(mesh, 2)
+    K = space.stiffness_matrix(LAM, MU, "dofi-2mu", space.numbering(natural=True))
     f = quadratic_body_force()
     load = body_force_k2(mesh, lambda x, y: (f[0] + 0 * x, f[1] + 0 * x))
     normals = {"left": (-1, 0), "right": (1, 0), "bottom": (0, -1), "top": (0, 1)}
@@ -135,32 +143,33 @@ def test_stiffness_times_quadratic_is_its_load(case):
             return s11 * n1 + s12 * n2, s12 * n1 + s22 * n2
 
         load += traction_load_k2(mesh, mesh.boundary[side], traction)
-    u = interpolate_k2(mesh, quadratic).ravel()
+    u = space.interpolate(quadratic).ravel()
     assert np.abs(K @ u - load.ravel()).max() < 1e-10 * np.abs(load).max()
 
 
 def test_eliminated_assembly_is_the_restriction_of_the_full_matrix():
     mesh = family_mesh("hanging-random", 4)
-    nodes = NodeMapK2.from_sides(mesh, ["right", "bottom"])
-    full = stiffness_matrix_k2(mesh, LAM, MU, "trace").toarray()
+    space = VirtualElementSpace(mesh, 2)
+    nodes = clamped_sides(space, ["right", "bottom"])
+    full = space.stiffness_matrix(LAM, MU, "trace", space.numbering(natural=True)).toarray()
     free = (2 * nodes.free_nodes[:, None] + np.arange(2)).ravel()
-    reduced = stiffness_matrix_k2(mesh, LAM, MU, "trace", nodes).toarray()
+    reduced = space.stiffness_matrix(LAM, MU, "trace", nodes).toarray()
     assert np.abs(reduced - full[np.ix_(free, free)]).max() <= 1e-12 * np.abs(full).max()
-    values = interpolate_k2(mesh, quadratic)
+    values = space.interpolate(quadratic)
     clamped = (2 * nodes.clamped_nodes[:, None] + np.arange(2)).ravel()
     expected = -full[np.ix_(free, clamped)] @ values.ravel()[clamped]
-    assert np.allclose(dirichlet_lift(mesh, LAM, MU, "trace", nodes, values), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    assert np.allclose(dirichlet_lift(space, LAM, MU, "trace", nodes, values), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("case", ["triangle-delaunay", "voronoi", "nonconvex"])
 def test_body_force_loads_integrate_exactly_against_quadratics(case):
     """<f_h, v> for quadratic v: the P_1 load is int f . v for linear f; the paper's P_0 load is
     int P_0 f . v (equal to int f . v for constant f only)."""
-    from vemkit.vem.load_k2 import body_force_p1_k2
-    from vemkit.vem.norms import reference_quadrature
+    from vemkit.vem.elements.k2_fields import body_force_p1_k2
+    from vemkit.vem.quadrature import reference_quadrature
 
     mesh = patch_mesh(case)
-    v = interpolate_k2(mesh, quadratic).ravel()
+    v = VirtualElementSpace(mesh, 2).interpolate(quadratic).ravel()
     points, weights, _ = reference_quadrature(mesh, degree=5)
 
     def linear(x, y):
@@ -178,10 +187,11 @@ def test_body_force_loads_integrate_exactly_against_quadratics(case):
 def test_global_null_space_is_the_three_rigid_motions(case):
     """With no Dirichlet part the assembled k = 2 matrix is singular exactly on the rigid motions."""
     mesh = family_mesh(case, 3) if case != "nonconvex" else nonconvex_mesh()
-    K = stiffness_matrix_k2(mesh, LAM, MU, "dofi-2mu").toarray()
+    space = VirtualElementSpace(mesh, 2)
+    K = space.stiffness_matrix(LAM, MU, "dofi-2mu", space.numbering(natural=True)).toarray()
     ev = np.linalg.eigvalsh(K)
     assert np.all(np.abs(ev[:3]) < 1e-11 * ev[-1]) and ev[3] > 1e-8 * ev[-1]
-    rotation = interpolate_k2(mesh, lambda x, y: (-y, x)).ravel()
+    rotation = space.interpolate(lambda x, y: (-y, x)).ravel()
     assert np.abs(K @ rotation).max() < 1e-11 * ev[-1]
 
 

@@ -1,4 +1,4 @@
-"""The k = 2 sparsity pattern (``vemkit.vem.pattern_k2``) pinned by an independent construction: the
+"""The k = 2 sparsity pattern (``vemkit.vem.pattern``) pinned by an independent construction: the
 free nodes r, c are coupled exactly when some cell holds both, i.e. (B B^T)[r, c] != 0 for the
 node-cell incidence B, each coupling a full 2 x 2 block of scalar dofs."""
 
@@ -7,13 +7,14 @@ import pytest
 import scipy.sparse as sp
 
 from conftest import family_mesh
-from vemkit.vem.assembly import vertex_cells
-from vemkit.vem.assembly_k2 import NodeMapK2, cell_nodes, stiffness_matrix_k2
+from vemkit.vem.dofs import DofMap
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.pattern_k2 import dof_pattern_k2
+from vemkit.vem.elements.k2_fields import cell_nodes
+from vemkit.vem.pattern import dof_pattern, node_cells
+from vemkit.vem.space import VirtualElementSpace
 
 
-def incidence_pattern(mesh, nodes: NodeMapK2) -> sp.csr_matrix:
+def incidence_pattern(mesh, nodes: DofMap) -> sp.csr_matrix:
     """Scalar-dof pattern from B B^T, rows and columns in the free-dof order of ``nodes``."""
     offsets, cn = cell_nodes(mesh)
     cells = np.repeat(np.arange(mesh.n_cells), np.diff(offsets))
@@ -30,17 +31,17 @@ def incidence_pattern(mesh, nodes: NodeMapK2) -> sp.csr_matrix:
 @pytest.mark.parametrize("clamping", ["none", "sides", "condensed"])
 def test_pattern_is_the_cell_incidence_product(case, clamping):
     mesh = family_mesh(case, 5)
+    space = VirtualElementSpace(mesh, 2)
     if clamping == "none":
-        nodes = NodeMapK2.from_clamped_edges(mesh)
+        nodes = space.numbering()
     else:
-        clamped = np.zeros(NodeMapK2.natural(mesh).n_nodes, dtype=bool)
-        clamped[NodeMapK2.from_sides(mesh, ["left", "bottom"]).clamped_nodes] = True
-        nodes = NodeMapK2.from_clamped_nodes(mesh, clamped, condensed=clamping == "condensed")
+        clamped = space.clamped_on(np.concatenate([mesh.boundary[s] for s in ["left", "bottom"]]))
+        nodes = space.numbering(clamped, condensed=clamping == "condensed")
     offsets, cn = cell_nodes(mesh)
-    nc_ptr, nc = vertex_cells(offsets, cn, nodes.n_nodes)
-    indptr, indices = dof_pattern_k2(offsets, cn, nc_ptr, nc, nodes.free_nodes, nodes.free_index)
+    nc_ptr, nc = node_cells(offsets, cn, nodes.n_nodes)
+    indptr, indices = dof_pattern(offsets, cn, nc_ptr, nc, nodes.free_nodes, nodes.free_index)
     expected = incidence_pattern(mesh, nodes)
     assert np.array_equal(indptr, expected.indptr) and np.array_equal(indices, expected.indices)
     lam, mu = lame_parameters(2000.0, 0.4)
-    A = stiffness_matrix_k2(mesh, lam, mu, "dofi-2mu", nodes)  # assembled on that pattern, sorted
+    A = space.stiffness_matrix(lam, mu, "dofi-2mu", nodes)  # assembled on that pattern, sorted
     assert A.has_sorted_indices and np.array_equal(A.indices, expected.indices)

@@ -5,13 +5,16 @@ import pytest
 import scipy.sparse as sp
 
 from conftest import FAMILY_CASES, POLYGONS, family_mesh, nonconvex_mesh
-from vemkit.vem.assembly import stiffness_matrix
+from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import exact_errors
-from vemkit.vem.projection import projected_solution, shear_energy_density, stress
+from vemkit.vem.projection import shear_energy_density, stress
+from vemkit.vem.space import VirtualElementSpace
 from vemkit.solvers.linear import linear_solver
 from vemkit.contact.problem import discrete_problem
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.element import STABILIZATIONS, element_stiffness, element_stiffness_reference
+from vemkit.vem.elements import STABILIZATIONS
+from vemkit.vem.elements.k1_kernel import element_stiffness
+from vemkit.vem.elements.k1_reference import element_stiffness_reference
 
 LAM, MU = lame_parameters(2000.0, 0.4)
 
@@ -101,11 +104,11 @@ def test_stiffness_times_any_linear_field_is_its_boundary_traction(case):
     mesh = nonconvex_mesh() if case == "nonconvex" else family_mesh(case, 5)
     G = np.array([[0.3, -1.2], [0.7, 0.25]])
     b = np.array([0.4, -0.9])
-    K = stiffness_matrix(mesh, LAM, MU, "dofi-2mu")
+    K = VirtualElementSpace(mesh, 1).stiffness_matrix(LAM, MU, "dofi-2mu")
     u = (mesh.vertices @ G.T + b).ravel()
     eps = 0.5 * (G + G.T)
     sig = LAM * np.trace(eps) * np.eye(2) + 2 * MU * eps
-    from vemkit.vem.load import traction_load
+    from vemkit.vem.elements.k1_fields import traction_load
 
     f = np.zeros((mesh.n_vertices, 2))
     normals = {"left": [-1, 0], "right": [1, 0], "bottom": [0, -1], "top": [0, 1]}
@@ -121,7 +124,7 @@ def test_triangles_give_exactly_the_p1_fem_matrix(stab):
     from skfem.models.elasticity import linear_elasticity
 
     mesh = family_mesh("triangle-delaunay", 10)
-    K = stiffness_matrix(mesh, LAM, MU, stab)
+    K = VirtualElementSpace(mesh, 1).stiffness_matrix(LAM, MU, stab)
     tri = mesh.cell_vertices.reshape(-1, 3)
     m = skfem.MeshTri(mesh.vertices.T.copy(), tri.T.copy())
     basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP1()))

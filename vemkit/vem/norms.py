@@ -40,10 +40,12 @@ def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=
 
     Returns {"h1": full H1 norm ratio, "h1_semi": seminorm ratio, "l2": L2 ratio} and, for every
     ``regions`` entry name -> mask(points) -> bool array, "share_<name>": the part of the squared
-    H1-seminorm error inside it. ``quadrature`` (from ``reference_quadrature(ref_mesh)``) may be
-    passed to reuse it (degree 2 by default: exact for two linear projections).
+    H1-seminorm error inside it. ``quadrature`` (from ``reference_quadrature(ref_mesh, degree)``) may
+    be passed to reuse it; by default its degree is that of the product of the two projections (2 for
+    two k = 1 projections, 4 -> the degree-5 rule with a k = 2 one).
     """
-    points, weights, ref_cells = quadrature if quadrature is not None else reference_quadrature(ref_mesh)
+    degree = getattr(coarse, "degree", 1) + getattr(ref, "degree", 1)
+    points, weights, ref_cells = quadrature if quadrature is not None else reference_quadrature(ref_mesh, degree)
     coarse_cells = locate_points(coarse_mesh, points)
     if np.any(coarse_cells < 0):
         raise ValueError("the reference mesh is not covered by the coarse mesh (different domains?)")

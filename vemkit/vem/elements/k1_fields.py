@@ -96,6 +96,7 @@ class ProjectedSolution:
 
     center: np.ndarray  # (M, 2) vertex mean xbar of each cell
     coef: np.ndarray  # (M, 6): c1, c2, omega, eps11, eps22, eps12
+    degree = 1  # polynomial degree of Pi u on a cell
 
     @property
     def strain(self) -> np.ndarray:

@@ -191,6 +191,7 @@ class ProjectedSolutionK2:
 
     coef: np.ndarray
     frame: np.ndarray
+    degree = 2  # polynomial degree of Pi u on a cell
 
     def _scaled(self, cells, points):
         f = self.frame[cells]
