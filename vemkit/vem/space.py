@@ -124,7 +124,10 @@ class VirtualElementSpace:
         """(E, 2) the trace of a discrete field (n_nodes, 2) at parameter s[e] in [0, 1] of every edge (a, b)."""
         weights = self.element.edge_trace(np.asarray(s, dtype=float))  # (E, k + 1)
         values = np.asarray(node_values, dtype=float).reshape(-1, 2)[self.edge_nodes(edges)]  # (E, k + 1, 2)
-        return np.einsum("en,enc->ec", weights, values)
+        trace = weights[:, 0:1] * values[:, 0]
+        for k in range(1, weights.shape[1]):  # node by node, in the trace's order
+            trace = trace + weights[:, k:k + 1] * values[:, k]
+        return trace
 
     # -- loads and the stiffness matrix -----------------------------------------------------
     def traction_load(self, edges: np.ndarray, traction) -> np.ndarray:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.vem.elements import k2_fields, k2_stiffness
 from vemkit.vem.elements.base import Element
 
 BODY_FORCE_PROJECTIONS = ("p0", "p1")
@@ -23,35 +22,54 @@ class SecondOrder(Element):
     numbering = "cells"
     # Simpson's rule at the trace nodes: |e|/6 at each vertex, 4|e|/6 at the midpoint (vemkit.contact.boundary)
     contact_rule = ((0.0, 1.0 / 6.0), (1.0, 1.0 / 6.0), (0.5, 4.0 / 6.0))
-    workspace = staticmethod(k2_stiffness.workspace)
-    cell_matrix = staticmethod(k2_stiffness.cell_matrix)
+
+    # the kernels and fields are imported on first use: the element's facts (layout, ...) cost no Numba import
+    @property
+    def workspace(self):
+        from vemkit.vem.elements.k2_stiffness import workspace
+        return workspace
+
+    @property
+    def cell_matrix(self):
+        from vemkit.vem.elements.k2_stiffness import cell_matrix
+        return cell_matrix
 
     def cell_nodes(self, mesh):
-        return k2_fields.cell_nodes(mesh)
+        return _fields().cell_nodes(mesh)
 
     def node_coordinates(self, mesh) -> np.ndarray:
-        return k2_fields.node_coordinates(mesh)
+        return _fields().node_coordinates(mesh)
 
     def traction_load(self, mesh, edges, traction) -> np.ndarray:
-        return k2_fields.traction_load_k2(mesh, edges, traction)
+        return _fields().traction_load_k2(mesh, edges, traction)
 
     def body_force_load(self, mesh, field, lam, mu, projection="p0") -> np.ndarray:
         """P_0 f1 on the cell means (the paper's P_{k-2} f1) or P_1 f1 against Pi_2 v ("p1")."""
         if projection == "p0":
-            return k2_fields.body_force_k2(mesh, field)
-        return k2_fields.body_force_p1_k2(mesh, field, lam, mu)
+            return _fields().body_force_k2(mesh, field)
+        return _fields().body_force_p1_k2(mesh, field, lam, mu)
 
     def project(self, mesh, node_values, lam, mu):
-        return k2_fields.projected_solution_k2(mesh, node_values, lam, mu)
+        return _fields().projected_solution_k2(mesh, node_values, lam, mu)
 
     def interpolate(self, mesh, field) -> np.ndarray:
-        return k2_fields.interpolate_k2(mesh, field)
+        return _fields().interpolate_k2(mesh, field)
 
     def dirichlet_components(self, mesh, dirichlet):
-        return k2_fields.dirichlet_components(mesh, dirichlet)
+        return _fields().dirichlet_components(mesh, dirichlet)
 
     def edge_trace(self, s) -> np.ndarray:
-        return k2_fields.trace_weights(np.asarray(s, dtype=float))
+        return _fields().trace_weights(np.asarray(s, dtype=float))
 
 
 ELEMENT = SecondOrder()
+
+
+def _fields():
+    from vemkit.vem.elements import k2_fields
+    return k2_fields
+
+
+def _quadrature():
+    from vemkit.vem import quadrature
+    return quadrature
