@@ -261,9 +261,16 @@ def _normalized(value, node: dict):
     return value
 
 
+#: the body-force load of k = 2 when the scene names none (issue 18, item 9: p1 gives k = 2 its L2
+#: order 3; p0, the paper's, caps it at 2). At order 1 the key is irrelevant and stays unset.
+DEFAULT_BODY_FORCE_PROJECTION_K2 = "p1"
+
+
 def _check_order_options(discretization: dict) -> None:
-    """Options that exist for one order k only are refused at the other."""
-    if discretization["body_force_projection"] != "p0" and discretization["order"] != 2:
+    """Options that exist for one order k only are refused at the other; the k = 2 load's default."""
+    if discretization["order"] == 2:
+        discretization.setdefault("body_force_projection", DEFAULT_BODY_FORCE_PROJECTION_K2)
+    elif discretization.get("body_force_projection", "p0") != "p0":
         raise SceneError(f"discretization.body_force_projection = {discretization['body_force_projection']!r} "
                          "needs discretization.order = 2 (k = 1 loads the cell mean of f1); drop it or set "
                          "discretization.order=2", key="discretization.body_force_projection")
@@ -346,8 +353,10 @@ class Scene:
     contact_gauss_points = _field("discretization", "contact_gauss_points",
                                   doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
     order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
-    body_force_projection = _field("discretization", "body_force_projection",
-                                   doc="p0 (the paper's P_0 f1) or p1 (P_1 f1 against Pi_2 v): the k = 2 load")
+    body_force_projection = property(
+        lambda self: self._data["discretization"].get("body_force_projection", "p0"),
+        doc="the k = 2 load: p1 (the default at order 2: P_1 f1 against Pi_2 v) or p0 (the paper's "
+            "P_0 f1); p0 at order 1, where it is irrelevant")
     mesh_options = _field("discretization", "mesh", convert=dict,
                           doc="discretization.mesh: family, n / h / cells (or file) and the family "
                               "options given (a copy)")
