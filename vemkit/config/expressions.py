@@ -58,6 +58,22 @@ _NODE_DESCRIPTIONS = {
 }
 
 
+def _nesting_depth(text: str) -> int:
+    """The depth of ``text``'s syntax tree where a chain of one binary operator (a + b + c + ...)
+    counts as one level: what a reader calls nesting (only for the message of the depth limit)."""
+    try:
+        stack, deepest = [(ast.parse(text, mode="eval").body, 0)], 0
+    except (SyntaxError, RecursionError, MemoryError, ValueError):
+        return MAX_NESTING_DEPTH + 1
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        for child in ast.iter_child_nodes(node):
+            chained = isinstance(node, ast.BinOp) and isinstance(child, ast.BinOp) and type(child.op) is type(node.op)
+            stack.append((child, depth if chained else depth + 1))
+    return deepest
+
+
 def _shorten(text: str, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
@@ -84,8 +100,12 @@ class _Compiler:
 
     def compile(self, node: ast.AST, depth: int = 0):
         """Return ``("const", float)`` or ``("func", callable(x, y))`` for ``node``."""
-        if depth > MAX_NESTING_DEPTH:
+        if depth > MAX_NESTING_DEPTH and _nesting_depth(self.text) > MAX_NESTING_DEPTH:
             raise self.fail(f"nested more than {MAX_NESTING_DEPTH} levels deep", hint=False)
+        if depth > MAX_NESTING_DEPTH:  # a long flat chain: a + b + c + ... is not nested
+            raise self.fail(f"more than {MAX_NESTING_DEPTH} operations in one chain (a sum or product of "
+                            "that many terms); group the terms in parentheses, e.g. (a + b + ...) + (c + ...)",
+                            hint=False)
         if isinstance(node, ast.Constant):
             return self.compile_constant(node)
         if isinstance(node, ast.Name):
