@@ -18,6 +18,7 @@ targets and renamed over them only on success: whatever the paths held before is
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from contextlib import contextmanager
@@ -326,9 +327,25 @@ def _run(argv) -> int:
 
 
 def main(argv=None) -> int:
-    """The command; ``argv=None`` (the real command line) keeps the signal handlers installed up
-    to the process exit, so that a signal after the work still ends the process cleanly."""
-    from vemkit.io.output_files import exit_on_signals
+    """The command. ``argv=None`` (the real command line): the work runs in a forked worker and
+    this process only handles signals, so that SIGINT/SIGTERM/SIGHUP end the run within a second
+    even inside a long compiled kernel (``vemkit.io.supervisor``); it exits with the status.
+    ``main(argv)`` (in-process) runs here, with signal handlers for the duration of the call."""
+    if argv is None and hasattr(os, "fork"):
+        from vemkit.io.supervisor import supervised
+
+        status = supervised(lambda: _in_process(None))
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)  # no interpreter shutdown: nothing may run after the worker's result
+    return _in_process(argv)
+
+
+def _in_process(argv) -> int:
+    from vemkit.io.output_files import REPORT_FD, exit_on_signals
+
+    if REPORT_FD is not None:  # a supervised worker: signals are the parent's (ignored here)
+        return _run(argv)
 
     with exit_on_signals(restore=argv is not None):
         try:

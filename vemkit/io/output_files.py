@@ -12,7 +12,9 @@
   are gone. Two processes writing the same target each rename a complete file: one wins.
 - :func:`exit_on_signals` (the command line) makes SIGINT/SIGTERM/SIGHUP end the process at once,
   exit status 128 + signal number, after removing the temporary files this process created
-  (:data:`CREATED`); nothing else is touched.
+  (:data:`CREATED`); nothing else is touched. Under the command's supervisor
+  (``vemkit.io.supervisor``) the worker ignores signals instead and reports its temporary files and
+  the final write on a pipe (:data:`REPORT_FD`, :func:`_report`): the parent handles the signal.
 """
 
 from __future__ import annotations
