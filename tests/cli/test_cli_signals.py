@@ -123,3 +123,32 @@ def test_the_worker_dies_with_its_parent(tmp_path):
             break
         time.sleep(0.1)
     assert not found.strip(), f"worker left running: {found}"
+
+
+IN_THE_WRITE = """
+original_run = cli._run
+def marked_run(argv):
+    import time
+    import xarray as xr
+    write = xr.Dataset.to_netcdf
+    def slow_write(self, path, *args, **kwargs):
+        write(self, path, *args, **kwargs)
+        open(MARK, "w").close()
+        time.sleep(0.5)
+        open(MARK + ".written", "w").close()
+    xr.Dataset.to_netcdf = slow_write
+    return original_run(argv)
+cli._run = marked_run
+"""
+
+
+@pytest.mark.parametrize("signame, status", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_during_the_final_write_waits_for_the_writer_then_discards_it(tmp_path, signame, status):
+    """The parent forwards a signal that comes while the worker writes: the writer finishes (never
+    interrupted inside a lock), then the run ends with 128 + signal and the earlier file."""
+    args = ["solve", PAPER, "-q", "--set", "discretization.mesh.n=4"]
+    process, stderr, latency = _signalled(tmp_path, IN_THE_WRITE, args, signame)
+    assert (tmp_path / "mark.written").exists() and latency < LIMIT + 0.5
+    assert process.returncode == status, stderr
+    assert stderr.strip() == f"vemkit: interrupted by {signame}; no output written"
+    assert not _parts(tmp_path) and (tmp_path / "out.nc").read_bytes() == EARLIER

@@ -23,6 +23,7 @@ The worker dies with the parent (``PR_SET_PDEATHSIG`` on Linux). In-process call
 from __future__ import annotations
 
 import os
+import select
 import signal
 import sys
 
@@ -96,13 +97,16 @@ class _Supervisor:
         self.forwarded: int | None = None
         os.set_blocking(read_fd, False)
 
-    def drain(self) -> None:
+    def drain(self) -> bool:
+        """Read the worker's records so far; False once the worker closed its end (it ended)."""
+        open_end = True
         while True:
             try:
                 chunk = os.read(self.fd, 65536)
             except BlockingIOError:
-                chunk = None
+                break
             if not chunk:
+                open_end = False
                 break
             self.pending += chunk
         *lines, self.pending = self.pending.split(b"\n")
@@ -115,6 +119,7 @@ class _Supervisor:
                 self.parts = {p: None for p in self.parts if os.path.exists(p)}
             else:
                 self.holding = kind == "hold"
+        return open_end
 
     def on_signal(self, number, _frame) -> None:
         self.drain()
@@ -145,7 +150,10 @@ class _Supervisor:
             os._exit(128 + number)
 
     def wait(self) -> int:
-        """The worker's exit status, once it ended by itself."""
+        """The worker's exit status, once it ended by itself (its records read as they come, so
+        that it never blocks on a full pipe)."""
+        while self.drain():
+            select.select([self.fd], [], [])  # a signal interrupts it: on_signal runs at once
         while True:
             try:
                 _, status = os.waitpid(self.pid, 0)
