@@ -152,3 +152,18 @@ def test_a_signal_during_the_final_write_waits_for_the_writer_then_discards_it(t
     assert process.returncode == status, stderr
     assert stderr.strip() == f"vemkit: interrupted by {signame}; no output written"
     assert not _parts(tmp_path) and (tmp_path / "out.nc").read_bytes() == EARLIER
+
+
+def test_the_supervised_command_keeps_every_exit_status_and_stream(tmp_path):
+    """The parent exits with the worker's status: --version / --help (argparse's own exits) 0, a
+    usage error 2 in one line, a solve 0 with its summary on stdout."""
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True,
+                              text=True, timeout=300, cwd=tmp_path)
+    version = run("--version")
+    assert version.returncode == 0 and version.stdout.startswith("vemkit ") and not version.stderr
+    assert run("--help").returncode == 0
+    usage = run("solve")
+    assert usage.returncode == 2 and usage.stderr.count("\n") == 1 and "required" in usage.stderr
+    solved = run("solve", PAPER, "-o", "o.nc", "--set", "discretization.mesh.n=4")
+    assert solved.returncode == 0 and solved.stdout.startswith("o.nc: ssn converged") and not solved.stderr

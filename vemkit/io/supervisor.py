@@ -64,6 +64,10 @@ def _worker(work, write_fd: int, old_mask) -> None:
         _die_with_parent()
         output_files.REPORT_FD = write_fd
         status = work()
+    except SystemExit as done:  # --help, --version: argparse ends the work with a status
+        status = done.code if isinstance(done.code, int) else (0 if done.code is None else 2)
+        if not isinstance(done.code, (int, type(None))):
+            print(done.code, file=sys.stderr)
     except BaseException as error:  # noqa: BLE001 - work() reports its own failures; this is a bug
         print(f"vemkit: error: internal error ({type(error).__name__}: {error}); please report", file=sys.stderr)
     finally:
