@@ -96,3 +96,19 @@ def test_a_very_long_path_is_shortened_in_the_message_and_the_reason_stays_whole
     assert run.returncode == 2 and message.count("\n") == 1 and len(message) < 400, message
     fix = "does not exist; create it first" if where == "missing-folder" else "choose a shorter one"
     assert message.rstrip().endswith(fix) and "..." in message
+
+
+def test_an_append_only_target_is_refused_before_any_work(tmp_path):
+    """chattr +a on the file itself: it cannot be renamed over; refused, the file and the folder untouched."""
+    out = tmp_path / "out.nc"
+    out.write_bytes(b"earlier")
+    if not _append_only(out):
+        pytest.skip("chattr +a needs root and a file system with inode flags")
+    try:
+        run = vemkit("solve", PAPER, "-o", out, *SMALL, cwd=tmp_path)
+        message = run.stderr.decode()
+        assert run.returncode == 2 and message.count("\n") == 1, message
+        assert "the file is append-only or immutable (chattr); it cannot be replaced" in message
+        assert sorted(os.listdir(tmp_path)) == ["out.nc"] and out.read_bytes() == b"earlier"
+    finally:
+        subprocess.run(["chattr", "-a", str(out)], check=True)

@@ -148,7 +148,7 @@ def _inode_flags(path) -> int:
     except ImportError:  # not a POSIX system
         return 0
     try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError:
         return 0
     try:
