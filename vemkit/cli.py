@@ -18,6 +18,7 @@ targets and renamed over them only on success: whatever the paths held before is
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from contextlib import contextmanager
@@ -54,25 +55,37 @@ class _Progress:
 
 def _outputs(args, inputs):
     """(output, vtu) targets checked before any work (vemkit.io.output_files.output_target)."""
-    from vemkit.io.output_files import output_target, same_file
+    from vemkit.io.output_files import output_target, same_file, shown
 
     output = output_target(args.output, "-o", inputs)
     vtu = None if args.vtu is None else output_target(args.vtu, "--vtu", inputs)
     if vtu is not None and same_file(output, vtu):
-        raise OutputError(f"-o {args.output} and --vtu {args.vtu} name the same file; give two "
+        raise OutputError(f"-o {shown(args.output)} and --vtu {shown(args.vtu)} name the same file; give two "
                           "different paths", key="--vtu")
     return output, vtu
 
 
 @contextmanager
 def _writing(args):
-    """A failing writer (a full disk, a vanished directory) is an OutputError naming the outputs."""
+    """A failing writer (a full disk, a vanished directory) is an OutputError naming the outputs
+    and saying truly what was written (paths shortened, the reason whole)."""
     try:
         yield
     except (OSError, RuntimeError) as error:
-        names = " and ".join(p for p in (args.output, args.vtu) if p)
-        raise OutputError(f"cannot write {names} ({' '.join(str(error).split())}); nothing was "
-                          "written: check the disk space and permissions", key="-o") from None
+        from vemkit.io.output_files import WRITTEN, shown
+
+        names = " and ".join(shown(p) for p in (args.output, args.vtu) if p)
+        reason = error.strerror if isinstance(error, OSError) and error.strerror else shown(" ".join(str(error).split()), 200)
+        done = f"only {', '.join(map(shown, WRITTEN))} was written" if WRITTEN else "nothing was written"
+        raise OutputError(f"cannot write {names} ({reason}); {done}: check the disk space and permissions",
+                          key="-o") from None
+
+
+def _name(path) -> str:
+    """An output path for the summary line: printable even when it is not UTF-8."""
+    from vemkit.io.output_files import shown
+
+    return shown(path, limit=4096)
 
 
 def cmd_solve(args) -> int:
@@ -106,7 +119,7 @@ def cmd_solve(args) -> int:
             cells = {k: ds[k].values for k in ("stress_11", "stress_22", "stress_12", "shear_energy_density")}
             write_vtu(problem.mesh, vtu_part, point_data={"displacement": u}, cell_data=cells)
     if not args.quiet:
-        print(f"{args.output}: {solution.method} converged in {solution.iterations} iterations, "
+        print(f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
               f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})")
     return 0
 
@@ -157,9 +170,9 @@ def cmd_adapt(args) -> int:
     if run.reason != "target":
         print(f"vemkit: note: adaptivity.target = {settings.target:g} not reached: {STOP_REASONS[run.reason]} "
               f"(estimate {last['estimate']:.3e} after {len(run.history)} steps, {last['n_dofs']} dofs); "
-              f"{args.output} holds the last solution", file=sys.stderr)
+              f"{_name(args.output)} holds the last solution", file=sys.stderr)
     if not args.quiet:
-        print(f"{args.output}: {len(run.history)} adaptive steps ({run.reason}), {last['n_dofs']} dofs, "
+        print(f"{_name(args.output)}: {len(run.history)} adaptive steps ({run.reason}), {last['n_dofs']} dofs, "
               f"{last['n_cells']} cells, estimate {last['estimate']:.3e}, {ds.attrs['adapt_wall_time']:.2f} s "
               f"(check {ds.attrs['check_worst']:.1e})")
     return 0
@@ -213,7 +226,7 @@ def cmd_mesh(args) -> int:
         if vtu_part is not None:
             write_vtu(mesh, vtu_part)
     if not args.quiet:
-        print(f"{args.output}: {family} mesh, {mesh.n_cells} cells, {mesh.n_vertices} vertices")
+        print(f"{_name(args.output)}: {family} mesh, {mesh.n_cells} cells, {mesh.n_vertices} vertices")
     return 0
 
 
@@ -281,7 +294,9 @@ MAX_MESSAGE = 1000  # characters of an error line: a 4000-character path or a li
 
 def _fail(message, status: int = EXIT_FAILURE) -> int:
     text = " ".join(str(message).split())
-    text = text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE - 3] + "..."
+    text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    if len(text) > MAX_MESSAGE:  # cut the middle: the fix is at the end of the line
+        text = text[:MAX_MESSAGE // 3] + " ... " + text[-(2 * MAX_MESSAGE // 3 - 5):]
     print(f"vemkit: error: {text}", file=sys.stderr)
     return status
 
@@ -304,7 +319,9 @@ def _run(argv) -> int:
         return _fail("out of memory although the estimate fitted (please report); use a coarser "
                      "discretization.mesh")
     except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
-        where = f"{error.filename}: " if error.filename else ""
+        from vemkit.io.output_files import shown
+
+        where = f"{shown(error.filename)}: " if error.filename else ""
         return _fail(f"{where}{error.strerror or error}; nothing was written")
     except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
         return _fail(f"internal error ({type(error).__name__}: {error}); please report",
@@ -312,9 +329,25 @@ def _run(argv) -> int:
 
 
 def main(argv=None) -> int:
-    """The command; ``argv=None`` (the real command line) keeps the signal handlers installed up
-    to the process exit, so that a signal after the work still ends the process cleanly."""
-    from vemkit.io.output_files import exit_on_signals
+    """The command. ``argv=None`` (the real command line): the work runs in a forked worker and
+    this process only handles signals, so that SIGINT/SIGTERM/SIGHUP end the run within a second
+    even inside a long compiled kernel (``vemkit.io.supervisor``); it exits with the status.
+    ``main(argv)`` (in-process) runs here, with signal handlers for the duration of the call."""
+    if argv is None and hasattr(os, "fork"):
+        from vemkit.io.supervisor import supervised
+
+        status = supervised(lambda: _in_process(None))
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)  # no interpreter shutdown: nothing may run after the worker's result
+    return _in_process(argv)
+
+
+def _in_process(argv) -> int:
+    from vemkit.io.output_files import REPORT_FD, exit_on_signals
+
+    if REPORT_FD is not None:  # a supervised worker: signals are the parent's (ignored here)
+        return _run(argv)
 
     with exit_on_signals(restore=argv is not None):
         try:

@@ -76,6 +76,22 @@ def shorten(text: str, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def nesting_depth(text: str) -> int:
+    """The depth of ``text``'s syntax tree where a chain of one binary operator (a + b + c + ...)
+    counts as one level: what a reader calls nesting (only for the message of the depth limit)."""
+    try:
+        stack, deepest = [(ast.parse(text, mode="eval").body, 0)], 0
+    except (SyntaxError, RecursionError, MemoryError, ValueError):
+        return MAX_NESTING_DEPTH + 1
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        for child in ast.iter_child_nodes(node):
+            chained = isinstance(node, ast.BinOp) and isinstance(child, ast.BinOp) and type(child.op) is type(node.op)
+            stack.append((child, depth if chained else depth + 1))
+    return deepest
+
+
 def fail(name: str, text: str, problem: str, *, hint: bool = True) -> ExpressionError:
     """The one-line error of scene key ``name`` = ``text``, with the language summary if ``hint``."""
     message = f"{name} = {shorten(text)!r}: {problem}"
@@ -91,6 +107,13 @@ class _Parser:
     def fail(self, problem: str, *, hint: bool = True) -> ExpressionError:
         return fail(self.name, self.text, problem, hint=hint)
 
+    def too_deep(self) -> ExpressionError:
+        """The depth limit: truly nested, or a long flat chain a + b + c + ... (which is not nested)."""
+        if nesting_depth(self.text) > MAX_NESTING_DEPTH:
+            return self.fail(f"nested more than {MAX_NESTING_DEPTH} levels deep", hint=False)
+        return self.fail(f"more than {MAX_NESTING_DEPTH} operations in one chain (a sum or product of that many "
+                         "terms); group the terms in parentheses, e.g. (a + b + ...) + (c + ...)", hint=False)
+
     def segment(self, node: ast.AST) -> str:
         try:
             source = ast.get_source_segment(self.text, node)
@@ -105,7 +128,7 @@ class _Parser:
     def value(self, node: ast.AST, depth: int = 0) -> Node:
         """A numeric subtree (conditions are refused here)."""
         if depth > MAX_NESTING_DEPTH:
-            raise self.fail(f"nested more than {MAX_NESTING_DEPTH} levels deep", hint=False)
+            raise self.too_deep()
         if isinstance(node, ast.Constant):
             return self.constant(node)
         if isinstance(node, ast.Name):
@@ -131,7 +154,7 @@ class _Parser:
     def condition(self, node: ast.AST, depth: int) -> Node:
         """A condition: comparisons (chained ones as ``and``) joined by and/or/not or & |."""
         if depth > MAX_NESTING_DEPTH:
-            raise self.fail(f"nested more than {MAX_NESTING_DEPTH} levels deep", hint=False)
+            raise self.too_deep()
         if isinstance(node, ast.Compare):
             operands = [self.value(part, depth + 1) for part in [node.left, *node.comparators]]
             pairs = []

@@ -95,35 +95,72 @@ def _branch_for(node: dict, segment: str) -> dict:
     return node
 
 
+_KEY_PATH = re.compile(r"[\w-]+(?:\.[\w-]+|\[\d+\])*")
+_KEY_SEGMENT = re.compile(r"\.?([\w-]+)|\[(\d+)\]")
+
+
+def _key_segments(override: str, key_text: str) -> list:
+    """``a.b[0].c`` as ["a", "b", 0, "c"]; an empty component or a bad index is a true message."""
+    if _KEY_PATH.fullmatch(key_text):
+        return [int(m[2]) if m[2] is not None else m[1] for m in _KEY_SEGMENT.finditer(key_text)]
+    if re.search(r"\.\.|^\.|\.$|\.\[", key_text):
+        problem = "a key component is empty (two dots, or a dot at an end)"
+    elif re.search(r"\[[^\]]*\]", key_text) and not re.search(r"\[\d+\]", key_text) or \
+            re.search(r"\[(?!\d+\])", key_text):
+        problem = "a list index is a whole number from 0 in brackets, e.g. boundary.dirichlet[0]"
+    else:
+        problem = "a key is letters, digits, _ and -, joined by dots"
+    raise SceneError(f"--set {override}: {problem}; expected key.path=value, e.g. --set solver.method=uzawa",
+                     key=key_text)
+
+
+def _schema_step(node: dict, segment, container, override: str, path: list) -> dict:
+    """The schema of ``container[segment]`` (``container`` the value at ``path``)."""
+    node = _branch_for(node, str(segment))
+    if isinstance(segment, int):
+        if not isinstance(container, list) or "items" not in node:
+            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} is not a list; "
+                             f"drop [{segment}]", key=_key(path))
+        if segment >= len(container):
+            count = len(container)
+            indices = {0: "no index", 1: "the index 0"}.get(count, f"an index 0 ... {count - 1}")
+            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has {count} "
+                             f"entr{'y' if count == 1 else 'ies'}: give {indices}, or set the whole list, "
+                             f"e.g. --set '{_key(path)}=[...]'", key=_key(path))
+        return _resolve(node["items"])
+    if isinstance(container, list):
+        raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} is a list: index it "
+                         f"({_key(path)}[0]) or set the whole value, e.g. --set '{_key(path)}={{{segment}: ...}}'",
+                         key=_key(path))
+    if not isinstance(container, dict):
+        raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has no entry {segment!r}",
+                         key=_key(path))
+    if "properties" in node:
+        if segment not in node["properties"]:
+            raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
+                             f"{_suggest(segment, node['properties'])}", key=_key([*path, segment]))
+        return _resolve(node["properties"][segment])
+    if isinstance(node.get("additionalProperties"), dict):  # a map: side name -> entry
+        return _resolve(node["additionalProperties"])
+    raise SceneError(f"--set {override}: {_key(path)!r} has no key {segment!r}", key=_key(path))
+
+
 def _apply_override(data: dict, override: str) -> None:
-    """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema."""
+    """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema, every index in
+    the list it indexes."""
     key_text, separator, value_text = str(override).partition("=")
-    segments = [s for s in re.split(r"\.|\[(\d+)\]", key_text.strip()) if s]
-    if not separator or not segments or not all(re.fullmatch(r"[\w-]+", s) for s in segments):
+    if not separator or not key_text.strip():
         raise SceneError(f"--set {override}: expected key.path=value, e.g. --set solver.method=uzawa")
+    segments = _key_segments(override, key_text.strip())
     value = _parse_yaml(value_text, f"--set {override}")
     node, container, path = _resolve(_validator().schema), data, []
     for position, segment in enumerate(segments):
-        node = _branch_for(node, segment)
-        if "properties" in node:
-            if segment not in node["properties"]:
-                raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
-                                 f"{_suggest(segment, node['properties'])}")
-            node = _resolve(node["properties"][segment])
-        elif isinstance(node.get("additionalProperties"), dict):  # a map: side name -> entry
-            node = _resolve(node["additionalProperties"])
-        elif "items" in node and segment.isdigit():
-            node, segment = _resolve(node["items"]), int(segment)
-        else:
-            raise SceneError(f"--set {override}: {_key(path)!r} has no key {segment!r}")
-        if isinstance(container, dict) and isinstance(segment, str) and segments[position + 1:]:
+        node = _schema_step(node, segment, container, override, path)
+        last = position == len(segments) - 1
+        if isinstance(segment, str) and not last:
             container.setdefault(segment, copy.deepcopy(node.get("default", {})))
-        elif not (isinstance(container, dict) and isinstance(segment, str) or isinstance(
-                container, list) and isinstance(segment, int) and segment < len(container)):
-            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has no "
-                             f"entry {segment!r}")
         path.append(segment)
-        if segments[position + 1:]:
+        if not last:
             container = container[segment]
         else:
             if path[:2] == ["discretization", "mesh"] and segment in _MESH_SIZE_KEYS:
@@ -262,9 +299,16 @@ def _normalized(value, node: dict):
     return value
 
 
+#: the body-force load of k = 2 when the scene names none (issue 18, item 9: p1 gives k = 2 its L2
+#: order 3; p0, the paper's, caps it at 2). At order 1 the key is irrelevant and stays unset.
+DEFAULT_BODY_FORCE_PROJECTION_K2 = "p1"
+
+
 def _check_order_options(discretization: dict) -> None:
-    """Options that exist for one order k only are refused at the other."""
-    if discretization["body_force_projection"] != "p0" and discretization["order"] != 2:
+    """Options that exist for one order k only are refused at the other; the k = 2 load's default."""
+    if discretization["order"] >= 2:  # the cell moments of k >= 2 carry the body force
+        discretization.setdefault("body_force_projection", DEFAULT_BODY_FORCE_PROJECTION_K2)
+    elif discretization.get("body_force_projection", "p0") != "p0":
         raise SceneError(f"discretization.body_force_projection = {discretization['body_force_projection']!r} "
                          "needs discretization.order = 2 (k = 1 loads the cell mean of f1); drop it or set "
                          "discretization.order=2", key="discretization.body_force_projection")
@@ -348,8 +392,10 @@ class Scene:
     contact_gauss_points = _field("discretization", "contact_gauss_points",
                                   doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
     order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
-    body_force_projection = _field("discretization", "body_force_projection",
-                                   doc="p0 (the paper's P_0 f1) or p1 (P_1 f1 against Pi_2 v): the k = 2 load")
+    body_force_projection = property(
+        lambda self: self._data["discretization"].get("body_force_projection", "p0"),
+        doc="the k = 2 load: p1 (the default at order 2: P_1 f1 against Pi_2 v) or p0 (the paper's "
+            "P_0 f1); p0 at order 1, where it is irrelevant")
     mesh_options = _field("discretization", "mesh", convert=dict,
                           doc="discretization.mesh: family, n / h / cells (or file) and the family "
                               "options given (a copy)")

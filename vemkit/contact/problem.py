@@ -126,7 +126,7 @@ def discrete_problem(
     mesh: Mesh, E: float, nu: float, *, order: int = 1, dirichlet=("right",), neumann=None, pressure=None,
     contact=(), gap=lambda x, y: np.zeros_like(x), law: ContactLaw | None = None, body_force=None,
     stabilization: str = "dofi-2mu", contact_quadrature: str = "nodal", contact_gauss_points: int = 3,
-    body_force_projection: str = "p0", model: str = "plane_stress",
+    body_force_projection: str | None = None, model: str = "plane_stress",
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -134,8 +134,9 @@ def discrete_problem(
     dirichlet: side names (u = 0) or {part: (u1, u2)}, each None (free), a number or a function
     of (x, y); a rigid motion left free is a SceneError.
     neumann: {part: traction(x, y) -> (f2_1, f2_2)}; pressure: {part: p(x, y)} (traction -p nu);
-    body_force(x, y) -> (f1_1, f1_2), projected as ``body_force_projection`` (k = 2: "p0", the paper's
-    P_0 f1, or "p1"). contact_quadrature: nodal or gauss (with contact_gauss_points per edge).
+    body_force(x, y) -> (f1_1, f1_2), projected as ``body_force_projection`` (k = 2: "p1", the default,
+    or "p0", the paper's P_0 f1; None: the element's default). contact_quadrature: nodal or gauss
+    (with contact_gauss_points per edge).
     model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
@@ -144,7 +145,8 @@ def discrete_problem(
     lam, mu = lame_parameters(E, nu, model)
     dofs = constrained(space, dirichlet)
     K = space.stiffness_matrix(lam, mu, stabilization, dofs)
-    full_load = problem_load(space, neumann, pressure, body_force, body_force_projection, lam, mu)
+    projection = body_force_projection or space.element.default_body_force_projection
+    full_load = problem_load(space, neumann, pressure, body_force, projection, lam, mu)
     if dofs.condensed:
         f = condense_load(space, lam, mu, stabilization, dofs, full_load)
         interior = interior_load(space, full_load)

@@ -12,28 +12,33 @@
   are gone. Two processes writing the same target each rename a complete file: one wins.
 - :func:`exit_on_signals` (the command line) makes SIGINT/SIGTERM/SIGHUP end the process at once,
   exit status 128 + signal number, after removing the temporary files this process created
-  (:data:`CREATED`); nothing else is touched.
+  (:data:`CREATED`); nothing else is touched. Under the command's supervisor
+  (``vemkit.io.supervisor``) the worker ignores signals instead and reports its temporary files and
+  the final write on a pipe (:data:`REPORT_FD`, :func:`_report`): the parent handles the signal.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import secrets
 import signal
 import stat
 import sys
-import tempfile
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 
 from vemkit.exceptions import OutputError
 
-__all__ = ["CREATED", "atomic_outputs", "exit_on_signals", "output_target", "same_file"]
+__all__ = ["CREATED", "atomic_outputs", "deliver", "exit_on_signals", "output_target", "same_file", "shown"]
 
 #: temporary files this process created and has not renamed yet (removed on a signal)
 CREATED: set[str] = set()
 #: targets this process has replaced (for the message on a signal)
 WRITTEN: list[str] = []
+#: in a worker under ``vemkit.io.supervisor``: the pipe to the parent (see :func:`_report`)
+REPORT_FD: int | None = None
 HANDLED_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
                         if hasattr(signal, name))
 _KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
@@ -60,10 +65,25 @@ def _limits(directory: str) -> tuple[int, int]:
         return 255, 4096
 
 
+def shown(path, limit: int = 80) -> str:
+    """``path`` for a message: printable (bytes that are not UTF-8 as ``\\xff``, as a shell shows
+    them) and at most ``limit`` characters (the middle cut), so a long path never crowds the reason
+    out of the one-line error."""
+    text = os.fspath(path)
+    text = os.fsdecode(text) if isinstance(text, bytes) else text
+    text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    if len(text) <= limit:
+        return text
+    tail = max(20, min(len(os.path.basename(text)) + 1, limit - 23))  # the name whole if it fits
+    return text[:limit - 3 - tail] + "..." + text[-tail:]
+
+
 def output_target(path, option: str = "-o", inputs=()) -> Path:
     """The file ``path`` names, checked for writing (see the module docstring); else OutputError."""
     text = os.fspath(path)
-    where = f"{option} {text if len(text) <= 80 else text[:60] + '...' + text[-17:]}"
+    text = os.fsdecode(text) if isinstance(text, bytes) else text
+    where = f"{option} {shown(text)}"
     if not text or text.endswith(os.sep) or "\0" in text:
         raise OutputError(f"{where}: give the path of a file, e.g. {option} out.nc", key=option)
     target = Path(os.path.realpath(text))  # follow links: replace what they point to
@@ -73,7 +93,7 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
                           f"at most {name_max - 24} bytes here); choose a shorter one", key=option)
     for source in inputs:
         if source is not None and same_file(source, target):
-            raise OutputError(f"{where}: this is the input file {source}; write the output to "
+            raise OutputError(f"{where}: this is the input file {shown(source)}; write the output to "
                               "another path", key=option)
     try:
         mode = os.stat(target).st_mode
@@ -86,41 +106,131 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
         raise OutputError(f"{where}: exists and is {_kind(mode)}; give the path of a regular "
                           "file", key=option)
     _check_directory(target.parent, where, option)
+    _check_replaceable(target, mode, where, option)
     return target
 
 
 def _check_directory(directory: Path, where: str, option: str) -> None:
+    folder = shown(directory)
     try:
         mode = os.stat(directory).st_mode
     except FileNotFoundError:
-        raise OutputError(f"{where}: the directory {directory} does not exist; create it first",
+        raise OutputError(f"{where}: the directory {folder} does not exist; create it first",
                           key=option) from None
     except OSError as error:
-        raise OutputError(f"{where}: cannot use the directory {directory} ({error.strerror}); "
+        raise OutputError(f"{where}: cannot use the directory {folder} ({error.strerror}); "
                           "choose another path", key=option) from None
     if not stat.S_ISDIR(mode):
-        raise OutputError(f"{where}: {directory} is not a directory; choose another path",
+        raise OutputError(f"{where}: {folder} is not a directory; choose another path",
                           key=option)
     if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputError(f"{where}: the directory {directory} is not writable; choose another "
+        raise OutputError(f"{where}: the directory {folder} is not writable; choose another "
                           "path", key=option)
+    flags = _inode_flags(directory)
+    if flags & (FS_APPEND_FL | FS_IMMUTABLE_FL):
+        kind = "append-only" if flags & FS_APPEND_FL else "immutable"
+        raise OutputError(f"{where}: the directory {folder} is {kind} (chattr +{kind[0]}): a file "
+                          "made there could not be renamed into place nor removed; choose another "
+                          f"directory or lift it with chattr -{kind[0]}", key=option)
+
+
+#: Linux inode flags (``chattr``): a directory flagged so lets files be created in it but not
+#: renamed or removed (+a), or not even created (+i)
+FS_APPEND_FL, FS_IMMUTABLE_FL = 0x20, 0x10
+_FS_IOC_GETFLAGS = 0x80086601
+
+
+def _inode_flags(path) -> int:
+    """The ``chattr`` flags of ``path``, 0 where the file system or the platform has none."""
+    try:
+        import fcntl
+        import struct
+    except ImportError:  # not a POSIX system
+        return 0
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return 0
+    try:
+        return struct.unpack("l", fcntl.ioctl(fd, _FS_IOC_GETFLAGS, struct.pack("l", 0)))[0]
+    except OSError:  # ENOTTY: the file system keeps no such flags
+        return 0
+    finally:
+        os.close(fd)
+
+
+def _check_replaceable(target: Path, mode, where: str, option: str) -> None:
+    """An existing target that this process may not replace: flagged append-only or immutable, or
+    owned by another user in a sticky directory such as /tmp (rename over it fails)."""
+    if mode is None:
+        return
+    if _inode_flags(target) & (FS_APPEND_FL | FS_IMMUTABLE_FL):
+        raise OutputError(f"{where}: the file is append-only or immutable (chattr); it cannot be "
+                          "replaced: choose another path", key=option)
+    parent = os.stat(target.parent)
+    uid = os.geteuid() if hasattr(os, "geteuid") else None
+    if uid not in (None, 0) and parent.st_mode & stat.S_ISVTX and os.stat(target).st_uid != uid \
+            and parent.st_uid != uid:
+        raise OutputError(f"{where}: the file belongs to another user in a sticky directory; it "
+                          "cannot be replaced: choose another path", key=option)
+
+
+def _report(record: str) -> None:
+    """Tell the supervising parent (``vemkit.io.supervisor``) what this worker does, if it has one:
+    ``part NAME`` before a temporary file is made, ``done NAME`` once a target was replaced,
+    ``hold`` / ``free`` around the final write (a signal then waits for the writer)."""
+    if REPORT_FD is not None:
+        os.write(REPORT_FD, (record + "\n").encode("utf-8", "surrogateescape"))
 
 
 def _temporary_next_to(target: Path) -> Path:
-    fd, name = tempfile.mkstemp(prefix=f".{target.name[:100]}.", suffix=".part", dir=target.parent)
-    CREATED.add(name)
-    os.close(fd)
-    return Path(name)
+    """A new empty ``.NAME.XXXX.part`` next to ``target``; its name is ASCII (the netCDF library
+    encodes names as UTF-8: a target name that is not UTF-8 must not reach it)."""
+    safe = re.sub(r"[^A-Za-z0-9._-]", "_", target.name[:100])
+    while True:
+        name = os.path.join(target.parent, f".{safe}.{secrets.token_hex(6)}.part")
+        _report(f"part {name}")  # before it exists: a kill in between leaves nothing behind
+        CREATED.add(name)
+        try:
+            os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+        except FileExistsError:
+            CREATED.discard(name)
+            continue
+        except BaseException:
+            CREATED.discard(name)
+            raise
+        return Path(name)
 
 
-def _discard(paths) -> None:
+def _writer_path(temporary: Path, keep: list) -> Path:
+    """The name a writer library opens: ``temporary`` itself, or, when its directory's name is not
+    UTF-8, the same file through ``/proc/self/fd/DIRFD/`` (an ASCII alias)."""
+    try:
+        os.fspath(temporary).encode("utf-8")
+        return temporary
+    except UnicodeEncodeError:
+        if not os.path.isdir("/proc/self/fd"):
+            raise OutputError(f"{shown(temporary.parent)}: the directory's name is not UTF-8, which the "
+                              "netCDF library cannot open here; choose another directory", key="-o") from None
+        fd = os.open(temporary.parent, os.O_RDONLY)
+        keep.append(fd)
+        return Path(f"/proc/self/fd/{fd}/{temporary.name}")
+
+
+def _discard(paths) -> list:
+    """Remove the temporary files among ``paths`` this process made; returns (path, reason) of
+    those that could not be removed (an append-only directory, a permission taken away)."""
+    left = []
     for path in paths:
         if path is not None and str(path) in CREATED:
             try:
                 os.unlink(path)
             except FileNotFoundError:
                 pass
+            except OSError as error:
+                left.append((str(path), error.strerror or str(error)))
             CREATED.discard(str(path))
+    return left
 
 
 def _finish(temporary: Path) -> None:
@@ -157,11 +267,13 @@ def _signals_deferred():
         return
     previous = {s: signal.signal(s, lambda number, _frame: received.append(number))
                 for s in HANDLED_SIGNALS}
+    _report("hold")  # a supervising parent now forwards signals instead of ending this process
     try:
         yield received
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
+        _report("free")
 
 
 @contextmanager
@@ -169,36 +281,66 @@ def atomic_outputs(*targets):
     """Temporary files for ``targets`` (None entries stay None); renamed over them on success.
 
     ``with atomic_outputs(out, vtu) as (tmp_out, tmp_vtu): write(tmp_out); write(tmp_vtu)``
+    A failure to replace a target or to remove a temporary file is an OutputError saying what was
+    written and what was left.
     """
     targets = [None if t is None else Path(t) for t in targets]
     temporaries: list = []
-    committed = False
+    descriptors: list = []
+    committed, failure = False, None
     with _signals_deferred() as received:
         try:
             temporaries.extend(None if t is None else _temporary_next_to(t) for t in targets)
-            yield temporaries
+            yield [None if t is None else _writer_path(t, descriptors) for t in temporaries]
             if not received:
-                pairs = [(tmp, t) for tmp, t in zip(temporaries, targets) if t is not None]
-                for tmp, _ in pairs:
-                    _finish(tmp)
-                for tmp, target in pairs:
-                    os.replace(tmp, target)
-                    CREATED.discard(str(tmp))
-                    WRITTEN.append(str(target))
-                for directory in {target.parent for _, target in pairs}:
-                    _fsync_directory(directory)
+                _commit([(tmp, t) for tmp, t in zip(temporaries, targets) if t is not None])
                 committed = True
+        except OSError as error:
+            failure = error
+            raise
         finally:
-            if not committed:
-                _discard(temporaries)
+            for fd in descriptors:
+                os.close(fd)
+            left = [] if committed else _discard(temporaries)
+            if left:
+                _left_behind(left, failure)
     if received:  # deliver the deferred signal now that nothing is half written
-        signal.raise_signal(received[0])
+        deliver(received[0])
+
+
+def _commit(pairs) -> None:
+    for tmp, _ in pairs:
+        _finish(tmp)
+    for tmp, target in pairs:
+        os.replace(tmp, target)
+        CREATED.discard(str(tmp))
+        WRITTEN.append(str(target))
+        _report(f"done {target}")
+    for directory in {target.parent for _, target in pairs}:
+        _fsync_directory(directory)
+
+
+def _left_behind(left, failure) -> None:
+    name, reason = left[0]
+    written = f"wrote {', '.join(map(shown, WRITTEN))}" if WRITTEN else "nothing was written"
+    cause = f" after {failure.strerror or failure}" if isinstance(failure, OSError) else ""
+    raise OutputError(f"could not finish the output{cause}: {written}, and the temporary file "
+                      f"{shown(name)} could not be removed ({reason}); remove it by hand and check the "
+                      "directory's permissions and attributes (lsattr -d)", key="-o")
+
+
+def deliver(number: int) -> None:
+    """Act on a signal that was held back: in a supervised worker exit at once (its handlers ignore
+    signals: the parent handles them), else raise it again in this process."""
+    if REPORT_FD is not None:
+        _exit_now(number, None)
+    signal.raise_signal(number)
 
 
 def _exit_now(number, _frame) -> None:
     _discard(list(CREATED))
     name = signal.Signals(number).name
-    done = f"; wrote {', '.join(WRITTEN)} before it" if WRITTEN else "; no output written"
+    done = f"; wrote {', '.join(map(shown, WRITTEN))} before it" if WRITTEN else "; no output written"
     try:
         os.write(2, f"vemkit: interrupted by {name}{done}\n".encode())
     except OSError:

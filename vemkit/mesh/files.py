@@ -42,6 +42,7 @@ from vemkit.config.limits import check_resources, estimate_resources, memory_bud
 from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
+from vemkit.mesh.gmsh_errors import gmsh_read_error, meshio_warnings
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
 
@@ -221,7 +222,7 @@ def _check_precision(mesh: Mesh, path: Path) -> None:
 def read_gmsh(path) -> Mesh:
     """The mesh of a gmsh file (not validated; see ``read_mesh``), sides from physical line groups."""
     path = Path(path)
-    data = meshio.gmsh.read(path)  # not meshio.read: on a broken file it prints and exits the process
+    data = _meshio_gmsh(path)
     if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
         v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
         raise MeshError(f"{path.name}: node {v} (counting from 0) has z = {data.points[v, 2]:g}; give a plane mesh "
@@ -259,6 +260,24 @@ def read_gmsh(path) -> Mesh:
                             "which no cell uses; tag boundary lines of the mesh only", key=str(path))
         return mesh.with_boundary(**_gmsh_sides(mesh, renumber[lines], np.concatenate(line_tags), names, path))
     return mesh.with_boundary(untagged=mesh.boundary_edges)
+
+
+def _meshio_gmsh(path: Path):
+    """meshio's gmsh reader (not meshio.read: on a broken file it prints and exits the process), its
+    warnings kept off the terminal; a file it cannot read, or whose section it finds unclosed, is a
+    MeshError naming the file, the line and the fix (``vemkit.mesh.gmsh_errors``)."""
+    notes: list = []
+    with meshio_warnings(notes):
+        try:
+            data = meshio.gmsh.read(path)
+        except MemoryError:
+            raise
+        except Exception as error:  # meshio's raw Python text: located and explained instead
+            raise gmsh_read_error(path, " ".join(str(error).split()) or type(error).__name__) from None
+    unclosed = [note for note in notes if "not closed" in note]
+    if unclosed:
+        raise gmsh_read_error(path, unclosed[0])
+    return data
 
 
 def _gmsh_sides(mesh: Mesh, lines: np.ndarray, tags: np.ndarray, names: dict, path: Path) -> dict:

@@ -65,6 +65,7 @@ class Element:
     condensed_nodes: int = 0
     numbering: str = "mesh"
     projection_uses_material: bool = True
+    default_body_force_projection: str = "p0"  # the body-force load's projection of f1 (Section 3.3)
     stress_degree: int = 1  # degree of sigma(Pi u_h) on a cell: k - 1
     polynomial_on_triangles: bool = False  # V_h^K = [P_k]^2 on triangles: Pi = I, the stabilization vanishes
     contact_rule: tuple  # ((s, weight), ...) per trace node of an edge, in ``edge_trace`` order
