@@ -4,7 +4,8 @@ Each step solves the scene's contact problem on the current mesh, checks the sol
 independently (as ``vemkit solve`` does), computes the indicators η_K of ``vemkit.vem.estimator``
 (with the contact traction of the solution as the Γ_C datum), stops when the relative estimate
 η ≤ ``target``, when the next mesh would have more than ``max_dofs`` unknowns (counted as 2 × its
-vertices, an upper bound: no mesh beyond the limit is ever assembled) or after
+vertices, an upper bound: no mesh beyond the limit is ever assembled) or would need more memory than
+the machine has (the prediction of ``vemkit.config.limits``, checked before it is solved), or after
 ``max_steps`` solves, and otherwise refines the Dörfler-marked cells (``vemkit.mesh.refine``;
 new vertices on a circular hole or an arc of the scene's domain are placed on the curve).
 
@@ -28,7 +29,8 @@ import xarray as xr
 
 from vemkit.config.domain import CircleHole, domain_from_spec
 from vemkit.contact.problem import scene_problem
-from vemkit.exceptions import InputError, ResultError
+from vemkit.config.limits import check_resources, estimate_resources
+from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.refine import refine_cells
@@ -75,7 +77,7 @@ class AdaptiveRun:
     solution: object  # its ContactSolution
     indicators: dict  # error_indicators of the last solution
     history: list = field(default_factory=list)  # one dict per step (the keys of HISTORY_ATTRS)
-    reason: str = ""  # why the loop stopped: target, max_dofs, max_steps, unrefinable
+    reason: str = ""  # why the loop stopped: target, max_dofs, memory, max_steps, unrefinable
     checks: dict = field(default_factory=dict)  # the independent check of the last solution
 
 
@@ -196,9 +198,8 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
             refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
-            if 2 * refined.mesh.n_vertices > settings.max_dofs:
-                reason = "max_dofs"
-            elif refined.refined.size == 0:
+            reason = _limit_reason(refined.mesh, settings.max_dofs)  # before the mesh is assembled or solved
+            if reason is None and refined.refined.size == 0:
                 reason = "unrefinable"
             mesh, previous = refined.mesh, (refined, problem, solution)
         record["wall_time"] = time.perf_counter() - start
@@ -211,6 +212,19 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             return run
     run.reason = "max_steps"
     return run
+
+
+def _limit_reason(mesh, max_dofs: int):
+    """"max_dofs" or "memory" when solving ``mesh`` would pass ``max_dofs`` or the memory this machine has
+    (the prediction of ``vemkit.config.limits``, 2 DOFs per vertex), else None."""
+    estimate = estimate_resources(mesh.n_cells, mesh.n_vertices)
+    if estimate.dofs > max_dofs:
+        return "max_dofs"
+    try:
+        check_resources(estimate, None)
+    except ResourceLimitError:
+        return "memory"
+    return None
 
 
 def _stop_reason(estimate: float, step: int, settings: AdaptivitySettings):
@@ -227,6 +241,7 @@ STOP_REASONS = {
     "max_dofs": "the next mesh would exceed adaptivity.max_dofs (or --max-dofs)",
     "max_steps": "adaptivity.max_steps solves were done",
     "unrefinable": "no marked cell could be split (no centre in its kernel)",
+    "memory": "the next mesh would need more memory than this machine has available",
 }
 _STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop records
     ("estimate", "relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),
