@@ -27,12 +27,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from vemkit.config.domain import CircleHole, domain_from_spec
 from vemkit.contact.problem import scene_problem
 from vemkit.config.limits import check_resources, estimate_resources
 from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
-from vemkit.mesh.families import scene_mesh
+from vemkit.mesh.curves import domain_curves
+from vemkit.mesh.families import checked_mesh, scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
@@ -110,20 +110,10 @@ def scene_indicators(scene, problem, solution) -> dict:
                             body_force=body, neumann=neumann, contact=contact)
 
 
-def curved_sides(domain_spec) -> dict:
-    """{side: [cx, cy, r]} of the sides that lie on one circle: circular holes, and outer sides all of
-    whose edges are arcs of one circle (SPEC §7); refinement puts new boundary vertices on it."""
-    domain = domain_from_spec(domain_spec)
-    out = {hole.side: [hole.cx, hole.cy, hole.r] for hole in domain.holes if isinstance(hole, CircleHole)}
-    arcs = {}
-    for i, side in enumerate(domain.sides):
-        centre = domain.arcs[i] if domain.arcs else None
-        r = None if centre is None else round(float(np.hypot(*np.subtract(domain.polygon[i], centre))), 12)
-        arcs.setdefault(side, set()).add(None if centre is None else (float(centre[0]), float(centre[1]), r))
-    for side, circles in arcs.items():
-        if len(circles) == 1 and None not in circles and side not in out:
-            out[side] = list(next(iter(circles)))
-    return out
+def curved_sides(domain_spec) -> list:
+    """The curved pieces of the domain (``vemkit.mesh.curves.domain_curves``: circular holes and outer
+    arcs, each its own circle); refinement puts a new boundary vertex on the piece its edge lies on."""
+    return domain_curves(domain_spec)
 
 
 def prolongated_start(refined, problem, solution, new_problem):
@@ -201,7 +191,9 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             reason = _limit_reason(refined.mesh, settings.max_dofs)  # before the mesh is assembled or solved
             if reason is None and refined.refined.size == 0:
                 reason = "unrefinable"
-            mesh, previous = refined.mesh, (refined, problem, solution)
+            mesh = refined.mesh if reason is not None else checked_mesh(  # as every mesh a command solves
+                refined.mesh, f"the refined mesh of step {step + 2}", "please report it; meanwhile try another mesh size")
+            previous = (refined, problem, solution)
         record["wall_time"] = time.perf_counter() - start
         if progress is not None:
             progress(step, record)
