@@ -111,8 +111,8 @@ def scene_indicators(scene, problem, solution) -> dict:
 
 
 def curved_sides(domain_spec) -> list:
-    """The curved pieces of the domain (``vemkit.mesh.curves.domain_curves``: circular holes and outer
-    arcs, each its own circle); refinement puts a new boundary vertex on the piece its edge lies on."""
+    """The boundary pieces of the domain (``vemkit.mesh.curves.domain_curves``: circular holes, outer
+    arcs and edges, polygonal holes' edges); refinement puts a new boundary vertex on its edge's own piece."""
     return domain_curves(domain_spec)
 
 
