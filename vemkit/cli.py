@@ -190,9 +190,9 @@ def _family_mesh(args):
     estimate = estimate_resources(*estimate_mesh(options))  # before anything is built
     family, n = options.pop("family"), options.pop("n")
     check_resources(estimate, args.max_dofs, what=f"the {family} mesh with N = {n}", fix="a smaller N")
-    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.families import build_mesh, checked_mesh
 
-    return build_mesh(family, n, **options), family
+    return checked_mesh(build_mesh(family, n, **options), f"the {family} mesh with N = {n}", "try another N"), family
 
 
 def _scene_mesh(args):
@@ -217,10 +217,8 @@ def cmd_mesh(args) -> int:
     mesh, family = _scene_mesh(args) if args.scene else _family_mesh(args)
 
     from vemkit.io.output_files import atomic_outputs
-    from vemkit.mesh.checks import validate_mesh
     from vemkit.mesh.files import write_ugrid, write_vtu
 
-    validate_mesh(mesh)
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_ugrid(mesh, output_part)
         if vtu_part is not None:

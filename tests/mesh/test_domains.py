@@ -33,6 +33,11 @@ def bracket_segments(h):
     return polygonal, polygonal.points[polygonal.segments]
 
 
+def chord_size(mesh) -> float:
+    """The size of the chords standing for the circle: 1/N, for hanging that of its finest squares."""
+    return 1.0 / N / (2 ** mesh.meta["levels"] if mesh.meta["family"] == "hanging" else 1)
+
+
 @pytest.fixture(scope="module", params=FAMILY_CASES, ids=IDS)
 def bracket_mesh(request):
     family, options = request.param
@@ -41,19 +46,19 @@ def bracket_mesh(request):
 
 def test_bracket_meshes_are_valid_and_keep_the_area(bracket_mesh):
     validate_mesh(bracket_mesh)
-    polygonal, _ = bracket_segments(1.0 / N)
+    polygonal, _ = bracket_segments(chord_size(bracket_mesh))
     assert (bracket_mesh.cell_areas > 0).all()
     assert bracket_mesh.cell_areas.sum() == pytest.approx(polygonal.shape.area, rel=1e-13)
     # the area of the polygonal domain: exact minus the circle's segments (inscribed polygon)
     circle = domain_from_spec(BRACKET).holes[0]
-    m = circle.polygon(1.0 / N).shape[0]
+    m = circle.polygon(chord_size(bracket_mesh)).shape[0]
     exact_polygon_area = 0.5 * m * circle.r**2 * np.sin(2 * np.pi / m)
     assert polygonal.shape.area == pytest.approx(3.0 + 1.2 - exact_polygon_area - 0.5 * 0.5 * 0.4, rel=1e-13)
 
 
 def test_every_boundary_edge_is_named_after_the_side_it_lies_on(bracket_mesh):
     mesh = bracket_mesh
-    polygonal, segments = bracket_segments(1.0 / N)
+    polygonal, segments = bracket_segments(chord_size(mesh))
     assert set(mesh.boundary) == set(domain_from_spec(BRACKET).side_names)
     parts = np.concatenate(list(mesh.boundary.values()))
     assert sorted(map(tuple, parts)) == sorted(map(tuple, mesh.boundary_edges))  # a partition

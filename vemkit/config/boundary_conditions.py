@@ -18,6 +18,7 @@ import numpy as np
 from vemkit.config.domain import Domain
 from vemkit.config.expression_tree import shorten
 from vemkit.config.expressions import Expression, compile_expression
+from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import ExpressionError, SceneError
 
 __all__ = ["MAX_NORMAL_K_OVER_E", "PROBES", "boundary_expressions", "check_contact", "check_expressions_on_mesh",
@@ -213,35 +214,6 @@ def _domain_name(data) -> str:
 
 
 # -- rigid motions (before assembly), mesh files' sides, expressions at the mesh's vertices ------
-def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | None:
-    """Which rigid motion u = (a - θ y, b + θ x) keeps every prescribed component at zero change,
-    in words; None when the prescribed components (rows of ``prescribed``: u1, u2 at each of
-    ``coordinates``) hold all three."""
-    centre = coordinates.mean(axis=0) if coordinates.size else np.zeros(2)
-    scale = max(float(np.ptp(coordinates, axis=0).max()) if coordinates.size else 1.0, 1e-300)
-    x, y = ((coordinates - centre) / scale).T
-    one, zero = np.ones_like(x), np.zeros_like(x)
-    rows = np.concatenate([np.stack([one, zero, -y], axis=1)[prescribed[:, 0]],
-                           np.stack([zero, one, x], axis=1)[prescribed[:, 1]]])
-    if rows.shape[0] == 0:
-        return "every rigid motion (nothing is prescribed)"
-    for component, axis in ((0, "x"), (1, "y")):
-        if not prescribed[:, component].any():
-            return f"a translation in {axis}"
-    _, singular, vt = np.linalg.svd(rows, full_matrices=True)
-    rank = int(np.sum(singular > 1e-9 * singular[0]))
-    if rank == 3:
-        return None
-    a, b, theta = vt[rank]  # a motion the constraints do not see
-    if abs(theta) < 1e-9:
-        direction = np.array([a, b]) / np.hypot(a, b)
-        named = {(1.0, 0.0): "x", (0.0, 1.0): "y"}.get(tuple(np.round(np.abs(direction), 12)))
-        return f"a translation in {named}" if named else \
-            f"a translation along ({direction[0]:.3g}, {direction[1]:.3g})"
-    point = centre + scale * np.array([-b / theta, a / theta])
-    return f"a rotation about ({point[0]:.6g}, {point[1]:.6g})"
-
-
 def rigid_motion_error(motion: str) -> SceneError:
     return SceneError(f"boundary.dirichlet leaves {motion} of the body free (the stiffness is singular); "
                       "prescribe a component that stops it, e.g. clamp a side", key="boundary.dirichlet")

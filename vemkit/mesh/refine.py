@@ -17,8 +17,9 @@ a cell without a kernel at all (not star-shaped) is left whole (reported in ``Re
 A new edge midpoint is inserted as a vertex into the one or two cells sharing that edge, so the mesh
 stays vertex-conforming: the neighbour is not refined, it simply gains a vertex (SPEC §3).
 ``max_hanging = k`` also refines every cell that would otherwise carry more than k vertices inside
-one of its geometric edges (repeated until none does). On a circular side (``mesh.meta["circles"]``:
-{side: [cx, cy, r]}) a new boundary vertex is placed on the circle, not on the chord (see above). Boundary
+one of its geometric edges (repeated until none does). A new vertex of a boundary edge of a curved
+piece (a circular hole or an arc: ``circles``, ``vemkit.mesh.curves``) is placed on that piece's own
+circle, not on the chord, nor on another piece with the same side name (see above). Boundary
 edges keep their side names. The prolongation maps vertex values of the old mesh to the new one
 (linear along split edges, the vertex mean at cell centres): a warm start for the next solve.
 """
@@ -31,6 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from vemkit.exceptions import InputError
+from vemkit.mesh.curves import as_pieces, on_curves
 from vemkit.mesh.mesh import Mesh
 from vemkit.mesh.refine_kernels import (augmented_rings, children, corner_flags, max_inner_vertices,
                                         midpoint_requests, split_centres)
@@ -63,7 +65,7 @@ class _Splits(NamedTuple):
     chords: np.ndarray  # (new, 2) the coordinates on the old edge (points: moved onto a circle)
 
 
-def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: dict) -> _Splits:
+def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: list) -> _Splits:
     """Midpoints of the geometric edges of ``cells``, merged per old edge (SPEC §9)."""
     a, b, t = midpoint_requests(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, corner, cells)
     lo, hi = np.minimum(a, b), np.maximum(a, b)
@@ -73,21 +75,10 @@ def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: dict) -> _
     keys, ticks = rows[:, 0], rows[:, 1] / 1e9
     ends = np.stack([keys // n, keys % n], axis=1)
     chords = mesh.vertices[ends[:, 0]] + ticks[:, None] * (mesh.vertices[ends[:, 1]] - mesh.vertices[ends[:, 0]])
-    points = _on_circles(mesh, ends, chords.copy(), circles)
+    points = on_curves(mesh, ends, chords, circles)
     unique_keys, first = np.unique(keys, return_index=True)
     ptr = np.r_[first, keys.size].astype(np.int64)
     return _Splits(unique_keys, ptr, n + np.arange(keys.size), points, ends, ticks, chords)
-
-
-def _on_circles(mesh: Mesh, ends: np.ndarray, points: np.ndarray, circles: dict) -> np.ndarray:
-    """Points on boundary edges of a circular side moved radially onto the circle."""
-    for side, (cx, cy, r) in circles.items():
-        edges = np.sort(mesh.boundary.get(side, np.zeros((0, 2), np.int64)), axis=1)
-        on = (edges[:, 0][None, :] == ends[:, :1]) & (edges[:, 1][None, :] == ends[:, 1:])
-        hit = on.any(axis=1) if edges.size else np.zeros(len(points), bool)
-        d = points[hit] - (cx, cy)
-        points[hit] = np.array([cx, cy]) + r * d / np.linalg.norm(d, axis=1)[:, None]
-    return points
 
 
 def _rings(mesh: Mesh, splits: _Splits):
@@ -97,7 +88,7 @@ def _rings(mesh: Mesh, splits: _Splits):
     return points, offsets, ring
 
 
-def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles: dict | None = None) -> RefinedMesh:
+def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles=None) -> RefinedMesh:
     """Split the marked cells (indices or a boolean mask) as the module docstring describes."""
     marked = np.asarray(marked)
     marked = np.flatnonzero(marked) if marked.dtype == bool else np.unique(marked.astype(np.int64))
@@ -105,7 +96,7 @@ def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles:
         raise InputError(f"refine_cells: cell indices must lie in [0, {mesh.n_cells})", key="marked")
     if max_hanging is not None and max_hanging < 1:
         raise InputError(f"adaptivity.max_hanging = {max_hanging}: must be >= 1 (or absent)", key="max_hanging")
-    circles = dict(mesh.meta.get("circles", {}) if circles is None else circles)
+    circles = as_pieces(mesh.meta.get("circles") if circles is None else circles)
     corner = corner_flags(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices)
     refine = marked
     while True:

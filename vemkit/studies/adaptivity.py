@@ -4,7 +4,9 @@ Each step solves the scene's contact problem on the current mesh, checks the sol
 independently (as ``vemkit solve`` does), computes the indicators η_K of ``vemkit.vem.estimator``
 (with the contact traction of the solution as the Γ_C datum), stops when the relative estimate
 η ≤ ``target``, when the next mesh would have more than ``max_dofs`` unknowns (counted as the
-degrees of freedom of its space, an upper bound: no mesh beyond the limit is ever assembled) or after
+degrees of freedom of its space, an upper bound: no mesh beyond the limit is ever assembled) or would
+need more memory than the machine has (the prediction of ``vemkit.config.limits``, checked before it
+is solved), or after
 ``max_steps`` solves, and otherwise refines the Dörfler-marked cells (``vemkit.mesh.refine``;
 new vertices on a circular hole or an arc of the scene's domain are placed on the curve).
 
@@ -26,11 +28,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from vemkit.config.domain import CircleHole, domain_from_spec
 from vemkit.contact.problem import scene_problem
-from vemkit.exceptions import InputError, ResultError
+from vemkit.config.limits import check_resources, estimate_resources
+from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
-from vemkit.mesh.families import scene_mesh
+from vemkit.mesh.curves import domain_curves
+from vemkit.mesh.families import checked_mesh, scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
@@ -76,7 +79,7 @@ class AdaptiveRun:
     solution: object  # its ContactSolution
     indicators: dict  # error_indicators of the last solution
     history: list = field(default_factory=list)  # one dict per step (the keys of HISTORY_ATTRS)
-    reason: str = ""  # why the loop stopped: target, max_dofs, max_steps, unrefinable
+    reason: str = ""  # why the loop stopped: target, max_dofs, memory, max_steps, unrefinable
     checks: dict = field(default_factory=dict)  # the independent check of the last solution
 
 
@@ -109,20 +112,10 @@ def scene_indicators(scene, problem, solution) -> dict:
                             problem.stabilization, body_force=body, neumann=neumann, contact=contact)
 
 
-def curved_sides(domain_spec) -> dict:
-    """{side: [cx, cy, r]} of the sides that lie on one circle: circular holes, and outer sides all of
-    whose edges are arcs of one circle (SPEC §7); refinement puts new boundary vertices on it."""
-    domain = domain_from_spec(domain_spec)
-    out = {hole.side: [hole.cx, hole.cy, hole.r] for hole in domain.holes if isinstance(hole, CircleHole)}
-    arcs = {}
-    for i, side in enumerate(domain.sides):
-        centre = domain.arcs[i] if domain.arcs else None
-        r = None if centre is None else round(float(np.hypot(*np.subtract(domain.polygon[i], centre))), 12)
-        arcs.setdefault(side, set()).add(None if centre is None else (float(centre[0]), float(centre[1]), r))
-    for side, circles in arcs.items():
-        if len(circles) == 1 and None not in circles and side not in out:
-            out[side] = list(next(iter(circles)))
-    return out
+def curved_sides(domain_spec) -> list:
+    """The boundary pieces of the domain (``vemkit.mesh.curves.domain_curves``: circular holes, outer
+    arcs and edges, polygonal holes' edges); refinement puts a new boundary vertex on its edge's own piece."""
+    return domain_curves(domain_spec)
 
 
 def prolongated_start(refined, problem, solution, new_problem):
@@ -236,11 +229,12 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
             refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
-            if VirtualElementSpace(refined.mesh, problem.space.element).n_dofs > settings.max_dofs:
-                reason = "max_dofs"
-            elif refined.refined.size == 0:
+            reason = _limit_reason(refined.mesh, settings.max_dofs, problem.space.element)  # before it is solved
+            if reason is None and refined.refined.size == 0:
                 reason = "unrefinable"
-            mesh, previous = refined.mesh, (refined, problem, solution)
+            mesh = refined.mesh if reason is not None else checked_mesh(  # as every mesh a command solves
+                refined.mesh, f"the refined mesh of step {step + 2}", "please report it; meanwhile try another mesh size")
+            previous = (refined, problem, solution)
         record["wall_time"] = time.perf_counter() - start
         if progress is not None:
             progress(step, record)
@@ -251,6 +245,19 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
             return run
     run.reason = "max_steps"
     return run
+
+
+def _limit_reason(mesh, max_dofs: int, element):
+    """"max_dofs" or "memory" when solving ``mesh`` with ``element`` would pass ``max_dofs`` or the memory
+    this machine has (the prediction of ``vemkit.config.limits`` from the space's nodes), else None."""
+    estimate = estimate_resources(mesh.n_cells, VirtualElementSpace(mesh, element).n_nodes)
+    if estimate.dofs > max_dofs:
+        return "max_dofs"
+    try:
+        check_resources(estimate, None)
+    except ResourceLimitError:
+        return "memory"
+    return None
 
 
 def _stop_reason(estimate: float, step: int, settings: AdaptivitySettings):
@@ -267,6 +274,7 @@ STOP_REASONS = {
     "max_dofs": "the next mesh would exceed adaptivity.max_dofs (or --max-dofs)",
     "max_steps": "adaptivity.max_steps solves were done",
     "unrefinable": "no marked cell could be split (no centre in its kernel)",
+    "memory": "the next mesh would need more memory than this machine has available",
 }
 _STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop records
     ("estimate", "relative a posteriori estimate eta (vemkit.vem.estimator)", "1"),

@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
 from vemkit.studies.convergence import ReferenceSolution
+from vemkit.studies.reference_file import read_reference_file
 from vemkit.studies.tradeoff import check_reference_scene
 from vemkit.mesh.locate import locate_points
 from vemkit.vem.elements.k1_fields import projected_solution
@@ -90,25 +91,21 @@ def reference_path(scene) -> Path | None:
 
 
 def load_reference(scene) -> ReferenceSolution | None:
-    """The reference solution of ``adaptivity.reference``, checked to solve the scene's problem."""
+    """The reference solution of ``adaptivity.reference``, read as an input
+    (:func:`vemkit.studies.reference_file.read_reference_file`) and checked to solve the scene's problem."""
     path = reference_path(scene)
     if path is None:
         return None
-    if not path.is_file():
+    if not path.exists():
         raise InputError(f"adaptivity.reference = {str(path)!r}: no such file; give a solution file written by "
                          "vemkit solve (relative to the scene file)", key="adaptivity.reference")
+    mesh, dataset, scene_data = read_reference_file(path)
     try:
-        reference = ReferenceSolution(path)
-    except (OSError, ValueError, KeyError) as error:
-        raise InputError(f"adaptivity.reference = {str(path)!r}: not a vemkit solution file "
-                         f"({' '.join(str(error).split())[:120]}); give the output of vemkit solve",
-                         key="adaptivity.reference") from None
-    try:
-        check_reference_scene(scene, str(reference.dataset.attrs.get("scene", "")))
+        check_reference_scene(scene, scene_data)
     except ValueError as error:
         raise InputError(f"adaptivity.reference = {str(path)!r}: {error}; solve this scene on a fine mesh for "
                          "the reference", key="adaptivity.reference") from None
-    return reference
+    return ReferenceSolution(path, solution=(mesh, dataset))
 
 
 def scene_true_error(scene):

@@ -49,11 +49,17 @@ RECORD_OPTIONAL_INTS = {"order": lambda r: 1, "n_unknowns": lambda r: r["n_dofs"
 RECORD_STRINGS = ("family", "family_name", "solver", "stabilization", "message")
 
 
-def check_reference_scene(scene, reference_scene_yaml: str) -> None:
-    """The reference must solve the same physical problem (domain, material, loads, contact)."""
-    import yaml
+def check_reference_scene(scene, reference_scene) -> None:
+    """The reference must solve the same physical problem (domain, material, loads, contact).
+    ``reference_scene``: its scene as a mapping, or the YAML text of its ``scene`` attribute (read by
+    the safe loader, ``vemkit.config.safe_yaml``: a file's attribute is user input)."""
+    from vemkit.config.safe_yaml import parse_yaml
 
-    reference = yaml.safe_load(reference_scene_yaml or "") or {}
+    reference = reference_scene if isinstance(reference_scene, dict) else \
+        parse_yaml(reference_scene or "", "the reference's scene attribute") or {}
+    if not isinstance(reference, dict):
+        raise InputError("the reference's scene attribute is not a scene (a mapping); give a solution file "
+                         "written by vemkit solve", key="reference")
     mine = scene.data
     for section in SCENE_SECTIONS:
         if section in reference and reference.get(section) != mine.get(section):

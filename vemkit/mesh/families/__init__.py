@@ -83,13 +83,26 @@ def build_mesh(family: str, n: float | None = None, *, domain=None, h: float | N
     return builder(n, domain=region, **options)
 
 
-__all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "family_builder", "square", "structured_triangle", "delaunay_triangle",
+__all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "checked_mesh", "scene_mesh", "family_builder", "square", "structured_triangle", "delaunay_triangle",
            "voronoi", "hanging"]
 
 
+def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
+    """``mesh``, validated (``vemkit.mesh.checks.validate_mesh``); a MeshError naming ``what`` was
+    built and ``fix`` otherwise. Every mesh a command solves or writes passes here or through
+    ``vemkit.mesh.files.read_mesh``: ``vemkit solve``, ``adapt`` and ``mesh`` refuse the same meshes."""
+    from vemkit.mesh.checks import validate_mesh
+
+    try:
+        validate_mesh(mesh)
+    except MeshError as error:
+        raise MeshError(f"{what} is broken: {error}; {fix}", key="discretization.mesh") from None
+    return mesh
+
+
 def scene_mesh(scene) -> Mesh:
-    """The mesh a scene (``vemkit.config.Scene``) asks for: its family on its domain with one of
-    n / h / cells, or its mesh file (SPEC §8, read and validated)."""
+    """The validated mesh a scene (``vemkit.config.Scene``) asks for: its family on its domain with
+    one of n / h / cells (:func:`checked_mesh`), or its mesh file (SPEC §8, read and validated)."""
     if scene.mesh_file is not None:
         from vemkit.mesh.files import read_mesh
 
@@ -98,4 +111,6 @@ def scene_mesh(scene) -> Mesh:
     family = opts.pop("family")
     sizes = {key: opts.pop(key) for key in ("n", "h", "cells") if key in opts}
     # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7)
-    return build_mesh(family, domain=scene.domain, **sizes, **opts)
+    size = ", ".join(f"{key} = {value:g}" for key, value in sizes.items())
+    return checked_mesh(build_mesh(family, domain=scene.domain, **sizes, **opts), f"the {family} mesh ({size})",
+                        "try another discretization.mesh size or family")

@@ -47,7 +47,7 @@ def cut_hanging(domain: Domain, n: float, levels: int, rule: str, seed: int, fra
     h = 1.0 / n
     unit = 1 << levels
     fine = h / unit
-    polygonal = domain.discretize(h)
+    polygonal = domain.discretize(fine)  # curved sides follow the refinement: chords of the finest squares
     squares = _grid_squares(polygonal.shape, h, unit)
     on_side = polygonal.segments[polygonal.segment_sides == contact_side]
     side = shapely.multilinestrings(polygonal.points[on_side]) if rule == "contact" else None

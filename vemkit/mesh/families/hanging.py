@@ -16,7 +16,8 @@ integer grid of the finest possible level and divided once, so shared vertices c
 
 On any other domain (``domain=``, a :class:`~vemkit.config.domain.Domain`) the same refinement runs on
 the squares of side 1/n that meet the domain (``contact_side``: any side name of the domain), and
-the refined squares are then cut to the domain (``cut.cut_hanging``).
+the refined squares are then cut to the domain (``cut.cut_hanging``), whose circles and arcs are
+chords of the finest squares (h / 2^levels): curved sides follow the refinement.
 """
 
 from __future__ import annotations
