@@ -43,17 +43,9 @@ class PolyhedralMesh:
                                               for k, v in self.boundary.items()})
 
     # -- sizes -----------------------------------------------------------------------------
-    @property
-    def n_vertices(self) -> int:
-        return self.vertices.shape[0]
-
-    @property
-    def n_faces(self) -> int:
-        return self.face_offsets.shape[0] - 1
-
-    @property
-    def n_cells(self) -> int:
-        return self.cell_offsets.shape[0] - 1
+    n_vertices = property(lambda self: self.vertices.shape[0], doc="number of vertices")
+    n_faces = property(lambda self: self.face_offsets.shape[0] - 1, doc="number of faces (each stored once)")
+    n_cells = property(lambda self: self.cell_offsets.shape[0] - 1, doc="number of cells")
 
     def face(self, f: int) -> np.ndarray:
         return self.face_vertices[self.face_offsets[f]:self.face_offsets[f + 1]]

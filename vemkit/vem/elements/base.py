@@ -39,6 +39,8 @@ vertices, edges, cells (``layout``). Each element module provides:
 
 from __future__ import annotations
 
+from importlib import import_module
+
 STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
 
 
@@ -69,6 +71,22 @@ class Element:
     stress_degree: int = 1  # degree of sigma(Pi u_h) on a cell: k - 1
     polynomial_on_triangles: bool = False  # V_h^K = [P_k]^2 on triangles: Pi = I, the stabilization vanishes
     contact_rule: tuple  # ((s, weight), ...) per trace node of an edge, in ``edge_trace`` order
+
+    kernel_module: str  # the module of the element's Numba hooks ``workspace`` and ``cell_matrix``
+    fields_module: str  # the module of its loads, projected fields and interpolation
+
+    # the kernels and fields are imported on first use: the element's facts (layout, ...) cost no Numba import
+    @property
+    def workspace(self):
+        return import_module(self.kernel_module).workspace
+
+    @property
+    def cell_matrix(self):
+        return import_module(self.kernel_module).cell_matrix
+
+    @property
+    def fields(self):
+        return import_module(self.fields_module)
 
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"

@@ -22,39 +22,33 @@ class FirstOrder(Element):
     projection_uses_material = False  # Pi_1: the strain is the cell average of eps(v), from boundary values
     contact_rule = ((0.0, 0.5), (1.0, 0.5))  # the trapezoid: half of each adjacent edge per vertex (SPEC §3)
 
-    # the kernels and fields are imported on first use: the element's facts (layout, ...) cost no Numba import
-    @property
-    def workspace(self):
-        from vemkit.vem.elements.k1_kernel import workspace
-        return workspace
-
-    @property
-    def cell_matrix(self):
-        from vemkit.vem.elements.k1_kernel import cell_matrix
-        return cell_matrix
+    kernel_module = "vemkit.vem.elements.k1_kernel"
+    fields_module = "vemkit.vem.elements.k1_fields"
 
     def cell_nodes(self, mesh):
         return mesh.cell_offsets, mesh.cell_vertices
 
     def node_coordinates(self, mesh) -> np.ndarray:
-        return _fields().node_coordinates(mesh)
+        return self.fields.node_coordinates(mesh)
 
     def traction_load(self, mesh, edges, traction) -> np.ndarray:
-        return _fields().traction_load(mesh, edges, traction)
+        return self.fields.traction_load(mesh, edges, traction)
 
     def body_force_load(self, mesh, field, lam, mu, projection="p0") -> np.ndarray:
         """int_K P_0 f1 . Pi v_h dx (Section 3.3); the k = 1 load has no other projection."""
-        return _fields().body_force_load(mesh, _quadrature().body_force_averages(mesh, field))
+        from vemkit.vem.quadrature import body_force_averages
+
+        return self.fields.body_force_load(mesh, body_force_averages(mesh, field))
 
     def project(self, mesh, node_values, lam=None, mu=None):
-        return _fields().projected_solution(mesh, node_values)
+        return self.fields.projected_solution(mesh, node_values)
 
     def interpolate(self, mesh, field) -> np.ndarray:
         f1, f2 = field(mesh.vertices[:, 0], mesh.vertices[:, 1])
         return np.stack(np.broadcast_arrays(f1, f2), axis=1).astype(float)
 
     def dirichlet_components(self, mesh, dirichlet):
-        return _fields().dirichlet_components(mesh, dirichlet)
+        return self.fields.dirichlet_components(mesh, dirichlet)
 
     def edge_trace(self, s) -> np.ndarray:
         s = np.asarray(s, dtype=float)
@@ -63,12 +57,3 @@ class FirstOrder(Element):
 
 ELEMENT = FirstOrder()
 
-
-def _fields():
-    from vemkit.vem.elements import k1_fields
-    return k1_fields
-
-
-def _quadrature():
-    from vemkit.vem import quadrature
-    return quadrature

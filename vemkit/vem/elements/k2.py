@@ -25,53 +25,36 @@ class SecondOrder(Element):
     # Simpson's rule at the trace nodes: |e|/6 at each vertex, 4|e|/6 at the midpoint (vemkit.contact.boundary)
     contact_rule = ((0.0, 1.0 / 6.0), (1.0, 1.0 / 6.0), (0.5, 4.0 / 6.0))
 
-    # the kernels and fields are imported on first use: the element's facts (layout, ...) cost no Numba import
-    @property
-    def workspace(self):
-        from vemkit.vem.elements.k2_stiffness import workspace
-        return workspace
-
-    @property
-    def cell_matrix(self):
-        from vemkit.vem.elements.k2_stiffness import cell_matrix
-        return cell_matrix
+    kernel_module = "vemkit.vem.elements.k2_stiffness"
+    fields_module = "vemkit.vem.elements.k2_fields"
 
     def cell_nodes(self, mesh):
-        return _fields().cell_nodes(mesh)
+        return self.fields.cell_nodes(mesh)
 
     def node_coordinates(self, mesh) -> np.ndarray:
-        return _fields().node_coordinates(mesh)
+        return self.fields.node_coordinates(mesh)
 
     def traction_load(self, mesh, edges, traction) -> np.ndarray:
-        return _fields().traction_load_k2(mesh, edges, traction)
+        return self.fields.traction_load_k2(mesh, edges, traction)
 
     def body_force_load(self, mesh, field, lam, mu, projection="p0") -> np.ndarray:
         """P_0 f1 on the cell means (the paper's P_{k-2} f1) or P_1 f1 against Pi_2 v ("p1")."""
         if projection == "p0":
-            return _fields().body_force_k2(mesh, field)
-        return _fields().body_force_p1_k2(mesh, field, lam, mu)
+            return self.fields.body_force_k2(mesh, field)
+        return self.fields.body_force_p1_k2(mesh, field, lam, mu)
 
     def project(self, mesh, node_values, lam, mu):
-        return _fields().projected_solution_k2(mesh, node_values, lam, mu)
+        return self.fields.projected_solution_k2(mesh, node_values, lam, mu)
 
     def interpolate(self, mesh, field) -> np.ndarray:
-        return _fields().interpolate_k2(mesh, field)
+        return self.fields.interpolate_k2(mesh, field)
 
     def dirichlet_components(self, mesh, dirichlet):
-        return _fields().dirichlet_components(mesh, dirichlet)
+        return self.fields.dirichlet_components(mesh, dirichlet)
 
     def edge_trace(self, s) -> np.ndarray:
-        return _fields().trace_weights(np.asarray(s, dtype=float))
+        return self.fields.trace_weights(np.asarray(s, dtype=float))
 
 
 ELEMENT = SecondOrder()
 
-
-def _fields():
-    from vemkit.vem.elements import k2_fields
-    return k2_fields
-
-
-def _quadrature():
-    from vemkit.vem import quadrature
-    return quadrature
