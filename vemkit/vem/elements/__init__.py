@@ -14,7 +14,7 @@ from importlib import import_module
 from vemkit.vem.elements.base import STABILIZATIONS, Element, stabilization_code
 
 #: (order, dimension) -> the module of the element
-MODULES = {(1, 2): "vemkit.vem.elements.k1", (2, 2): "vemkit.vem.elements.k2"}
+MODULES = {(1, 2): "vemkit.vem.elements.k1", (2, 2): "vemkit.vem.elements.k2", (1, 3): "vemkit.vem.elements.k1_3d"}
 ORDERS = tuple(sorted({order for order, _ in MODULES}))
 
 __all__ = ["ORDERS", "STABILIZATIONS", "Element", "element_for", "stabilization_code"]

@@ -1,0 +1,84 @@
+"""The lowest-order element in three dimensions (k = 1, Section 3 for d = 3): the displacement at
+the vertices of polyhedra (SPEC §10).
+
+Its kernel is ``k1_3d_kernel`` (the projection (3.8) from face integrals of the vertex values and
+the stiffness (3.9)), its loads and projected fields ``k1_3d_fields``, its numpy twin
+``k1_3d_reference``. The kernel needs the cells' faces, not only their vertices: ``geometry(mesh)``
+is what the assembly hands it in place of the vertex coordinates (the 2D elements hand the
+coordinates themselves).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from vemkit.vem.elements import k1_3d_fields, k1_3d_kernel
+from vemkit.vem.elements.base import Element
+
+
+_FACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mesh -> local_faces(mesh)
+
+
+def local_faces(mesh):
+    """(cell_face_ptr, face_ptr, face_local): every cell's faces, outward, as lists of local vertex
+    numbers (positions in the cell's list of ``mesh.cell_vertex_lists``)."""
+    offsets, ids = mesh.cell_vertex_lists
+    cell_face_ptr = mesh.cell_offsets.copy()
+    signed = mesh.cell_faces
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    sizes = np.diff(mesh.face_offsets)[faces]
+    face_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    face_local = np.empty(face_ptr[-1], dtype=np.int64)
+    for c in range(mesh.n_cells):
+        local = {int(v): k for k, v in enumerate(ids[offsets[c]:offsets[c + 1]])}
+        for t in range(cell_face_ptr[c], cell_face_ptr[c + 1]):
+            vs = mesh.face(faces[t])
+            vs = vs if signed[t] >= 0 else vs[::-1]
+            face_local[face_ptr[t]:face_ptr[t + 1]] = [local[int(v)] for v in vs]
+    return cell_face_ptr, face_ptr, face_local
+
+
+class FirstOrder3D(Element):
+    name = "k1_3d"
+    order = 1
+    dimension = 3
+    layout = {"vertex": 1}
+    condensed_nodes = 0
+    numbering = "mesh"
+    stress_degree = 0
+    polynomial_on_triangles = True  # on tetrahedra V_h is P1: the stiffness of P1 finite elements
+    projection_uses_material = False
+    contact_rule = ()  # contact in 3D is not part of this element yet
+    workspace = staticmethod(k1_3d_kernel.workspace)
+    cell_matrix = staticmethod(k1_3d_kernel.cell_matrix)
+
+    def cell_nodes(self, mesh):
+        return mesh.cell_vertex_lists
+
+    def geometry(self, mesh):
+        """(vertices, cell_face_ptr, face_ptr, face_local): what ``cell_matrix`` reads (``local_faces``)."""
+        if mesh not in _FACES:
+            _FACES[mesh] = local_faces(mesh)
+        return (mesh.vertices,) + _FACES[mesh]
+
+    def node_coordinates(self, mesh) -> np.ndarray:
+        return mesh.vertices
+
+    def interpolate(self, mesh, field) -> np.ndarray:
+        x, y, z = mesh.vertices.T
+        return np.stack(np.broadcast_arrays(*field(x, y, z)), axis=1).astype(float)
+
+    def body_force_load(self, mesh, field, lam, mu, projection="p0") -> np.ndarray:
+        """int_K P_0 f . Pi v_h dx (Section 3.3), P_0 f the cell average of f."""
+        return k1_3d_fields.body_force_load(mesh, self.geometry(mesh), field)
+
+    def project(self, mesh, node_values, lam=None, mu=None):
+        return k1_3d_fields.projected_solution(mesh, self.geometry(mesh), node_values)
+
+    def dirichlet_components(self, mesh, dirichlet):
+        return k1_3d_fields.dirichlet_components(mesh, dirichlet)
+
+
+ELEMENT = FirstOrder3D()

@@ -1,0 +1,148 @@
+"""The 3D k = 1 element's loads, Dirichlet data and projected fields (Section 3.3, (3.8), SPEC §10).
+
+- Cell integrals by a signed tetrahedral fan: cell vertex mean, face vertex mean, one face edge;
+  signed volumes make it exact for polynomials on any polyhedron with planar faces, non-convex
+  ones included. Each tetrahedron carries a collapsed (Duffy) Gauss-Legendre product rule.
+- Body force: int_K P_0 f . Pi v_h dx, P_0 f the cell average of f; exact for linear Pi v_h.
+- ``projected_solution``: per cell Pi u = c + G (x - xbar), G = E + W (the kernel's coefficients).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vemkit.vem.elements.k1_3d_kernel import boundary_vectors, projection_coefficients, strain_operator
+
+
+def tetrahedron_rule(points: int = 3):
+    """(barycentric-free) reference rule on the unit tetrahedron: (Q, 3) points, (Q,) weights, by the
+    collapsed product of Gauss-Legendre rules (exact for degree 2 points - 3 and more)."""
+    g, w = np.polynomial.legendre.leggauss(points)
+    g, w = (g + 1) / 2, w / 2
+    a, b, c = np.meshgrid(g, g, g, indexing="ij")
+    wa, wb, wc = np.meshgrid(w, w, w, indexing="ij")
+    x = a * (1 - b) * (1 - c)
+    y = b * (1 - c)
+    z = c
+    weight = wa * wb * wc * (1 - b) * (1 - c) ** 2
+    return np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1), weight.ravel()
+
+
+def cell_quadrature(mesh, points: int = 3):
+    """(x (Q, 3), weight (Q,), cell (Q,)): a rule on every cell by its signed tetrahedral fan."""
+    ref, ref_w = tetrahedron_rule(points)
+    offsets, ids = mesh.cell_vertex_lists
+    xs, ws, cs = [], [], []
+    for c in range(mesh.n_cells):
+        centre = mesh.vertices[ids[offsets[c]:offsets[c + 1]]].mean(axis=0)
+        for s in mesh.cell_face_list(c):
+            face = mesh.face(s) if s >= 0 else mesh.face(-s - 1)[::-1]
+            p = mesh.vertices[face]
+            m = p.mean(axis=0)
+            for a, b in zip(p, np.roll(p, -1, axis=0)):
+                J = np.stack([m - centre, a - centre, b - centre], axis=1)
+                xs.append(centre + ref @ J.T)
+                ws.append(ref_w * np.linalg.det(J))
+                cs.append(np.full(ref_w.size, c))
+    return np.concatenate(xs), np.concatenate(ws), np.concatenate(cs)
+
+
+def cell_projections(mesh, geometry):
+    """(xbar (M, 3), P list of (12, 3n), volumes (M,)): the kernel's Pi coefficients per cell."""
+    vertices, cell_face_ptr, face_ptr, face_local = geometry
+    offsets, ids = mesh.cell_vertex_lists
+    xbars, Ps, vols = np.zeros((mesh.n_cells, 3)), [], np.zeros(mesh.n_cells)
+    for c in range(mesh.n_cells):
+        p = np.ascontiguousarray(vertices[ids[offsets[c]:offsets[c + 1]]])
+        n = p.shape[0]
+        q, w, B, P = np.empty((n, 3)), np.empty(n), np.empty((6, 3 * n)), np.empty((12, 3 * n))
+        vols[c] = boundary_vectors(p, face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], q, w)
+        strain_operator(q, vols[c], B)
+        xbars[c] = projection_coefficients(p, B, P)
+        Ps.append(P)
+    return xbars, Ps, vols
+
+
+def _gradients(P):
+    """(3n, 3, 3) G = E + W of Pi phi_j for every dof j (rows of P: c, omega, E11 E22 E33 E12 E13 E23)."""
+    G = np.zeros((P.shape[1], 3, 3))
+    G[:, 0, 0], G[:, 1, 1], G[:, 2, 2] = P[6], P[7], P[8]
+    G[:, 0, 1] = G[:, 1, 0] = P[9]
+    G[:, 0, 2] = G[:, 2, 0] = P[10]
+    G[:, 1, 2] = G[:, 2, 1] = P[11]
+    om = P[3:6]
+    G[:, 0, 1] -= om[2]
+    G[:, 1, 0] += om[2]
+    G[:, 0, 2] += om[1]
+    G[:, 2, 0] -= om[1]
+    G[:, 1, 2] -= om[0]
+    G[:, 2, 1] += om[0]
+    return G
+
+
+@dataclass
+class ProjectedSolution3D:
+    """Pi u_h on every cell: u(x) = c_K + G_K (x - xbar_K)."""
+
+    xbar: np.ndarray  # (M, 3)
+    c: np.ndarray  # (M, 3)
+    G: np.ndarray  # (M, 3, 3)
+
+    def evaluate(self, cells, points):
+        cells = np.asarray(cells)
+        return self.c[cells] + np.einsum("qij,qj->qi", self.G[cells], np.asarray(points) - self.xbar[cells])
+
+    def gradient_at(self, cells, points=None):
+        return self.G[np.asarray(cells)]
+
+    def cell_mean_strain(self):
+        return 0.5 * (self.G + np.transpose(self.G, (0, 2, 1)))
+
+
+def projected_solution(mesh, geometry, node_values) -> ProjectedSolution3D:
+    u = np.asarray(node_values, float).reshape(-1, 3)
+    offsets, ids = mesh.cell_vertex_lists
+    xbar, Ps, _ = cell_projections(mesh, geometry)
+    c, G = np.zeros((mesh.n_cells, 3)), np.zeros((mesh.n_cells, 3, 3))
+    for k, P in enumerate(Ps):
+        v = u[ids[offsets[k]:offsets[k + 1]]].ravel()
+        c[k] = P[:3] @ v
+        G[k] = np.einsum("j,jab->ab", v, _gradients(P))
+    return ProjectedSolution3D(xbar, c, G)
+
+
+def body_force_load(mesh, geometry, field) -> np.ndarray:
+    """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid."""
+    x, w, cells = cell_quadrature(mesh, 3)
+    f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1) * w[:, None]
+    volume = np.bincount(cells, w, mesh.n_cells)
+    mean_f = np.stack([np.bincount(cells, f[:, k], mesh.n_cells) for k in range(3)], axis=1) / volume[:, None]
+    centroid = np.stack([np.bincount(cells, w * x[:, k], mesh.n_cells) for k in range(3)], axis=1) / volume[:, None]
+    offsets, ids = mesh.cell_vertex_lists
+    xbar, Ps, _ = cell_projections(mesh, geometry)
+    out = np.zeros((mesh.n_vertices, 3))
+    for k, P in enumerate(Ps):
+        value = P[:3].T + _gradients(P) @ (centroid[k] - xbar[k])  # (3n, 3) Pi phi_j (x_K)
+        load = volume[k] * value @ mean_f[k]
+        np.add.at(out, ids[offsets[k]:offsets[k + 1]], load.reshape(-1, 3))
+    return out
+
+
+def dirichlet_components(mesh, dirichlet):
+    """(prescribed (N, 3) bool, values (N, 3)) of side names (u = 0) or a mapping side -> (u1, u2, u3),
+    each None (free), a number or a function of (x, y, z), on the vertices of the sides' faces."""
+    prescribed = np.zeros((mesh.n_vertices, 3), dtype=bool)
+    values = np.zeros((mesh.n_vertices, 3))
+    items = dirichlet.items() if isinstance(dirichlet, dict) else ((side, (0.0, 0.0, 0.0)) for side in dirichlet)
+    for side, components in items:
+        faces = mesh.boundary[side]
+        vs = np.unique(np.concatenate([mesh.face(f) for f in faces])) if faces.size else np.zeros(0, np.int64)
+        x, y, z = mesh.vertices[vs].T
+        for k, g in enumerate(components):
+            if g is None:
+                continue
+            prescribed[vs, k] = True
+            values[vs, k] = g(x, y, z) if callable(g) else float(g)
+    return prescribed, values
