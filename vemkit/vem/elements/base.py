@@ -18,9 +18,12 @@ vertices, edges, cells (``layout``). Each element module provides:
     along a Morton curve of the cells (locality when a cell has edge and cell nodes).
 ``cell_nodes(mesh)``
     CSR (offsets, nodes) of every cell's nodes in the kernel's local order.
-``workspace(max_nodes)``, ``cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)``
+``workspace(max_nodes)``, ``cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)``
     Numba functions: work arrays, and the local stiffness (3.9) of cell c (consistency plus the
     stabilization S_K scaled by ``stab``) in the leading block of the matrix returned.
+``geometry(mesh)``
+    what ``cell_matrix`` reads besides the cell's nodes: the vertex coordinates (the default, every
+    2D element), or a tuple of arrays (the 3D element: coordinates and the cells' faces).
 ``traction_load(mesh, edges, traction)``, ``body_force_load(mesh, field, lam, mu, projection)``
     the load vector of Section 3.3, (n_nodes, d).
 ``project(mesh, node_values, lam, mu)``
@@ -68,6 +71,10 @@ class Element:
     stress_degree: int = 1  # degree of sigma(Pi u_h) on a cell: k - 1
     polynomial_on_triangles: bool = False  # V_h^K = [P_k]^2 on triangles: Pi = I, the stabilization vanishes
     contact_rule: tuple  # ((s, weight), ...) per trace node of an edge, in ``edge_trace`` order
+
+    def geometry(self, mesh):
+        """The first argument of ``cell_matrix`` (module docstring): the vertex coordinates."""
+        return mesh.vertices
 
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"
