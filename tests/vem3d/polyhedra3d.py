@@ -84,10 +84,17 @@ def boxes_mesh(boxes, splits=None):
 
 
 def hex_grid(n, size=(1.0, 1.0, 1.0)):
-    """n^3 boxes on [0, size]."""
+    """n^3 boxes on [0, size] (``box_cell``'s faces, their vertices found among the box's corners)."""
     h = np.asarray(size, float) / n
-    boxes = [(np.array(ijk) * h, (np.array(ijk) + 1) * h) for ijk in itertools.product(range(n), repeat=3)]
-    return boxes_mesh(boxes)
+    grid = np.array(list(itertools.product(range(n + 1), repeat=3)))
+    points = grid * h
+    number = lambda ijk: (ijk[0] * (n + 1) + ijk[1]) * (n + 1) + ijk[2]  # noqa: E731
+    cells = []
+    for ijk in itertools.product(range(n), repeat=3):
+        corner_ids = [number(np.array(ijk) + bits) for bits in itertools.product((0, 1), repeat=3)]
+        local = box_cell(points[corner_ids], np.array(ijk) * h, (np.array(ijk) + 1) * h)
+        cells.append([[corner_ids[v] for v in face] for face in local])
+    return from_polyhedra(points, cells, _boundary(points, cells, (np.zeros(3), np.asarray(size, float))))
 
 
 def hanging_mesh():
@@ -183,3 +190,23 @@ def random_affine(rng):
     if np.linalg.det(A) < 0:
         A[:, 0] *= -1
     return A, rng.standard_normal(3)
+
+
+def l_stack(layers=3):
+    """The box [0, 2]^2 x [0, layers], each layer a non-convex L-shaped prism and the cube that
+    fills its notch; the vertices (1, 1, z) between the layers are interior."""
+    base = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2], [2, 2]], float)
+    points = np.vstack([np.c_[base, np.full(7, z)] for z in range(layers + 1)])
+    cells = []
+    for k in range(layers):
+        lo, hi = 7 * k, 7 * (k + 1)
+        ell = [0, 1, 2, 3, 4, 5]
+        cube = [3, 2, 6, 4]
+        cells.append(prism_faces(6, [lo + i for i in ell], [hi + i for i in ell]))
+        cells.append(prism_faces(4, [lo + i for i in cube], [hi + i for i in cube]))
+    return from_polyhedra(points, cells, _boundary(points, cells, ((0, 0, 0), (2, 2, layers))))
+
+
+def boundary_vertices(mesh):
+    """The vertices of the boundary faces."""
+    return np.unique(np.concatenate([mesh.face(f) for f in mesh.boundary_faces]))

@@ -34,19 +34,21 @@ def cell_quadrature(mesh, points: int = 3):
     """(x (Q, 3), weight (Q,), cell (Q,)): a rule on every cell by its signed tetrahedral fan."""
     ref, ref_w = tetrahedron_rule(points)
     offsets, ids = mesh.cell_vertex_lists
-    xs, ws, cs = [], [], []
+    corners, cells = [], []
     for c in range(mesh.n_cells):
         centre = mesh.vertices[ids[offsets[c]:offsets[c + 1]]].mean(axis=0)
         for s in mesh.cell_face_list(c):
             face = mesh.face(s) if s >= 0 else mesh.face(-s - 1)[::-1]
             p = mesh.vertices[face]
-            m = p.mean(axis=0)
-            for a, b in zip(p, np.roll(p, -1, axis=0)):
-                J = np.stack([m - centre, a - centre, b - centre], axis=1)
-                xs.append(centre + ref @ J.T)
-                ws.append(ref_w * np.linalg.det(J))
-                cs.append(np.full(ref_w.size, c))
-    return np.concatenate(xs), np.concatenate(ws), np.concatenate(cs)
+            m = np.broadcast_to(p.mean(axis=0), p.shape)
+            corners.append(np.stack([np.broadcast_to(centre, p.shape), m, p, np.roll(p, -1, axis=0)], axis=1))
+            cells.append(np.full(p.shape[0], c))
+    tets = np.concatenate(corners)  # (T, 4, 3): cell mean, face mean, one edge of the face
+    J = np.transpose(tets[:, 1:] - tets[:, :1], (0, 2, 1))  # columns: the three edges from the cell mean
+    x = tets[:, None, 0] + np.einsum("tij,qj->tqi", J, ref)
+    w = np.linalg.det(J)[:, None] * ref_w[None]
+    cell = np.repeat(np.concatenate(cells), ref_w.size)
+    return x.reshape(-1, 3), w.ravel(), cell
 
 
 def cell_projections(mesh, geometry):

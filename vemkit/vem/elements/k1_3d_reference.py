@@ -77,6 +77,7 @@ def element_stiffness_reference(coords, faces, lam, mu, stabilization="dofi-2mu"
     D = np.stack([v.ravel() for v in values], axis=1)
     Pi = D @ coef
     Kc = coef.T @ G @ coef
-    alpha_K = {"dofi": 1.0, "dofi-2mu": 2 * mu, "trace": np.trace(Kc) / (3 * n)}[stabilization]
+    h = max(np.linalg.norm(a - b) for a in coords for b in coords)  # h_K^(d - 2), d = 3 (``k1_3d_kernel``)
+    alpha_K = {"dofi": h, "dofi-2mu": 2 * mu * h, "trace": np.trace(Kc) / (3 * n)}[stabilization]
     R = np.eye(3 * n) - Pi
     return Kc + alpha_K * R.T @ R, Pi
