@@ -2,9 +2,11 @@
 
 - ``k1``: the lowest order, vertex values (kernel ``k1_kernel``, fields ``k1_fields``, twin ``k1_reference``);
 - ``k2``: second order, vertex values, edge and cell means (kernels ``k2_kernel``, ``k2_stiffness``,
-  fields ``k2_fields``, twin ``k2_reference``).
+  fields ``k2_fields``, twin ``k2_reference``);
+- ``k1_3d``: the lowest order on polyhedra (d = 3), vertex values (kernel ``k1_3d_kernel``, fields
+  ``k1_3d_fields``, twin ``k1_3d_reference``).
 
-``element_for(order)`` is the element a scene's ``discretization.order`` names.
+``element_for(order, dimension)`` is the element a scene's ``discretization.order`` names (in 3D).
 """
 
 from __future__ import annotations

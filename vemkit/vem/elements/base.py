@@ -25,7 +25,7 @@ vertices, edges, cells (``layout``). Each element module provides:
     what ``cell_matrix`` reads besides the cell's nodes: the vertex coordinates (the default, every
     2D element), or a tuple of arrays (the 3D element: coordinates and the cells' faces).
 ``traction_load(mesh, edges, traction)``, ``body_force_load(mesh, field, lam, mu, projection)``
-    the load vector of Section 3.3, (n_nodes, d).
+    the load vector of Section 3.3, (n_nodes, d) (3D: boundary faces instead of edges).
 ``project(mesh, node_values, lam, mu)``
     Pi u_h (3.8) on every cell: an object with ``evaluate(cells, points)``,
     ``gradient_at(cells, points)`` and ``cell_mean_strain()``; ``projection_uses_material``: whether

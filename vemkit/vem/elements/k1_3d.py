@@ -74,6 +74,10 @@ class FirstOrder3D(Element):
         """int_K P_0 f . Pi v_h dx (Section 3.3), P_0 f the cell average of f."""
         return k1_3d_fields.body_force_load(mesh, self.geometry(mesh), field)
 
+    def traction_load(self, mesh, faces, traction) -> np.ndarray:
+        """int_F g . v_h ds over boundary ``faces`` (face numbers), v_h as Pi^F v_h on each face."""
+        return k1_3d_fields.traction_load(mesh, faces, traction)
+
     def project(self, mesh, node_values, lam=None, mu=None):
         return k1_3d_fields.projected_solution(mesh, self.geometry(mesh), node_values)
 

@@ -148,3 +148,44 @@ def dirichlet_components(mesh, dirichlet):
             prescribed[vs, k] = True
             values[vs, k] = g(x, y, z) if callable(g) else float(g)
     return prescribed, values
+
+
+def triangle_rule(points: int = 3):
+    """(Q, 2) points (barycentric s, t of the second and third corner) and weights on the unit
+    triangle (area 1/2), a collapsed Gauss-Legendre product (exact for degree 2 points - 2)."""
+    g, w = np.polynomial.legendre.leggauss(points)
+    g, w = (g + 1) / 2, w / 2
+    a, b = np.meshgrid(g, g, indexing="ij")
+    wa, wb = np.meshgrid(w, w, indexing="ij")
+    return np.stack([(a * (1 - b)).ravel(), b.ravel()], axis=1), (wa * wb * (1 - b)).ravel()
+
+
+def face_trace_weights(p, points):
+    """(Q, m) the values of Pi^F phi_i (the face's k = 1 projection, ``k1_3d_kernel``) at ``points``
+    (Q, 3) of the planar face with vertices p (m, 3): 1/m + grad_i . (x - xbar_F)."""
+    m = p.shape[0]
+    xb = p.mean(axis=0)
+    a = 0.5 * np.cross(p - xb, np.roll(p, -1, axis=0) - xb).sum(axis=0)
+    area = np.linalg.norm(a)
+    grad = np.cross(np.roll(p, -1, axis=0) - np.roll(p, 1, axis=0), a / area) / (2 * area)  # (m, 3)
+    return 1.0 / m + (points - xb) @ grad.T
+
+
+def traction_load(mesh, faces, traction, points: int = 4) -> np.ndarray:
+    """(N, 3) int_F g . phi_i ds over the boundary ``faces`` (stored outward): v_h on a face taken as
+    Pi^F v_h, as the face integrals of the projection (exact for v_h linear), by signed fan triangles
+    from the face's vertex mean (any planar face); traction(x, y, z) -> (g1, g2, g3)."""
+    ref, ref_w = triangle_rule(points)
+    out = np.zeros((mesh.n_vertices, 3))
+    for f in np.asarray(faces, dtype=np.int64).ravel():
+        ids = mesh.face(f)
+        p = mesh.vertices[ids]
+        xb = p.mean(axis=0)
+        q = np.roll(p, -1, axis=0)
+        x = xb + ref[None, :, :1] * (p - xb)[:, None] + ref[None, :, 1:] * (q - xb)[:, None]  # (m, Q, 3)
+        c = np.cross(p - xb, q - xb)
+        w = (c @ (c.sum(axis=0) / np.linalg.norm(c.sum(axis=0))))[:, None] * ref_w[None]  # 2 |T| (signed) x weights
+        x, w = x.reshape(-1, 3), w.ravel()
+        g = np.stack(np.broadcast_arrays(*traction(x[:, 0], x[:, 1], x[:, 2])), axis=1)  # (Q, 3)
+        np.add.at(out, ids, face_trace_weights(p, x).T @ (w[:, None] * g))
+    return out
