@@ -92,3 +92,24 @@ def test_constrained_dofs_with_fixed_components():
     u = dofs.node_values(spla.spsolve(K.tocsc(), f))
     exact = space.interpolate(field)
     assert np.abs(u - exact).max() < 1e-12 * np.abs(exact).max()
+
+
+def test_numbering_carries_three_components_per_node():
+    """dof = 3 free_index + component; restrict and node_values are inverse on the free nodes."""
+    mesh = hanging_mesh()
+    space = VirtualElementSpace(mesh, 1)
+    clamped = np.zeros(space.n_nodes, dtype=bool)
+    clamped[[0, 5]] = True
+    dofs = space.numbering(clamped)
+    assert dofs.n_free == 3 * (space.n_nodes - 2)
+    values = np.random.default_rng(0).standard_normal((space.n_nodes, 3))
+    u = dofs.restrict(values)
+    node = dofs.free_nodes[4]
+    assert np.array_equal(u[3 * dofs.free_index[node]:3 * dofs.free_index[node] + 3], values[node])
+    back = dofs.node_values(u)
+    assert np.array_equal(back[~clamped], values[~clamped]) and np.all(back[clamped] == 0)
+    assert dofs.expand(u).shape == (mesh.n_vertices, 3)
+    prescribed = np.zeros((space.n_nodes, 3), dtype=bool)
+    prescribed[3, 1] = True
+    fixed = dofs.with_fixed(prescribed, values)
+    assert fixed.prescribed_displacement()[3, 1] == values[3, 1] and not fixed.unconstrained_nodes()[3]
