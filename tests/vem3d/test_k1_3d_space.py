@@ -53,7 +53,7 @@ def linear_field(seed):
 
 MESHES = {
     "hex": lambda: hex_grid(3),
-    "tet": lambda: tet_grid(2)[0],
+    "tet": lambda: tet_grid(3)[0],
     "non-convex": lambda: mapped(l_stack(3), *random_affine(np.random.default_rng(1))),
     "hanging": hanging_mesh,
     "hanging-mapped": lambda: mapped(hanging_mesh(), *random_affine(np.random.default_rng(2))),
