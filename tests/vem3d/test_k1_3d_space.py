@@ -113,3 +113,10 @@ def test_numbering_carries_three_components_per_node():
     prescribed[3, 1] = True
     fixed = dofs.with_fixed(prescribed, values)
     assert fixed.prescribed_displacement()[3, 1] == values[3, 1] and not fixed.unconstrained_nodes()[3]
+
+
+def test_clamping_a_side_clamps_the_vertices_of_its_faces():
+    mesh = hanging_mesh()
+    space = VirtualElementSpace(mesh, 1)
+    mask = space.clamped_on(mesh.boundary["right"])
+    assert np.array_equal(np.flatnonzero(mask), np.flatnonzero(np.abs(mesh.vertices[:, 0] - 2.0) < 1e-12))

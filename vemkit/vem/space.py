@@ -88,8 +88,13 @@ class VirtualElementSpace:
 
     def clamped_on(self, edges) -> np.ndarray:
         """(n_nodes,) mask of the trace nodes of the given boundary edges (vertex pairs (k, 2)): what
-        ``dirichlet: [side]`` clamps."""
+        ``dirichlet: [side]`` clamps. In 3D ``edges`` are boundary faces (face numbers): their vertices."""
         mask = np.zeros(self.n_nodes, dtype=bool)
+        if self.element.dimension == 3:
+            faces = np.asarray(edges, dtype=np.int64).ravel()
+            if faces.size:
+                mask[np.concatenate([self.mesh.face(f) for f in faces])] = True
+            return mask
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if edges.size:
             mask[self.edge_nodes(edges).ravel()] = True

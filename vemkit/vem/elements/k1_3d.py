@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import weakref
 
+import numba
 import numpy as np
 
 from vemkit.vem.elements import k1_3d_fields, k1_3d_kernel
@@ -25,19 +26,30 @@ def local_faces(mesh):
     """(cell_face_ptr, face_ptr, face_local): every cell's faces, outward, as lists of local vertex
     numbers (positions in the cell's list of ``mesh.cell_vertex_lists``)."""
     offsets, ids = mesh.cell_vertex_lists
-    cell_face_ptr = mesh.cell_offsets.copy()
     signed = mesh.cell_faces
     faces = np.where(signed >= 0, signed, -signed - 1)
-    sizes = np.diff(mesh.face_offsets)[faces]
-    face_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    face_local = np.empty(face_ptr[-1], dtype=np.int64)
-    for c in range(mesh.n_cells):
-        local = {int(v): k for k, v in enumerate(ids[offsets[c]:offsets[c + 1]])}
-        for t in range(cell_face_ptr[c], cell_face_ptr[c + 1]):
-            vs = mesh.face(faces[t])
-            vs = vs if signed[t] >= 0 else vs[::-1]
-            face_local[face_ptr[t]:face_ptr[t + 1]] = [local[int(v)] for v in vs]
-    return cell_face_ptr, face_ptr, face_local
+    face_ptr = np.concatenate([[0], np.cumsum(np.diff(mesh.face_offsets)[faces])]).astype(np.int64)
+    face_local = _local_faces(mesh.cell_offsets, signed, mesh.face_offsets, mesh.face_vertices, offsets, ids,
+                              face_ptr, mesh.n_vertices)
+    return mesh.cell_offsets.copy(), face_ptr, face_local
+
+
+@numba.njit(cache=True)
+def _local_faces(cell_offsets, cell_faces, face_offsets, face_vertices, offsets, ids, face_ptr, n_vertices):
+    """face_local of ``local_faces``: each face's vertices (reversed where the cell lists it reversed)
+    renumbered by their positions in the cell's vertex list."""
+    local = np.full(n_vertices, -1, dtype=np.int64)
+    out = np.empty(face_ptr[-1], dtype=np.int64)
+    for c in range(cell_offsets.shape[0] - 1):
+        for k in range(offsets[c], offsets[c + 1]):
+            local[ids[k]] = k - offsets[c]
+        for t in range(cell_offsets[c], cell_offsets[c + 1]):
+            s = cell_faces[t]
+            f = s if s >= 0 else -s - 1
+            lo, m = face_offsets[f], face_offsets[f + 1] - face_offsets[f]
+            for i in range(m):
+                out[face_ptr[t] + i] = local[face_vertices[lo + (i if s >= 0 else m - 1 - i)]]
+    return out
 
 
 class FirstOrder3D(Element):
