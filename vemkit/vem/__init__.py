@@ -2,8 +2,8 @@
 
 - ``elements/``: the elements as plug-ins behind one interface (``elements/base.py`` says what an
   element declares: its degrees of freedom per mesh entity and its local kernels): ``k1`` (vertex
-  values) and ``k2`` (vertex values, edge and cell means), each with its Numba kernels and a
-  plain-numpy twin (``*_reference``).
+  values) and ``k2`` (vertex values, edge and cell means), ``k1_3d`` (vertex values on polyhedra),
+  each with its Numba kernels and a plain-numpy twin (``*_reference``).
 - ``space``: :class:`~vemkit.vem.space.VirtualElementSpace` (mesh, element): layout, numbering,
   constraints, interpolation, traces, loads, the projection of discrete fields.
 - ``dofs``: the one numbering (:class:`~vemkit.vem.dofs.DofMap`) and the symmetric elimination of

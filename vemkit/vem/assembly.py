@@ -1,14 +1,16 @@
 """One assembly for every element: local stiffness matrices (3.9) scattered straight into CSR.
 
-The matrix lives on the free dofs of a :class:`~vemkit.vem.dofs.DofMap` (dof = 2 * free_index +
-component); clamped nodes are eliminated while assembling, and with ``dofs.condensed`` each cell's
+The matrix lives on the free dofs of a :class:`~vemkit.vem.dofs.DofMap` (dof = d * free_index +
+component, d the element's dimension); clamped nodes are eliminated while assembling, and with ``dofs.condensed`` each cell's
 interior nodes (its last ``Element.condensed_nodes``, the k = 2 cell mean) are condensed out cell by
 cell (the Schur complement, ``condense_interior``). The sparsity pattern (``vemkit.vem.pattern``) is
 built once and every entry added in place: no COO triplets are ever formed.
 
 The element is a parameter: the Numba functions below marked *template* are written once and
 specialized per element (``specialized``), their calls ``workspace`` and ``cell_matrix`` bound to
-that element's kernels (compiled and cached on disk per element, as any ``cache=True`` kernel).
+that element's kernels and ``DIM`` to its dimension (a compile-time constant); the kernels receive
+``element.geometry(mesh)`` (the vertex coordinates in 2D; the 3D element adds its cells' faces).
+Compiled and cached on disk per element, as any ``cache=True`` kernel.
 The rows are split into contiguous chunks, one thread each; a thread computes the cells that touch
 its rows and writes only those rows, so no two threads write the same entry (cells straddling two
 chunks are computed twice) and the sums are the same whatever the number of threads.
@@ -30,11 +32,12 @@ _SPECIALIZED: dict = {}
 
 def specialized(template, element: Element, parallel: bool = False, **calls):
     """The Numba function of a template (a plain function of this module or another) for one
-    element: the names ``workspace`` and ``cell_matrix`` in its body (and any in ``calls``) are that
-    element's. Cached on disk per element under the name ``<template>_<element>``."""
+    element: the names ``workspace``, ``cell_matrix`` and ``DIM`` in its body (and any in ``calls``)
+    are that element's. Cached on disk per element under the name ``<template>_<element>``."""
     key = (template.__module__, template.__name__, element.name)
     if key not in _SPECIALIZED:
-        namespace = dict(template.__globals__, workspace=element.workspace, cell_matrix=element.cell_matrix, **calls)
+        namespace = dict(template.__globals__, workspace=element.workspace, cell_matrix=element.cell_matrix,
+                         DIM=element.dimension, **calls)
         function = types.FunctionType(template.__code__, namespace, f"{template.__name__}_{element.name}",
                                       template.__defaults__)
         function.__qualname__ = function.__name__
@@ -74,13 +77,13 @@ def cells_of_rows(row_lo, row_hi, free_items, item_ptr, item_cells, offsets, ids
 
 
 @numba.njit(cache=True, inline="always")
-def add_block(data, p0, p1, K, i, j):
-    """The 2 x 2 block (node i, j) of an element matrix K into the CSR data of the two scalar rows
-    of i, at positions p0 (first component's row) and p1 (second's)."""
-    data[p0] += K[2 * i, 2 * j]
-    data[p0 + 1] += K[2 * i, 2 * j + 1]
-    data[p1] += K[2 * i + 1, 2 * j]
-    data[p1 + 1] += K[2 * i + 1, 2 * j + 1]
+def add_block(data, p, stride, K, i, j, dim):
+    """The d x d block (node i, j) of an element matrix K into the CSR data of the d scalar rows of
+    i: component a's row holds the block's row at p + a * stride (every row of a node has the same
+    columns)."""
+    for a in range(dim):
+        for b in range(dim):
+            data[p + a * stride + b] += K[dim * i + a, dim * j + b]
 
 
 @numba.njit(cache=True)
@@ -98,10 +101,10 @@ def condense_interior(K, size):
 
 
 @numba.njit(cache=True)
-def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
+def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data, dim):
     """data += the rows of K whose node rows lie in [row_lo, row_hi): the cell's free columns are
     sorted once, then each CSR row is found by one merge walk along its sorted column list (the
-    even entries 2c of the scalar row 2r)."""
+    entries d c of the scalar row d r, d = dim)."""
     count = 0
     for j in range(size):  # insertion sort of the free local columns by global row
         if rows[j] < 0:
@@ -116,16 +119,16 @@ def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
         r = rows[i]
         if r < row_lo or r >= row_hi:
             continue
-        q = indptr[2 * r]
-        deg2 = indptr[2 * r + 1] - q
+        q = indptr[dim * r]
+        stride = indptr[dim * r + 1] - q
         for s in range(count):
             j = order[s]
-            while indices[q] < 2 * rows[j]:
-                q += 2
-            add_block(data, q, q + deg2, K, i, j)
+            while indices[q] < dim * rows[j]:
+                q += dim
+            add_block(data, q, stride, K, i, j, dim)
 
 
-def scatter_rows(row_lo, row_hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam,
+def scatter_rows(row_lo, row_hi, geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam,
                  mu, stab, condense, max_nodes, data):
     """*Template.* Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
     work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
@@ -136,19 +139,19 @@ def scatter_rows(row_lo, row_hi, vertices, offsets, nodes, free_index, free_node
         size = offsets[c + 1] - start
         for i in range(size):
             rows[i] = free_index[nodes[start + i]]
-        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
         if condense:
             condense_interior(K, size)
-        _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)
+        _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data, DIM)  # noqa: F821
 
 
-def scatter_stiffness(vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab,
+def scatter_stiffness(geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab,
                       condense, data):
     """*Template* (parallel). Every element stiffness (3.9) added into the CSR ``data`` (zeroed)."""
     max_nodes = largest_cell(offsets)
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, free_nodes.shape[0])
-        scatter_rows(lo, hi, vertices, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices,  # noqa: F821
+        scatter_rows(lo, hi, geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices,  # noqa: F821
                      lam, mu, stab, condense, max_nodes, data)
 
 
@@ -175,15 +178,17 @@ def stiffness_matrix(space, lam: float, mu: float, stabilization: str, dofs=None
     dofs = space.numbering() if dofs is None else dofs
     offsets, nodes = space.cell_nodes
     nc_ptr, nc = node_cells(offsets, nodes, dofs.n_nodes)
-    indptr, indices = dof_pattern(offsets, nodes, nc_ptr, nc, dofs.free_nodes, dofs.free_index)
+    dim = space.element.dimension
+    indptr, indices = dof_pattern(offsets, nodes, nc_ptr, nc, dofs.free_nodes, dofs.free_index, dim)
     data = np.zeros(indices.shape[0])  # fresh zero pages from the system: no zeroing pass
-    scatter_kernel(space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index, dofs.free_nodes, nc_ptr, nc,
+    geometry = space.element.geometry(space.mesh)
+    scatter_kernel(space.element)(geometry, offsets, nodes, dofs.free_index, dofs.free_nodes, nc_ptr, nc,
                                   indptr, indices, float(lam), float(mu), stabilization_code(stabilization),
                                   dofs.condensed, data)
     return sorted_csr(data, indices, indptr, dofs.n_free)
 
 
-def lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, condense, out):
+def lift(geometry, offsets, nodes, free_index, values, lam, mu, stab, condense, out):
     """*Template.* out[free] -= K_fc u_c over the cells that touch a clamped node with a non-zero value."""
     work = workspace(largest_cell(offsets))  # noqa: F821
     for c in range(offsets.shape[0] - 1):
@@ -192,11 +197,12 @@ def lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, condense, 
         touched = False
         for i in range(size):
             g = nodes[start + i]
-            if free_index[g] < 0 and (values[g, 0] != 0.0 or values[g, 1] != 0.0):
-                touched = True
+            for a in range(DIM):  # noqa: F821
+                if free_index[g] < 0 and values[g, a] != 0.0:
+                    touched = True
         if not touched:
             continue
-        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+        K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
         if condense:
             condense_interior(K, size)
         for i in range(size):
@@ -207,17 +213,18 @@ def lift(vertices, offsets, nodes, free_index, values, lam, mu, stab, condense, 
                 g = nodes[start + j]
                 if free_index[g] >= 0:
                     continue
-                for a in range(2):
-                    for b in range(2):
-                        out[2 * r + a] -= K[2 * i + a, 2 * j + b] * values[g, b]
+                for a in range(DIM):  # noqa: F821
+                    for b in range(DIM):  # noqa: F821
+                        out[DIM * r + a] -= K[DIM * i + a, DIM * j + b] * values[g, b]  # noqa: F821
 
 
 def dirichlet_lift(space, lam: float, mu: float, stabilization: str, dofs, values) -> np.ndarray:
     """-K_fc u_c on the free dofs: add it to the load when the clamped nodes carry the values
-    ``values`` (n_nodes, 2) (e.g. ``space.interpolate`` of the prescribed displacement) instead of 0."""
+    ``values`` (n_nodes, d) (e.g. ``space.interpolate`` of the prescribed displacement) instead of 0."""
     offsets, nodes = space.cell_nodes
     out = np.zeros(dofs.n_free)
-    vals = np.ascontiguousarray(values, dtype=float).reshape(dofs.n_nodes, 2)
-    specialized(lift, space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index, vals, float(lam), float(mu),
+    vals = np.ascontiguousarray(values, dtype=float).reshape(dofs.n_nodes, space.element.dimension)
+    geometry = space.element.geometry(space.mesh)
+    specialized(lift, space.element)(geometry, offsets, nodes, dofs.free_index, vals, float(lam), float(mu),
                                      stabilization_code(stabilization), dofs.condensed, out)
     return out

@@ -1,9 +1,10 @@
 """One numbering for every element: which nodes carry unknowns, and how Dirichlet data holds the rest.
 
 A :class:`DofMap` maps the unknown vector of a problem to the nodes of a space (vertices, edges,
-cells; ``vemkit.vem.elements.base``): dof = 2 * free_index[node] + component.
+cells; ``vemkit.vem.elements.base``): dof = d * free_index[node] + component, d the ``dimension``
+(2, or 3 for the 3D element).
 
-- A node with both components prescribed to exactly zero is *clamped*: eliminated while assembling,
+- A node with all its components prescribed to exactly zero is *clamped*: eliminated while assembling,
   as the paper's u = 0 on Gamma_D (2.4).
 - With ``condensed`` the interior nodes (the k = 2 cell means) carry no unknowns either: they are
   eliminated cell by cell (``vemkit.vem.condensation``).
@@ -45,6 +46,7 @@ class DofMap:
     fixed_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
     condensed: bool = False
     change: sp.csr_matrix | None = None
+    dimension: int = 2  # d: the components of every node
 
     @property
     def n_nodes(self) -> int:
@@ -52,7 +54,7 @@ class DofMap:
 
     @property
     def n_free(self) -> int:
-        return 2 * self.free_nodes.size
+        return self.dimension * self.free_nodes.size
 
     @property
     def clamped_nodes(self) -> np.ndarray:
@@ -62,20 +64,21 @@ class DofMap:
         return replace(self, change=change)
 
     def with_fixed(self, prescribed: np.ndarray, values: np.ndarray) -> "DofMap":
-        """The fixed dofs: the prescribed (n_nodes, 2) components of the kept nodes, held at ``values``."""
+        """The fixed dofs: the prescribed (n_nodes, d) components of the kept nodes, held at ``values``."""
         fixed = np.flatnonzero(prescribed[self.free_nodes].ravel())
         return replace(self, fixed_dofs=fixed, fixed_values=values[self.free_nodes].ravel()[fixed].copy())
 
     def unconstrained_nodes(self) -> np.ndarray:
-        """(n_nodes,) bool: both components of the node are unknowns (no Dirichlet data)."""
+        """(n_nodes,) bool: all components of the node are unknowns (no Dirichlet data)."""
         free = self.free_index >= 0
-        free[self.free_nodes[np.unique(self.fixed_dofs // 2)]] = False
+        free[self.free_nodes[np.unique(self.fixed_dofs // self.dimension)]] = False
         return free
 
     def prescribed_displacement(self) -> np.ndarray:
-        """(n_nodes, 2) the Dirichlet data: the fixed values, zero elsewhere."""
-        u = np.zeros((self.n_nodes, 2))
-        u.reshape(-1)[2 * self.free_nodes[self.fixed_dofs // 2] + self.fixed_dofs % 2] = self.fixed_values
+        """(n_nodes, d) the Dirichlet data: the fixed values, zero elsewhere."""
+        d = self.dimension
+        u = np.zeros((self.n_nodes, d))
+        u.reshape(-1)[d * self.free_nodes[self.fixed_dofs // d] + self.fixed_dofs % d] = self.fixed_values
         return u
 
     def dof_values(self, u: np.ndarray) -> np.ndarray:
@@ -84,7 +87,7 @@ class DofMap:
         return u if self.change is None else u + self.change @ u
 
     def unknowns(self, node_values: np.ndarray) -> np.ndarray:
-        """The unknown vector of given degrees of freedom (n_nodes, 2): ``restrict`` with the change of
+        """The unknown vector of given degrees of freedom (n_nodes, d): ``restrict`` with the change of
         variables inverted (its rows hold the changed dof on the diagonal and unchanged dofs besides)."""
         d = self.restrict(node_values).astype(float)
         if self.change is None:
@@ -96,30 +99,32 @@ class DofMap:
         return d
 
     def node_values(self, u: np.ndarray, clamped_values: np.ndarray | None = None) -> np.ndarray:
-        """(n_nodes, 2) degrees of freedom of every node; clamped nodes zero or ``clamped_values``,
+        """(n_nodes, d) degrees of freedom of every node; clamped nodes zero or ``clamped_values``,
         condensed interior nodes zero (``vemkit.vem.condensation.recover_interior`` computes them)."""
-        out = np.zeros((self.n_nodes, 2)) if clamped_values is None else np.array(clamped_values, float)
-        out[self.free_nodes] = self.dof_values(u).reshape(-1, 2)
+        d = self.dimension
+        out = np.zeros((self.n_nodes, d)) if clamped_values is None else np.array(clamped_values, float)
+        out[self.free_nodes] = self.dof_values(u).reshape(-1, d)
         return out
 
     def expand(self, u: np.ndarray) -> np.ndarray:
-        """(n_vertices, 2) the displacement at the mesh vertices, zero at clamped vertices."""
-        out = np.zeros((self.n_vertices, 2))
+        """(n_vertices, d) the displacement at the mesh vertices, zero at clamped vertices."""
+        out = np.zeros((self.n_vertices, self.dimension))
         vertices = self.free_nodes < self.n_vertices
-        out[self.free_nodes[vertices]] = np.asarray(u, dtype=float).reshape(-1, 2)[vertices]
+        out[self.free_nodes[vertices]] = np.asarray(u, dtype=float).reshape(-1, self.dimension)[vertices]
         return out
 
     def restrict(self, node_values: np.ndarray) -> np.ndarray:
-        """(n_nodes, 2) -> free-dof vector."""
+        """(n_nodes, d) -> free-dof vector."""
         return np.ascontiguousarray(np.asarray(node_values)[self.free_nodes]).ravel()
 
     @classmethod
-    def numbered(cls, n_vertices: int, order: np.ndarray, free: np.ndarray, condensed: bool = False) -> "DofMap":
+    def numbered(cls, n_vertices: int, order: np.ndarray, free: np.ndarray, condensed: bool = False,
+                 dimension: int = 2) -> "DofMap":
         """The free nodes (mask ``free``, (n_nodes,)) numbered in ``order`` (every node, the numbering)."""
         free_nodes = order[free[order]]
         free_index = np.full(free.size, -1, dtype=np.int64)
         free_index[free_nodes] = np.arange(free_nodes.size)
-        return cls(int(n_vertices), free_nodes, free_index, condensed=condensed)
+        return cls(int(n_vertices), free_nodes, free_index, condensed=condensed, dimension=int(dimension))
 
 
 def morton_order(mesh: Mesh) -> np.ndarray:

@@ -3,9 +3,10 @@
 Free node r couples with every free node of the cells around it (the cells' node lists of
 ``Element.cell_nodes``). A row's candidates hold each neighbour once per shared cell (a vertex row of
 a k = 2 quadrilateral mesh has 4 x 9 of them), so the duplicates are dropped by a sparse set as they
-come, only the distinct columns are sorted, and the int32 dof indices (2 x 2 blocks) are written
-directly, by numpy-allocated memory (huge pages). The rows are split into ``ROW_CHUNKS`` contiguous
-shares, one thread each (the same shares as the parallel assembly of ``vemkit.vem.assembly``).
+come, only the distinct columns are sorted, and the int32 dof indices (d x d blocks) are written
+directly (d the element's dimension), by numpy-allocated memory (huge pages). The rows are split
+into ``ROW_CHUNKS`` contiguous shares, one thread each (the same shares as the parallel assembly
+of ``vemkit.vem.assembly``).
 """
 
 from __future__ import annotations
@@ -89,21 +90,21 @@ def _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free):
 
 
 @numba.njit(cache=True)
-def _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices):
-    """Row r's columns, sorted (insertion sort: a row holds a few dozen), as the 2 x 2 dof blocks of
-    the scalar rows 2r and 2r + 1."""
+def _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices, dim):
+    """Row r's columns, sorted (insertion sort: a row holds a few dozen), as the d x d dof blocks of
+    the scalar rows d r ... d r + d - 1."""
     k = _row_columns(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf)
     sort_prefix(buf, k)
-    q0 = indptr[2 * r]
-    q1 = indptr[2 * r + 1]
-    for t in range(k):
-        indices[q0 + 2 * t] = indices[q1 + 2 * t] = 2 * buf[t]
-        indices[q0 + 2 * t + 1] = indices[q1 + 2 * t + 1] = 2 * buf[t] + 1
+    for a in range(dim):
+        q = indptr[dim * r + a]
+        for t in range(k):
+            for b in range(dim):
+                indices[q + dim * t + b] = dim * buf[t] + b
 
 
 @numba.njit(cache=True, parallel=True)
-def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
-    """indptr of ``dof_pattern``: the number of distinct free nodes around each free node, doubled."""
+def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index, dim):
+    """indptr of ``dof_pattern``: d times the number of distinct free nodes around each free node."""
     n_free = free_nodes.shape[0]
     degree = np.empty(n_free, dtype=np.int64)
     for chunk in numba.prange(ROW_CHUNKS):
@@ -111,30 +112,31 @@ def _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
         where, buf = _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free)
         for r in range(lo, hi):
             degree[r] = _row_columns(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf)
-    indptr = np.empty(2 * n_free + 1, dtype=np.int64)
+    indptr = np.empty(dim * n_free + 1, dtype=np.int64)
     indptr[0] = 0
     for r in range(n_free):
-        indptr[2 * r + 1] = indptr[2 * r] + 2 * degree[r]
-        indptr[2 * r + 2] = indptr[2 * r + 1] + 2 * degree[r]
+        for a in range(dim):
+            indptr[dim * r + a + 1] = indptr[dim * r + a] + dim * degree[r]
     return indptr
 
 
 @numba.njit(cache=True, parallel=True)
-def _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices):
+def _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices, dim):
     """The sorted columns of ``dof_pattern`` into indices, each thread its own contiguous rows."""
     n_free = free_nodes.shape[0]
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, n_free)
         where, buf = _row_buffers(lo, hi, free_nodes, nc_ptr, nc, offsets, n_free)
         for r in range(lo, hi):
-            _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices)
+            _sorted_row(r, free_nodes, free_index, nc_ptr, nc, offsets, nodes, where, buf, indptr, indices, dim)
 
 
-def dof_pattern(offsets, nodes, nc_ptr, nc, free_nodes, free_index):
-    """CSR pattern (indptr, int32 indices, sorted) of the global matrix: scalar rows 2r + a hold
-    (2c, 2c + 1) for every free node c sharing a cell with the free node r. The indices are
-    allocated here, by numpy (large arrays on huge pages: fewer page faults when first written)."""
-    indptr = _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index)
+def dof_pattern(offsets, nodes, nc_ptr, nc, free_nodes, free_index, dim=2):
+    """CSR pattern (indptr, int32 indices, sorted) of the global matrix, d = ``dim`` components per
+    node: scalar rows d r + a hold (d c, ..., d c + d - 1) for every free node c sharing a cell with
+    the free node r. The indices are allocated here, by numpy (large arrays on huge pages: fewer
+    page faults when first written)."""
+    indptr = _pattern_rows(offsets, nodes, nc_ptr, nc, free_nodes, free_index, dim)
     indices = np.empty(indptr[-1], dtype=np.int32)
-    _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices)
+    _pattern_columns(offsets, nodes, nc_ptr, nc, free_nodes, free_index, indptr, indices, dim)
     return indptr, indices

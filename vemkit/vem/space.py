@@ -24,11 +24,15 @@ from vemkit.vem.quadrature import pressure_traction
 
 
 class VirtualElementSpace:
-    """V_h of ``element`` (or of the element of order ``element``, an int) on ``mesh``."""
+    """V_h of ``element`` (or of the element of order ``element``, an int, in the mesh's dimension:
+    a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh` is 3D) on ``mesh``. Every node carries d =
+    ``element.dimension`` components."""
 
     def __init__(self, mesh: Mesh, element: Element | int = 1):
         self.mesh = mesh
-        self.element = element_for(element) if isinstance(element, (int, np.integer)) else element
+        if isinstance(element, (int, np.integer)):
+            element = element_for(element, getattr(mesh, "dimension", 2))
+        self.element = element
 
     def __repr__(self) -> str:
         return f"VirtualElementSpace({self.element.name}, {self.mesh.n_cells} cells, {self.n_dofs} dofs)"
@@ -44,7 +48,7 @@ class VirtualElementSpace:
     @property
     def n_dofs(self) -> int:
         """Scalar degrees of freedom of the space (no constraint applied)."""
-        return 2 * self.n_nodes
+        return self.element.dimension * self.n_nodes
 
     @cached_property
     def cell_nodes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -53,7 +57,7 @@ class VirtualElementSpace:
 
     @cached_property
     def node_coordinates(self) -> np.ndarray:
-        """(n_nodes, 2): where the nodes are (vertices, edge midpoints, cell centroids)."""
+        """(n_nodes, d): where the nodes are (vertices, edge midpoints, cell centroids)."""
         return self.element.node_coordinates(self.mesh)
 
     def node_range(self, entity: str) -> slice:
@@ -74,29 +78,36 @@ class VirtualElementSpace:
 
     def numbering(self, clamped: np.ndarray | None = None, condensed: bool = False, natural: bool = False) -> DofMap:
         """The unknowns: every node but the ``clamped`` ones (mask (n_nodes,)) and, with ``condensed``,
-        the interior nodes, in the element's numbering (``natural``: in node order, dof = 2 node + c)."""
+        the interior nodes, in the element's numbering (``natural``: in node order, dof = d node + c)."""
         free = np.ones(self.n_nodes, dtype=bool) if clamped is None else ~np.asarray(clamped, dtype=bool)
         if condensed and self.element.condensed_nodes:
             free[self.node_range("cell")] = False
         order = np.arange(self.n_nodes, dtype=np.int64) if natural else self._numbering_order
-        return DofMap.numbered(self.mesh.n_vertices, order, free, condensed=bool(condensed and self.element.condensed_nodes))
+        return DofMap.numbered(self.mesh.n_vertices, order, free, condensed=bool(condensed and self.element.condensed_nodes),
+                               dimension=self.element.dimension)
 
     def clamped_on(self, edges) -> np.ndarray:
         """(n_nodes,) mask of the trace nodes of the given boundary edges (vertex pairs (k, 2)): what
-        ``dirichlet: [side]`` clamps."""
+        ``dirichlet: [side]`` clamps. In 3D ``edges`` are boundary faces (face numbers): their vertices."""
         mask = np.zeros(self.n_nodes, dtype=bool)
+        if self.element.dimension == 3:
+            faces = np.asarray(edges, dtype=np.int64).ravel()
+            if faces.size:
+                mask[np.concatenate([self.mesh.face(f) for f in faces])] = True
+            return mask
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if edges.size:
             mask[self.edge_nodes(edges).ravel()] = True
         return mask
 
     def dirichlet_components(self, dirichlet) -> tuple[np.ndarray, np.ndarray]:
-        """(prescribed (n_nodes, 2) bool, values (n_nodes, 2)) of ``dirichlet``: side names (u = 0) or
-        a mapping side -> (u1, u2), each None (free), a number or a function of (x, y)."""
+        """(prescribed (n_nodes, d) bool, values (n_nodes, d)) of ``dirichlet``: side names (u = 0) or
+        a mapping side -> (u1, u2) (3D: (u1, u2, u3)), each None (free), a number or a function of
+        (x, y) (3D: (x, y, z))."""
         return self.element.dirichlet_components(self.mesh, dirichlet)
 
     def constrain(self, prescribed: np.ndarray, values: np.ndarray, condensed: bool | None = None) -> DofMap:
-        """The dof map of Dirichlet data: clamped nodes (both components prescribed zero) eliminated,
+        """The dof map of Dirichlet data: clamped nodes (all components prescribed zero) eliminated,
         the other prescribed components fixed dofs of kept nodes; interior nodes condensed (default:
         whenever the element has them)."""
         condensed = bool(self.element.condensed_nodes) if condensed is None else condensed
@@ -105,11 +116,11 @@ class VirtualElementSpace:
 
     # -- fields ----------------------------------------------------------------------------
     def interpolate(self, field) -> np.ndarray:
-        """(n_nodes, 2) the degrees of freedom of a field(x, y) -> (f1, f2)."""
+        """(n_nodes, d) the degrees of freedom of a field(x, y) -> (f1, f2) (3D: field(x, y, z) -> (f1, f2, f3))."""
         return self.element.interpolate(self.mesh, field)
 
     def project(self, node_values: np.ndarray, lam: float, mu: float):
-        """Pi u_h (3.8) of the degrees of freedom ``node_values`` (n_nodes, 2) on every cell."""
+        """Pi u_h (3.8) of the degrees of freedom ``node_values`` (n_nodes, d) on every cell."""
         return self.element.project(self.mesh, node_values, lam, mu)
 
     def edge_nodes(self, edges: np.ndarray) -> np.ndarray:

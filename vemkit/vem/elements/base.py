@@ -18,11 +18,14 @@ vertices, edges, cells (``layout``). Each element module provides:
     along a Morton curve of the cells (locality when a cell has edge and cell nodes).
 ``cell_nodes(mesh)``
     CSR (offsets, nodes) of every cell's nodes in the kernel's local order.
-``workspace(max_nodes)``, ``cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)``
+``workspace(max_nodes)``, ``cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)``
     Numba functions: work arrays, and the local stiffness (3.9) of cell c (consistency plus the
     stabilization S_K scaled by ``stab``) in the leading block of the matrix returned.
+``geometry(mesh)``
+    what ``cell_matrix`` reads besides the cell's nodes: the vertex coordinates (the default, every
+    2D element), or a tuple of arrays (the 3D element: coordinates and the cells' faces).
 ``traction_load(mesh, edges, traction)``, ``body_force_load(mesh, field, lam, mu, projection)``
-    the load vector of Section 3.3, (n_nodes, d).
+    the load vector of Section 3.3, (n_nodes, d) (3D: boundary faces instead of edges).
 ``project(mesh, node_values, lam, mu)``
     Pi u_h (3.8) on every cell: an object with ``evaluate(cells, points)``,
     ``gradient_at(cells, points)`` and ``cell_mean_strain()``; ``projection_uses_material``: whether
@@ -87,6 +90,10 @@ class Element:
     @property
     def fields(self):
         return import_module(self.fields_module)
+
+    def geometry(self, mesh):
+        """The first argument of ``cell_matrix`` (module docstring): the vertex coordinates."""
+        return mesh.vertices
 
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"

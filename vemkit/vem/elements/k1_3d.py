@@ -1,0 +1,100 @@
+"""The lowest-order element in three dimensions (k = 1, Section 3 for d = 3): the displacement at
+the vertices of polyhedra (SPEC §10).
+
+Its kernel is ``k1_3d_kernel`` (the projection (3.8) from face integrals of the vertex values and
+the stiffness (3.9)), its loads and projected fields ``k1_3d_fields``, its numpy twin
+``k1_3d_reference``. The kernel needs the cells' faces, not only their vertices: ``geometry(mesh)``
+is what the assembly hands it in place of the vertex coordinates (the 2D elements hand the
+coordinates themselves).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numba
+import numpy as np
+
+from vemkit.vem.elements import k1_3d_fields, k1_3d_kernel
+from vemkit.vem.elements.base import Element
+
+
+_FACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mesh -> local_faces(mesh)
+
+
+def local_faces(mesh):
+    """(cell_face_ptr, face_ptr, face_local): every cell's faces, outward, as lists of local vertex
+    numbers (positions in the cell's list of ``mesh.cell_vertex_lists``)."""
+    offsets, ids = mesh.cell_vertex_lists
+    signed = mesh.cell_faces
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    face_ptr = np.concatenate([[0], np.cumsum(np.diff(mesh.face_offsets)[faces])]).astype(np.int64)
+    face_local = _local_faces(mesh.cell_offsets, signed, mesh.face_offsets, mesh.face_vertices, offsets, ids,
+                              face_ptr, mesh.n_vertices)
+    return mesh.cell_offsets.copy(), face_ptr, face_local
+
+
+@numba.njit(cache=True)
+def _local_faces(cell_offsets, cell_faces, face_offsets, face_vertices, offsets, ids, face_ptr, n_vertices):
+    """face_local of ``local_faces``: each face's vertices (reversed where the cell lists it reversed)
+    renumbered by their positions in the cell's vertex list."""
+    local = np.full(n_vertices, -1, dtype=np.int64)
+    out = np.empty(face_ptr[-1], dtype=np.int64)
+    for c in range(cell_offsets.shape[0] - 1):
+        for k in range(offsets[c], offsets[c + 1]):
+            local[ids[k]] = k - offsets[c]
+        for t in range(cell_offsets[c], cell_offsets[c + 1]):
+            s = cell_faces[t]
+            f = s if s >= 0 else -s - 1
+            lo, m = face_offsets[f], face_offsets[f + 1] - face_offsets[f]
+            for i in range(m):
+                out[face_ptr[t] + i] = local[face_vertices[lo + (i if s >= 0 else m - 1 - i)]]
+    return out
+
+
+class FirstOrder3D(Element):
+    name = "k1_3d"
+    order = 1
+    dimension = 3
+    layout = {"vertex": 1}
+    condensed_nodes = 0
+    numbering = "mesh"
+    stress_degree = 0
+    polynomial_on_triangles = True  # on tetrahedra V_h is P1: the stiffness of P1 finite elements
+    projection_uses_material = False
+    contact_rule = ()  # contact in 3D is not part of this element yet
+    workspace = staticmethod(k1_3d_kernel.workspace)
+    cell_matrix = staticmethod(k1_3d_kernel.cell_matrix)
+
+    def cell_nodes(self, mesh):
+        return mesh.cell_vertex_lists
+
+    def geometry(self, mesh):
+        """(vertices, cell_face_ptr, face_ptr, face_local): what ``cell_matrix`` reads (``local_faces``)."""
+        if mesh not in _FACES:
+            _FACES[mesh] = local_faces(mesh)
+        return (mesh.vertices,) + _FACES[mesh]
+
+    def node_coordinates(self, mesh) -> np.ndarray:
+        return mesh.vertices
+
+    def interpolate(self, mesh, field) -> np.ndarray:
+        x, y, z = mesh.vertices.T
+        return np.stack(np.broadcast_arrays(*field(x, y, z)), axis=1).astype(float)
+
+    def body_force_load(self, mesh, field, lam, mu, projection="p0") -> np.ndarray:
+        """int_K P_0 f . Pi v_h dx (Section 3.3), P_0 f the cell average of f."""
+        return k1_3d_fields.body_force_load(mesh, self.geometry(mesh), field)
+
+    def traction_load(self, mesh, faces, traction) -> np.ndarray:
+        """int_F g . v_h ds over boundary ``faces`` (face numbers), v_h as Pi^F v_h on each face."""
+        return k1_3d_fields.traction_load(mesh, faces, traction)
+
+    def project(self, mesh, node_values, lam=None, mu=None):
+        return k1_3d_fields.projected_solution(mesh, self.geometry(mesh), node_values)
+
+    def dirichlet_components(self, mesh, dirichlet):
+        return k1_3d_fields.dirichlet_components(mesh, dirichlet)
+
+
+ELEMENT = FirstOrder3D()
