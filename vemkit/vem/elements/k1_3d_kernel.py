@@ -39,6 +39,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from vemkit.vem.elements.k1_kernel import add_stabilization
+
 
 @numba.njit(cache=True)
 def cross(a0, a1, a2, b0, b1, b2):
@@ -230,21 +232,6 @@ def consistency(B, volume, lam, mu, K):
             K[i, j] = t0 * B[0, j] + t1 * B[1, j] + t2 * B[2, j] + t3 * B[3, j] + t4 * B[4, j] + t5 * B[5, j]
         tr += K[i, i]
     return tr
-
-
-@numba.njit(cache=True)
-def add_stabilization(R, alpha, K):
-    """K += alpha (I - Pi)^T (I - Pi) (the dofi-dofi S_K of (3.9)), R = (I - Pi)^T."""
-    m = R.shape[0]
-    for i in range(m):
-        for j in range(i, m):
-            acc = 0.0
-            for k in range(m):
-                acc += R[i, k] * R[j, k]
-            acc *= alpha
-            K[i, j] += acc
-            if j != i:
-                K[j, i] += acc
 
 
 @numba.njit(cache=True)

@@ -149,7 +149,14 @@ def element_stiffness(px, py, lam, mu, stab, K, B, P, R):
             R[j, 2 * i] = -(c1 + e11 * d1 + (e12 - om) * d2)
             R[j, 2 * i + 1] = -(c2 + (e12 + om) * d1 + e22 * d2)
         R[j, j] += 1.0
-    # stabilization alpha (I - Pi)^T (I - Pi)
+    add_stabilization(R, alpha, K)
+    return area
+
+
+@numba.njit(cache=True)
+def add_stabilization(R, alpha, K):
+    """K += alpha (I - Pi)^T (I - Pi) (the dofi-dofi S_K of (3.9)), R = (I - Pi)^T (any dimension)."""
+    m = R.shape[0]
     for i in range(m):
         for j in range(i, m):
             acc = 0.0
@@ -159,7 +166,6 @@ def element_stiffness(px, py, lam, mu, stab, K, B, P, R):
             K[i, j] += acc
             if j != i:
                 K[j, i] += acc
-    return area
 
 
 # --------------------------------------------------------------------------------------------
