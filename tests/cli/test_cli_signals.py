@@ -48,12 +48,12 @@ cli._run = long_kernel
 IN_ASSEMBLY = """
 original_run = cli._run
 def marked_run(argv):
-    import vemkit.contact.problem_k2 as problem_k2
-    assemble = problem_k2.stiffness_matrix_k2
+    import vemkit.vem.assembly as assembly
+    assemble = assembly.stiffness_matrix
     def marked(*args, **kwargs):
         open(MARK, "w").close()
         return assemble(*args, **kwargs)
-    problem_k2.stiffness_matrix_k2 = marked
+    assembly.stiffness_matrix = marked
     return original_run(argv)
 cli._run = marked_run
 """
