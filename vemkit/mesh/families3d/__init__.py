@@ -1,0 +1,26 @@
+"""3D mesh families by name (SPEC §10): every one returns a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
+with named sides and ``meta``, valid for :func:`~vemkit.mesh.checks3d.validate_mesh3d`.
+
+On a box ``[lower, upper]`` (sides xmin, xmax, ymin, ymax, zmin, zmax, default ``left, right, front,
+back, bottom, top``):
+
+- ``hex``: the grid of max(1, round(n L)) hexahedra along each edge of length L;
+- ``tet``: the same grid, each hexahedron cut into its 6 Kuhn tetrahedra;
+- ``octree``: the hex grid with the cells at a side (``contact_side``) or a random ``fraction`` cut
+  into 8 (one level): coarse neighbours gain the hanging nodes as vertices;
+- ``voronoi``: about n³ per unit volume clipped centroidal Voronoi polyhedra (``seed``,
+  ``lloyd_iterations``, ``jitter``).
+
+``extrude(mesh2d, layers, depth)``: prisms over any 2D mesh (``families3d.extrude``). Domains and
+sizes (n, h, cells) are resolved by :mod:`vemkit.config.domain3d`.
+"""
+
+from vemkit.mesh.families3d.extrude import extrude
+from vemkit.mesh.families3d.grid import BOX_SIDES, UNIT_BOX, hex, tet
+from vemkit.mesh.families3d.octree import octree
+from vemkit.mesh.families3d.voronoi3d import voronoi
+
+#: family -> (builder, cells per n³ unit volume, for the size by ``cells``)
+BOX_FAMILIES = {"hex": (hex, 1.0), "tet": (tet, 6.0), "octree": (octree, 1.0), "voronoi": (voronoi, 1.0)}
+
+__all__ = ["BOX_FAMILIES", "BOX_SIDES", "UNIT_BOX", "extrude", "hex", "octree", "tet", "voronoi"]
