@@ -12,15 +12,13 @@ back, bottom, top``):
   ``lloyd_iterations``, ``jitter``).
 
 ``extrude(mesh2d, layers, depth)``: prisms over any 2D mesh (``families3d.extrude``). Domains and
-sizes (n, h, cells) are resolved by :mod:`vemkit.config.domain3d`.
+sizes (n, h, cells): ``build_mesh3d`` (``families3d.build``).
 """
 
 from vemkit.mesh.families3d.extrude import extrude
 from vemkit.mesh.families3d.grid import BOX_SIDES, UNIT_BOX, hex, tet
 from vemkit.mesh.families3d.octree import octree
 from vemkit.mesh.families3d.voronoi3d import voronoi
+from vemkit.mesh.families3d.build import BOX_FAMILIES, build_mesh3d
 
-#: family -> (builder, cells per n³ unit volume, for the size by ``cells``)
-BOX_FAMILIES = {"hex": (hex, 1.0), "tet": (tet, 6.0), "octree": (octree, 1.0), "voronoi": (voronoi, 1.0)}
-
-__all__ = ["BOX_FAMILIES", "BOX_SIDES", "UNIT_BOX", "extrude", "hex", "octree", "tet", "voronoi"]
+__all__ = ["BOX_FAMILIES", "build_mesh3d", "BOX_SIDES", "UNIT_BOX", "extrude", "hex", "octree", "tet", "voronoi"]
