@@ -82,7 +82,8 @@ def test_octree_hanging_nodes_are_coarse_vertices():
 
 
 @pytest.mark.parametrize("options", [{"n": 3}, {"cells": 150, "box": BOX, "seed": 4}, {"n": 4, "lloyd_iterations": 0},
-                                     {"n": 4, "jitter": 0.0, "lloyd_iterations": 0}])
+                                     {"n": 4, "jitter": 0.0, "lloyd_iterations": 0},
+                                     {"n": 3, "lloyd_samples": 0, "seed": 5}])
 def test_voronoi(options):
     mesh = voronoi(**options)
     box = options.get("box", ((0, 0, 0), (1, 1, 1)))
@@ -94,8 +95,8 @@ def test_voronoi_is_deterministic_and_lloyd_evens_the_cells():
     a, b = voronoi(4, seed=2), voronoi(4, seed=2)
     assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.cell_faces, b.cell_faces)
     rough = voronoi(5, seed=1, lloyd_iterations=0).cell_volumes
-    smooth = voronoi(5, seed=1, lloyd_iterations=4).cell_volumes
-    assert smooth.std() < rough.std()
+    assert voronoi(5, seed=1, lloyd_iterations=4).cell_volumes.std() < rough.std()
+    assert voronoi(5, seed=1, lloyd_iterations=2, lloyd_samples=0).cell_volumes.std() < rough.std()
 
 
 @pytest.mark.parametrize("family", ["square", "triangle", "voronoi", "hanging"])

@@ -2,13 +2,14 @@
 
 Seeds: a jittered grid of ``count`` points (about n³ per unit volume; one per lattice cell of the
 box's best-fitting grid, jittered by ``jitter`` of a cell with ``numpy.random.default_rng(seed)``),
-then ``lloyd_iterations`` Lloyd steps (every seed moved to its cell's centroid).
+then ``lloyd_iterations`` Lloyd steps (every seed moved to its cell's centroid, by default the
+centroid estimated on a regular grid of 27 sample points per cell: one diagram in all).
 
 Clipping by mirrors: every seed within ``margin`` of a box face is mirrored across that face. For
 a seed p inside the box, its mirror p' makes the face plane the bisector of p and p', and a mirror
 q' is never closer than q to a point of the box, so the Voronoi cell of p among the seeds and the
 mirrors is exactly its Voronoi cell among the seeds cut by the box (as long as every seed whose
-cell reaches a face is mirrored: the margin starts at 3 cell sizes and is doubled until every cell
+cell reaches a face is mirrored: the margin starts at 1.5 cell sizes and is doubled until every cell
 is bounded and inside the box). The diagram is scipy.spatial.Voronoi (Qhull), whose 3D ridges list
 their vertices in order around the ridge. Ridges between two seeds are interior faces, ridges
 between a seed and a mirror are boundary faces named after the mirror's face; vertices within
@@ -54,21 +55,47 @@ def jittered_seeds(count: int, lower, upper, rng, jitter: float) -> np.ndarray:
     return lower + (ijk + 0.5 + jitter * (rng.random((count, 3)) - 0.5)) * cell
 
 
-def voronoi(n=None, box=UNIT_BOX, sides=BOX_SIDES, cells=None, seed: int = 0, lloyd_iterations: int = 2,
-            jitter: float = 0.8) -> PolyhedralMesh:
-    """The clipped centroidal Voronoi mesh of the box (module doc)."""
+def voronoi(n=None, box=UNIT_BOX, sides=BOX_SIDES, cells=None, seed: int = 0, lloyd_iterations: int = 3,
+            jitter: float = 0.8, lloyd_samples: int = 3) -> PolyhedralMesh:
+    """The clipped centroidal Voronoi mesh of the box (module doc). ``lloyd_samples`` = k > 0: the
+    Lloyd steps take every cell's centroid as the mean of the points of a regular grid of about k³
+    points per cell that are nearer to its seed than to any other (a cKDTree query: no diagram per
+    step); k = 0: the exact centroids of the clipped diagram at every step."""
     lower, upper = check_box(box)
     count = seed_count(n, box, cells)
     rng = np.random.default_rng(seed)
     points = jittered_seeds(count, lower, upper, rng, jitter)
+    samples = sample_grid(count, lower, upper, int(lloyd_samples)) if lloyd_samples else None
     for _ in range(int(lloyd_iterations)):
-        mesh = clipped_voronoi(points, lower, upper, sides)
-        points = cell_centroids(mesh, points)
+        if samples is None:
+            points = cell_centroids(clipped_voronoi(points, lower, upper, sides), points)
+        else:
+            points = sampled_centroids(points, samples)
     mesh = clipped_voronoi(points, lower, upper, sides)
     meta = {"family": "voronoi", "n": n, "cells": count, "box": np.asarray(box, float).tolist(), "seed": int(seed),
-            "lloyd_iterations": int(lloyd_iterations), "jitter": float(jitter)}
+            "lloyd_iterations": int(lloyd_iterations), "jitter": float(jitter), "lloyd_samples": int(lloyd_samples)}
     return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
                           mesh.boundary, meta)
+
+
+def sample_grid(count: int, lower, upper, k: int) -> np.ndarray:
+    """The centres of a regular grid of about k³ x count cells of the box."""
+    size = upper - lower
+    step = (float(np.prod(size)) / (count * k**3)) ** (1.0 / 3.0)
+    shape = np.maximum(1, np.round(size / step).astype(int))
+    axes = [lower[a] + (np.arange(shape[a]) + 0.5) * size[a] / shape[a] for a in range(3)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def sampled_centroids(points: np.ndarray, samples: np.ndarray) -> np.ndarray:
+    """Every seed moved to the mean of the samples nearest to it (kept where it has none)."""
+    _, owner = cKDTree(points).query(samples, workers=-1)
+    count = np.bincount(owner, minlength=points.shape[0])
+    out = points.copy()
+    has = count > 0
+    for a in range(3):
+        out[has, a] = np.bincount(owner, weights=samples[:, a], minlength=points.shape[0])[has] / count[has]
+    return out
 
 
 def cell_centroids(mesh: PolyhedralMesh, inside: np.ndarray) -> np.ndarray:
@@ -104,7 +131,7 @@ def _diagram(points, lower, upper):
     count = points.shape[0]
     size = float(np.max(upper - lower))
     step = (float(np.prod(upper - lower)) / count) ** (1.0 / 3.0)
-    margin = min(3.0 * step, size)
+    margin = min(1.5 * step, size)
     while True:
         allpoints, plane = _mirrored(points, lower, upper, margin)
         vor = Voronoi(allpoints)
