@@ -45,6 +45,17 @@ def test_polyhedral_geometry_of_a_cube():
     assert sorted(mesh.cell_vertex_lists[1].tolist()) == list(range(8))
 
 
+def test_diameter_kernel_and_its_numpy_twin_agree():
+    from vemkit.mesh.polyhedral import _diameters, diameters_numpy
+
+    mesh = voronoi(3, seed=1)
+    offsets, ids = mesh.cell_vertex_lists
+    assert np.allclose(_diameters(mesh.vertices, offsets, ids), diameters_numpy(mesh.vertices, offsets, ids), rtol=1e-15)
+    mesh = octree(shape=(2, 2, 2), rule="random", seed=2)
+    offsets, ids = mesh.cell_vertex_lists
+    assert np.array_equal(mesh.cell_diameters, diameters_numpy(mesh.vertices, offsets, ids))
+
+
 def test_hex():
     mesh = hex(shape=(3, 4, 2), box=BOX)
     assert (mesh.n_cells, mesh.n_vertices, mesh.n_faces) == (24, 4 * 5 * 3, 4 * 4 * 2 + 3 * 5 * 2 + 3 * 4 * 3)

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import numba
 import numpy as np
 
 
@@ -142,23 +143,45 @@ class PolyhedralMesh:
 
     @cached_property
     def cell_diameters(self) -> np.ndarray:
-        """The largest vertex-to-vertex distance of every cell (cells grouped by vertex count, in chunks)."""
+        """The largest vertex-to-vertex distance of every cell (a numba kernel; ``diameters_numpy`` is its twin)."""
         offsets, ids = self.cell_vertex_lists
-        sizes = np.diff(offsets)
-        out = np.zeros(self.n_cells)
-        for size in np.unique(sizes):
-            cells = np.flatnonzero(sizes == size)
-            step = max(1, 2_000_000 // int(size * size))
-            for s in range(0, cells.size, step):
-                chunk = cells[s:s + step]
-                p = self.vertices[ids[offsets[chunk][:, None] + np.arange(size)]]
-                d = ((p[:, :, None, :] - p[:, None, :, :]) ** 2).sum(axis=-1)
-                out[chunk] = np.sqrt(d.reshape(chunk.size, -1).max(axis=1))
-        return out
+        return _diameters(self.vertices, offsets, ids)
 
     @property
     def h(self) -> float:
         return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+
+@numba.njit(cache=True)
+def _diameters(vertices, offsets, ids):
+    """Per CSR segment of vertex ids: the largest distance between two of its vertices."""
+    out = np.zeros(offsets.size - 1)
+    for c in range(offsets.size - 1):
+        best = 0.0
+        for i in range(offsets[c], offsets[c + 1]):
+            for j in range(i + 1, offsets[c + 1]):
+                d = 0.0
+                for a in range(3):
+                    t = vertices[ids[i], a] - vertices[ids[j], a]
+                    d += t * t
+                best = max(best, d)
+        out[c] = np.sqrt(best)
+    return out
+
+
+def diameters_numpy(vertices, offsets, ids) -> np.ndarray:
+    """The numpy twin of ``_diameters`` (segments grouped by size, in chunks)."""
+    sizes = np.diff(offsets)
+    out = np.zeros(sizes.size)
+    for size in np.unique(sizes):
+        cells = np.flatnonzero(sizes == size)
+        step = max(1, 2_000_000 // int(size * size))
+        for s in range(0, cells.size, step):
+            chunk = cells[s:s + step]
+            p = vertices[ids[offsets[chunk][:, None] + np.arange(size)]]
+            d = ((p[:, :, None, :] - p[:, None, :, :]) ** 2).sum(axis=-1)
+            out[chunk] = np.sqrt(d.reshape(chunk.size, -1).max(axis=1))
+    return out
 
 
 def _segment_sum(values: np.ndarray, offsets: np.ndarray) -> np.ndarray:
