@@ -81,7 +81,15 @@ def test_extruded_meshes_are_prisms_over_the_2d_mesh(family):
     assert build_mesh3d(family, EXTRUDE, n=8, layers=3).n_cells == 3 * base.n_cells
 
 
+@pytest.mark.parametrize("options", [{}, {"rule": "random", "fraction": 0.5, "seed": 2}, {"contact_side": "left"}])
+def test_octree_cells_count_the_refined_mesh(options):
+    mesh = build_mesh3d("octree", BOX, cells=3000, **options)
+    assert 0.6 * 3000 <= mesh.n_cells <= 1.5 * 3000
+
+
 def test_family_errors():
+    with pytest.raises(SceneError, match="mesh option 'levels2' is not valid for family octree; valid options: rule"):
+        build_mesh3d("octree", BOX, n=2, levels2=3)
     with pytest.raises(SceneError, match="does not mesh a box; valid families: hex, tet, octree, voronoi"):
         build_mesh3d("square", BOX, n=2)
     with pytest.raises(SceneError, match="does not mesh an extrude domain"):

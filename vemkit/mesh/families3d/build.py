@@ -6,6 +6,10 @@ the 3D families, on an extruded domain the prisms over the 2D family's mesh of t
 
 from __future__ import annotations
 
+import inspect
+
+import numpy as np
+
 from vemkit.config.domain3d import BOX_FAMILIES as BOX_FAMILY_NAMES, FAMILIES_2D, Box, cells_per_length3d, \
     domain3d_from_spec
 from vemkit.exceptions import SceneError
@@ -29,16 +33,17 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
         if layers is not None:
             raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
                              key="discretization.mesh.layers")
-        builder, per_cube = BOX_FAMILIES[family]
+        builder = BOX_FAMILIES[family][0]
+        _check_options(family, builder, options)
         box = (body.lower, body.upper)
         if family == "voronoi" and cells is not None:
             return builder(box=box, sides=body.sides, cells=cells, **options)
-        size = cells_per_length3d(body, n, h, cells, per_cube)
-        return builder(size, box=box, sides=body.sides, **options)
+        return builder(box_cells_per_length(family, body, n, h, cells, options), box=box, sides=body.sides, **options)
     if family not in FAMILIES_2D:
         raise SceneError(f"mesh family {family!r} does not mesh an extrude domain; valid families: "
                          f"{', '.join(FAMILIES_2D)} (prisms over the 2D mesh of the base)", key="discretization.mesh.family")
     size = cells_per_length3d(body, n, h, cells, 2.0 if family == "triangle" else 1.0)
+    _check_options(family, None, {k: v for k, v in options.items()})
     base = build_mesh(family, **({"h": h} if h is not None else {"n": size}), domain=body.base, **options)
     if layers is None:
         layers = max(1, int(round(body.depth * size)))
@@ -46,3 +51,36 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
         raise SceneError(f"discretization.mesh.layers = {layers!r}: give a whole number >= 1",
                          key="discretization.mesh.layers")
     return extrude(base, int(layers), body.depth, ends=body.ends)
+
+
+def _check_options(family: str, builder, options: dict) -> None:
+    """SceneError naming an option the box family does not take (2D families: ``build_mesh`` checks)."""
+    if builder is None:
+        return
+    valid = [p for p in inspect.signature(builder).parameters if p not in ("n", "box", "sides", "cells", "shape")]
+    unknown = sorted(set(options) - set(valid))
+    if unknown:
+        raise SceneError(f"mesh option {unknown[0]!r} is not valid for family {family}; valid options: "
+                         f"{', '.join(valid) or 'none'}", key=f"discretization.mesh.{unknown[0]}")
+
+
+def box_cells_per_length(family: str, body: Box, n=None, h=None, cells=None, options=None) -> float:
+    """n of a box family from n, h or cells. For ``octree`` ``cells`` counts the cells after the
+    refinement: (1 + 7 fraction) per grid cell (random), or n³ V + 7 n² A with A the area of the
+    contact side (contact), solved for n."""
+    options = options or {}
+    if family != "octree" or cells is None:
+        return cells_per_length3d(body, n, h, cells, BOX_FAMILIES[family][1])
+    if options.get("rule", "contact") == "random":
+        return cells_per_length3d(body, cells=cells, cells_per_cube=1.0 + 7.0 * float(options.get("fraction", 0.3)))
+    side = options.get("contact_side", "bottom")
+    target = float(cells_per_length3d(body, cells=cells)) ** 3 * body.volume  # checks cells
+    if side not in body.sides:
+        return cells_per_length3d(body, cells=cells)  # octree names the side
+    size = np.subtract(body.upper, body.lower)
+    area = float(np.prod(np.delete(size, list(body.sides).index(side) // 2)))
+    lo, hi = 0.0, (target / body.volume) ** (1.0 / 3.0)
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if mid**3 * body.volume + 7.0 * mid**2 * area < target else (lo, mid)
+    return hi

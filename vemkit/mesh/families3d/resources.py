@@ -22,6 +22,7 @@ import numpy as np
 
 from vemkit.config.domain3d import Box, cells_per_length3d, domain3d_from_spec
 from vemkit.exceptions import SceneError
+from vemkit.mesh.families3d.build import box_cells_per_length
 from vemkit.mesh.families3d.grid import grid_shape
 from vemkit.mesh.families3d.voronoi3d import seed_count
 
@@ -58,11 +59,10 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
         vertices = max(4, int(VORONOI_VERTICES_PER_CELL * count - deficit))
         faces = max(4, int(VORONOI_FACES_PER_CELL * count - deficit))
         return Mesh3dEstimate(count, vertices, faces, 3 * vertices, False)
-    per_cube = {"hex": 1.0, "tet": 6.0, "octree": 1.0}.get(family)
-    if per_cube is None:
+    if family not in ("hex", "tet", "octree"):
         raise SceneError(f"estimate_mesh3d: unknown box family {family!r}; valid: hex, tet, octree, voronoi",
                          key="discretization.mesh.family")
-    nx, ny, nz = grid_shape(cells_per_length3d(body, n, h, cells, per_cube), box)
+    nx, ny, nz = grid_shape(box_cells_per_length(family, body, n, h, cells, options), box)
     c, v, f = _grid_counts(nx, ny, nz)
     if family == "hex":
         return Mesh3dEstimate(c, v, f, 3 * v, True)
