@@ -11,8 +11,8 @@ domain:
 ``domain3d_from_spec`` returns a :class:`Box` or an :class:`Extruded` (whose base is a 2D
 :class:`~vemkit.config.domain.Domain`, parsed by ``domain_from_spec``) and refuses a broken entry
 with a one-line ``SceneError`` whose ``key`` names it. ``vemkit.mesh.families3d.build_mesh3d(family,
-domain, n=/h=/cells=)`` meshes it: on a box the 3D families ``hex``, ``tet``, ``octree``, ``voronoi``; on an extruded domain
-the prisms over the 2D family's mesh of the base (exactly ``build_mesh(family, ...)`` of the same
+domain, n=/h=/cells=)`` meshes it: on a box the 3D families ``hex``, ``tet``, ``octree``, ``voronoi``;
+on an extruded domain the prisms over the 2D family's mesh of the base (exactly ``build_mesh(family, ...)`` of the same
 keys) in ``layers`` layers (default ``max(1, round(depth n))``, about depth / h).
 Sizes: ``n`` cells per unit length (about n³ cells per unit volume), ``h = 1 / n`` or ``cells``.
 """
@@ -94,7 +94,8 @@ def _names(value, count: int, key: str, what: str) -> tuple:
 def _box(spec: dict) -> Box:
     unknown = sorted(set(spec) - {"box", "sides"})
     if unknown:
-        raise SceneError(f"domain.{unknown[0]}: unknown key; a box domain has box and sides", key=f"domain.{unknown[0]}")
+        raise SceneError(f"domain.{unknown[0]}: unknown key; a box domain has box and sides",
+                         key=f"domain.{unknown[0]}")
     try:
         corners = np.asarray(spec["box"], dtype=float)
     except (TypeError, ValueError):
@@ -104,9 +105,11 @@ def _box(spec: dict) -> Box:
     thin = np.flatnonzero(corners[1] <= corners[0])
     if thin.size:
         axis = "xyz"[thin[0]]
-        raise SceneError(f"domain.box: {axis}1 = {corners[1, thin[0]]:g} is not above {axis}0 = {corners[0, thin[0]]:g}; "
+        hi, lo = corners[1, thin[0]], corners[0, thin[0]]
+        raise SceneError(f"domain.box: {axis}1 = {hi:g} is not above {axis}0 = {lo:g}; "
                          "give the lower corner first and a positive size along x, y and z", key="domain.box")
-    sides = _names(spec.get("sides", list(BOX_SIDES)), 6, "domain.sides", "the faces xmin, xmax, ymin, ymax, zmin, zmax")
+    sides = _names(spec.get("sides", list(BOX_SIDES)), 6, "domain.sides",
+                   "the faces xmin, xmax, ymin, ymax, zmin, zmax")
     return Box(tuple(corners[0].tolist()), tuple(corners[1].tolist()), sides)
 
 
@@ -119,7 +122,8 @@ def _extruded(spec: dict) -> Extruded:
         raise SceneError(f"domain.extrude.{unknown[0]}: unknown key; valid keys: depth, ends",
                          key=f"domain.extrude.{unknown[0]}")
     if "depth" not in ext:
-        raise SceneError("domain.extrude.depth is missing; give the extrusion depth along z", key="domain.extrude.depth")
+        raise SceneError("domain.extrude.depth is missing; give the extrusion depth along z",
+                         key="domain.extrude.depth")
     try:
         depth = float(ext["depth"])
     except (TypeError, ValueError):

@@ -138,7 +138,8 @@ def _check_faces(mesh: PolyhedralMesh, planarity: float) -> None:
     flat = np.flatnonzero(area <= DEGENERATE_TOL * diameter**2)
     if flat.size:
         f = int(flat[0])
-        raise MeshError(f"face {f} has zero area (its vertices are collinear or coincide); remove it or fix its vertices")
+        raise MeshError(f"face {f} has zero area (its vertices are collinear or coincide); remove it or fix its "
+                        "vertices")
     unit = va / area[:, None]
     off = np.abs(np.einsum("ij,ij->i", p - centre[owner], unit[owner]))
     worst = np.zeros(mesh.n_faces)
@@ -146,8 +147,8 @@ def _check_faces(mesh: PolyhedralMesh, planarity: float) -> None:
     bent = np.flatnonzero(worst > planarity * diameter)
     if bent.size:
         f = int(bent[0])
-        raise MeshError(f"face {f} is not planar: a vertex lies {worst[f] / diameter[f]:.2e} x its diameter off its plane "
-                        f"(tolerance {planarity:.0e}); split it into planar faces")
+        raise MeshError(f"face {f} is not planar: a vertex lies {worst[f] / diameter[f]:.2e} x its diameter off its "
+                        f"plane (tolerance {planarity:.0e}); split it into planar faces")
 
 
 def _check_closed(mesh: PolyhedralMesh) -> None:
@@ -178,8 +179,9 @@ def _check_closed(mesh: PolyhedralMesh) -> None:
         i = starts[bad[0]]
         c, x, y = (int(t) for t in key[i])
         if count[bad[0]] != 2:
-            raise MeshError(f"cell {c} is not closed: its edge ({x}, {y}) belongs to {count[bad[0]]} of its faces instead "
-                            "of 2 (a missing face, or a neighbour's hanging node missing from this cell's faces)")
+            raise MeshError(f"cell {c} is not closed: its edge ({x}, {y}) belongs to {count[bad[0]]} of its faces "
+                            "instead of 2 (a missing face, or a neighbour's hanging node missing from this cell's "
+                            "faces)")
         raise MeshError(f"cell {c} is not consistently oriented: its two faces at edge ({x}, {y}) run along it in the "
                         "same direction; reverse one of them (cells list their faces outward)")
 
@@ -206,8 +208,8 @@ def _check_vertices(mesh: PolyhedralMesh, tol: float) -> None:
     pairs = cKDTree(mesh.vertices).query_pairs(tol * max(extent, np.finfo(float).tiny), output_type="ndarray")
     if pairs.size:
         a, b = sorted(int(x) for x in pairs[np.argmin(pairs.min(axis=1))])
-        raise MeshError(f"vertices {a} and {b} have the same coordinates {tuple(mesh.vertices[a].tolist())}; merge them "
-                        "into one vertex")
+        where = tuple(mesh.vertices[a].tolist())
+        raise MeshError(f"vertices {a} and {b} have the same coordinates {where}; merge them into one vertex")
 
 
 def _check_boundary(mesh: PolyhedralMesh, require_named: bool) -> None:
@@ -236,5 +238,6 @@ def _check_boundary(mesh: PolyhedralMesh, require_named: bool) -> None:
     if require_named:
         rest = unnamed_boundary_faces(mesh)
         if rest.size:
-            raise MeshError(f"{rest.size} boundary faces carry no side name (first: face {rest[0]}, centroid "
-                            f"{tuple(np.round(mesh.face_centroids[rest[0]], 12).tolist())}); name them in a boundary part")
+            where = tuple(np.round(mesh.face_centroids[rest[0]], 12).tolist())
+            raise MeshError(f"{rest.size} boundary faces carry no side name (first: face {rest[0]}, centroid {where}); "
+                            "name them in a boundary part")

@@ -112,7 +112,8 @@ def _mesh_from_dataset(ds: xr.Dataset, path: Path) -> PolyhedralMesh:
     for name in parts:
         key = f"{t}_boundary_{name}"
         if key not in ds.variables:
-            raise MeshError(f"{path.name}: boundary part {name!r} is listed but variable {key} is missing", key=str(path))
+            raise MeshError(f"{path.name}: boundary part {name!r} is listed but variable {key} is missing",
+                            key=str(path))
         boundary[name] = ds[key].values.astype(np.int64)
     meta = json.loads(str(ds[t].attrs.get("vemkit_meta", "{}")))
     return PolyhedralMesh(vertices, np.concatenate([[0], np.cumsum(valid.sum(axis=1))]), table[valid],
@@ -289,13 +290,14 @@ def _gmsh_sides3d(mesh, surfaces, tags, renumber, names, path) -> dict:
         faces = np.array([lookup.get(tuple(k), -1) for k in ids.tolist()], dtype=np.int64)
         if (faces < 0).any():
             bad = int(np.flatnonzero(faces < 0)[0])
-            raise MeshError(f"{path.name}: surface element {nodes[bad].tolist()} (nodes counting from 0) of physical group "
-                            f"{tag[bad]} is not a boundary face of the mesh; tag boundary surfaces only", key=str(path))
+            raise MeshError(f"{path.name}: surface element {nodes[bad].tolist()} (nodes counting from 0) of physical "
+                            f"group {tag[bad]} is not a boundary face of the mesh; tag boundary surfaces only",
+                            key=str(path))
         for t in dict.fromkeys(tag.tolist()):
             name = names.get(t, str(t)) if t else "untagged"
             if not SIDE_NAME.fullmatch(name):
-                raise MeshError(f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ and -",
-                                key=str(path))
+                raise MeshError(f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ "
+                                "and -", key=str(path))
             part = np.unique(faces[tag == t])
             parts[name] = np.union1d(parts.get(name, np.zeros(0, np.int64)), part)
             seen[part] = True

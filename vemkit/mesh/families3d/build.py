@@ -28,8 +28,8 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
     body = domain3d_from_spec(domain)
     if isinstance(body, Box):
         if family not in BOX_FAMILY_NAMES:
-            raise SceneError(f"mesh family {family!r} does not mesh a box; valid families: {', '.join(BOX_FAMILY_NAMES)}",
-                             key="discretization.mesh.family")
+            raise SceneError(f"mesh family {family!r} does not mesh a box; valid families: "
+                             f"{', '.join(BOX_FAMILY_NAMES)}", key="discretization.mesh.family")
         if layers is not None:
             raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
                              key="discretization.mesh.layers")
@@ -41,7 +41,8 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
         return builder(box_cells_per_length(family, body, n, h, cells, options), box=box, sides=body.sides, **options)
     if family not in FAMILIES_2D:
         raise SceneError(f"mesh family {family!r} does not mesh an extrude domain; valid families: "
-                         f"{', '.join(FAMILIES_2D)} (prisms over the 2D mesh of the base)", key="discretization.mesh.family")
+                         f"{', '.join(FAMILIES_2D)} (prisms over the 2D mesh of the base)",
+                         key="discretization.mesh.family")
     size = cells_per_length3d(body, n, h, cells, 2.0 if family == "triangle" else 1.0)
     _check_options(family, None, {k: v for k, v in options.items()})
     base = build_mesh(family, **({"h": h} if h is not None else {"n": size}), domain=body.base, **options)

@@ -77,7 +77,8 @@ def octree(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None, rule: str = "conta
     vertices = lower + np.stack([ii, jj, kk], axis=1) / (dims - 1) * (upper - lower)
     meta = {"family": "octree", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist(), "rule": rule,
             "levels": 1, "refined": int(refined.sum())}
-    meta.update({"fraction": float(fraction), "seed": int(seed)} if rule == "random" else {"contact_side": contact_side})
+    meta.update({"fraction": float(fraction), "seed": int(seed)} if rule == "random"
+                else {"contact_side": contact_side})
     mesh = from_face_soup(vertices, counts, valid.sum(axis=1), renumber[rows[valid]], None, (), meta)
     return tag_box_faces(mesh, lower, upper, sides)
 
