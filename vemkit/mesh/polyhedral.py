@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import numba
 import numpy as np
 
 
@@ -75,58 +76,113 @@ class PolyhedralMesh:
     def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]:
         """CSR (offsets, vertices): the distinct vertices of every cell, in order of first appearance
         along its faces."""
-        offsets, flat = [0], []
-        for c in range(self.n_cells):
-            faces = np.where(self.cell_face_list(c) >= 0, self.cell_face_list(c), -self.cell_face_list(c) - 1)
-            ids = np.concatenate([self.face(f) for f in faces])
-            _, first = np.unique(ids, return_index=True)
-            flat.append(ids[np.sort(first)])
-            offsets.append(offsets[-1] + flat[-1].size)
-        return np.asarray(offsets, dtype=np.int64), (np.concatenate(flat) if flat else np.zeros(0, np.int64))
+        faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
+        sizes = np.diff(self.face_offsets)[faces]
+        entry = np.repeat(np.arange(faces.size, dtype=np.int64), sizes)
+        local = np.arange(entry.size, dtype=np.int64) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        ids = self.face_vertices[self.face_offsets[faces][entry] + local]
+        cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))[entry]
+        _, first = np.unique(cells * np.int64(max(self.n_vertices, 1)) + ids, return_index=True)
+        first = np.sort(first)
+        counts = np.bincount(cells[first], minlength=self.n_cells)
+        return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), ids[first]
 
     # -- geometry -------------------------------------------------------------------------
     @cached_property
+    def _face_corners(self):
+        """(owner face, next corner, corner - vertex mean, cross products about the vertex mean)."""
+        sizes = np.diff(self.face_offsets)
+        owner = np.repeat(np.arange(self.n_faces, dtype=np.int64), sizes)
+        nxt = np.arange(1, self.face_vertices.size + 1, dtype=np.int64)
+        nxt[self.face_offsets[1:][sizes > 0] - 1] = self.face_offsets[:-1][sizes > 0]
+        p = self.vertices[self.face_vertices]
+        mean = _segment_sum(p, self.face_offsets) / np.maximum(sizes, 1)[:, None]
+        q = p - mean[owner]
+        return owner, nxt, mean, q, np.cross(q, q[nxt])
+
+    @cached_property
     def face_vector_areas(self) -> np.ndarray:
         """``(F, 3)``: |F| n_F of every face as stored (half the sum of cross products about its vertex mean)."""
-        out = np.zeros((self.n_faces, 3))
-        for f in range(self.n_faces):
-            p = self.vertices[self.face(f)]
-            q = p - p.mean(axis=0)
-            out[f] = 0.5 * np.cross(q, np.roll(q, -1, axis=0)).sum(axis=0)
-        return out
+        return 0.5 * _segment_sum(self._face_corners[4], self.face_offsets)
 
     @cached_property
     def face_centroids(self) -> np.ndarray:
-        """``(F, 3)`` area centroids of the faces (fan triangles from the vertex mean)."""
-        out = np.zeros((self.n_faces, 3))
-        for f in range(self.n_faces):
-            p = self.vertices[self.face(f)]
-            m = p.mean(axis=0)
-            a = np.linalg.norm(np.cross(p - m, np.roll(p, -1, axis=0) - m), axis=1)
-            centres = (p + np.roll(p, -1, axis=0) + m) / 3.0
-            out[f] = centres.T @ a / a.sum() if a.sum() > 0 else m
-        return out
+        """``(F, 3)`` area centroids of the faces (fan triangles from the vertex mean, signed along the
+        face normal, so that non-convex planar faces are right too)."""
+        owner, nxt, mean, q, cross = self._face_corners
+        va = self.face_vector_areas
+        unit = va / np.maximum(np.linalg.norm(va, axis=1), np.finfo(float).tiny)[:, None]
+        a = np.einsum("ij,ij->i", cross, unit[owner])
+        total = np.bincount(owner, weights=a, minlength=self.n_faces)
+        moment = _segment_sum((q + q[nxt]) / 3.0 * a[:, None], self.face_offsets)
+        ok = np.abs(total) > 0
+        shift = np.zeros_like(mean)
+        shift[ok] = moment[ok] / total[ok, None]
+        return mean + shift
 
     @cached_property
     def cell_volumes(self) -> np.ndarray:
-        """Signed volumes by the divergence theorem: sum over the cell's outward faces of x_F . (|F| n_F) / 3."""
+        """Signed volumes by the divergence theorem: sum over the cell's outward faces of x_F . (|F| n_F) / 3
+        (x_F relative to the cell's first vertex, so that a cell far from the origin keeps its digits)."""
         sign = np.where(self.cell_faces >= 0, 1.0, -1.0)
         faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
-        flux = sign * np.einsum("ij,ij->i", self.face_centroids[faces], self.face_vector_areas[faces]) / 3.0
-        return np.add.reduceat(flux, self.cell_offsets[:-1]) if self.n_cells else np.zeros(0)
+        cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))
+        ref = self.vertices[self.face_vertices[self.face_offsets[faces[self.cell_offsets[:-1]]]]] \
+            if self.n_cells else np.zeros((0, 3))
+        x = self.face_centroids[faces] - ref[cells]
+        flux = sign * np.einsum("ij,ij->i", x, self.face_vector_areas[faces]) / 3.0
+        return np.bincount(cells, weights=flux, minlength=self.n_cells)
 
     @cached_property
     def cell_diameters(self) -> np.ndarray:
+        """The largest vertex-to-vertex distance of every cell (a numba kernel; ``diameters_numpy`` is its twin)."""
         offsets, ids = self.cell_vertex_lists
-        out = np.zeros(self.n_cells)
-        for c in range(self.n_cells):
-            p = self.vertices[ids[offsets[c]:offsets[c + 1]]]
-            out[c] = np.max(np.linalg.norm(p[:, None] - p[None], axis=2))
-        return out
+        return _diameters(self.vertices, offsets, ids)
 
     @property
     def h(self) -> float:
         return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+
+@numba.njit(cache=True)
+def _diameters(vertices, offsets, ids):
+    """Per CSR segment of vertex ids: the largest distance between two of its vertices."""
+    out = np.zeros(offsets.size - 1)
+    for c in range(offsets.size - 1):
+        best = 0.0
+        for i in range(offsets[c], offsets[c + 1]):
+            for j in range(i + 1, offsets[c + 1]):
+                d = 0.0
+                for a in range(3):
+                    t = vertices[ids[i], a] - vertices[ids[j], a]
+                    d += t * t
+                best = max(best, d)
+        out[c] = np.sqrt(best)
+    return out
+
+
+def diameters_numpy(vertices, offsets, ids) -> np.ndarray:
+    """The numpy twin of ``_diameters`` (segments grouped by size, in chunks)."""
+    sizes = np.diff(offsets)
+    out = np.zeros(sizes.size)
+    for size in np.unique(sizes):
+        cells = np.flatnonzero(sizes == size)
+        step = max(1, 2_000_000 // int(size * size))
+        for s in range(0, cells.size, step):
+            chunk = cells[s:s + step]
+            p = vertices[ids[offsets[chunk][:, None] + np.arange(size)]]
+            d = ((p[:, :, None, :] - p[:, None, :, :]) ** 2).sum(axis=-1)
+            out[chunk] = np.sqrt(d.reshape(chunk.size, -1).max(axis=1))
+    return out
+
+
+def _segment_sum(values: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Sums of the rows of ``values`` over the CSR segments ``offsets`` (an empty segment sums to 0)."""
+    m = offsets.size - 1
+    owner = np.repeat(np.arange(m, dtype=np.int64), np.diff(offsets))
+    cols = values.reshape(values.shape[0], -1)
+    out = np.stack([np.bincount(owner, weights=cols[:, j], minlength=m) for j in range(cols.shape[1])], axis=1)
+    return out.reshape((m,) + values.shape[1:])
 
 
 def from_polyhedra(vertices, cells, boundary=None, meta=None) -> PolyhedralMesh:

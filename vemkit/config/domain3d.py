@@ -1,0 +1,165 @@
+"""3D bodies (SPEC §10): a box, or a §7 domain extruded along z; parsed, validated and meshed.
+
+```yaml
+domain: {box: [[0, 0, 0], [1, 1, 0.5]], sides: [left, right, front, back, bottom, top]}
+domain:
+  extrude: {depth: 0.25, ends: [front, back]}
+  polygon: [[0, 0], [1, 0], [1, 1], [0, 1]]
+  sides: [bottom, right, top, left]
+  holes: [{circle: [0.5, 0.5, 0.2], side: bore}]
+```
+``domain3d_from_spec`` returns a :class:`Box` or an :class:`Extruded` (whose base is a 2D
+:class:`~vemkit.config.domain.Domain`, parsed by ``domain_from_spec``) and refuses a broken entry
+with a one-line ``SceneError`` whose ``key`` names it. ``vemkit.mesh.families3d.build_mesh3d(family,
+domain, n=/h=/cells=)`` meshes it: on a box the 3D families ``hex``, ``tet``, ``octree``, ``voronoi``;
+on an extruded domain the prisms over the 2D family's mesh of the base (exactly ``build_mesh(family, ...)`` of the same
+keys) in ``layers`` layers (default ``max(1, round(depth n))``, about depth / h).
+Sizes: ``n`` cells per unit length (about n³ cells per unit volume), ``h = 1 / n`` or ``cells``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vemkit.config.domain import SIDE_NAME, Domain, domain_from_spec
+from vemkit.exceptions import InputError, SceneError
+
+BOX_SIDES = ("left", "right", "front", "back", "bottom", "top")
+DEFAULT_ENDS = ("front", "back")
+FAMILIES_2D = ("square", "triangle", "voronoi", "hanging")
+BOX_FAMILIES = ("hex", "tet", "octree", "voronoi")
+
+
+@dataclass(frozen=True)
+class Box:
+    lower: tuple
+    upper: tuple
+    sides: tuple = BOX_SIDES
+
+    @property
+    def volume(self) -> float:
+        return float(np.prod(np.subtract(self.upper, self.lower)))
+
+    @property
+    def side_names(self) -> tuple:
+        return tuple(dict.fromkeys(self.sides))
+
+
+@dataclass(frozen=True)
+class Extruded:
+    base: Domain
+    depth: float
+    ends: tuple = DEFAULT_ENDS
+
+    @property
+    def volume(self) -> float:
+        return self.depth * self.base.exact_area
+
+    @property
+    def side_names(self) -> tuple:
+        return tuple(dict.fromkeys(self.base.side_names + self.ends))
+
+
+def is_3d_domain(spec) -> bool:
+    """Whether a scene's ``domain`` entry is a 3D body (a mapping with ``box`` or ``extrude``)."""
+    return isinstance(spec, (Box, Extruded)) or (isinstance(spec, dict) and ("box" in spec or "extrude" in spec))
+
+
+def domain3d_from_spec(spec):
+    """The Box or Extruded of a SPEC §10 ``domain:`` mapping; SceneError naming the key otherwise."""
+    if isinstance(spec, (Box, Extruded)):
+        return spec
+    if not is_3d_domain(spec):
+        raise SceneError("domain: give a 3D body {box: [[x0, y0, z0], [x1, y1, z1]]} or {extrude: {depth: ...}, "
+                         "polygon: ..., sides: ...}", key="domain")
+    if "box" in spec and "extrude" in spec:
+        raise SceneError("domain: give either box or extrude, not both", key="domain")
+    return _box(spec) if "box" in spec else _extruded(spec)
+
+
+def _names(value, count: int, key: str, what: str) -> tuple:
+    if not isinstance(value, (list, tuple)) or len(value) != count:
+        given = len(value) if isinstance(value, (list, tuple)) else "no list of"
+        raise SceneError(f"{key} has {given} names; give {count} ({what})", key=key)
+    for name in value:
+        if not isinstance(name, str) or not SIDE_NAME.fullmatch(name):
+            raise SceneError(f"{key}: side name {name!r} is not an identifier; use letters, digits, _ and - only",
+                             key=key)
+    return tuple(value)
+
+
+def _box(spec: dict) -> Box:
+    unknown = sorted(set(spec) - {"box", "sides"})
+    if unknown:
+        raise SceneError(f"domain.{unknown[0]}: unknown key; a box domain has box and sides",
+                         key=f"domain.{unknown[0]}")
+    try:
+        corners = np.asarray(spec["box"], dtype=float)
+    except (TypeError, ValueError):
+        corners = None
+    if corners is None or corners.shape != (2, 3) or not np.isfinite(corners).all():
+        raise SceneError("domain.box: give two corners [[x0, y0, z0], [x1, y1, z1]] (finite numbers)", key="domain.box")
+    thin = np.flatnonzero(corners[1] <= corners[0])
+    if thin.size:
+        axis = "xyz"[thin[0]]
+        hi, lo = corners[1, thin[0]], corners[0, thin[0]]
+        raise SceneError(f"domain.box: {axis}1 = {hi:g} is not above {axis}0 = {lo:g}; "
+                         "give the lower corner first and a positive size along x, y and z", key="domain.box")
+    sides = _names(spec.get("sides", list(BOX_SIDES)), 6, "domain.sides",
+                   "the faces xmin, xmax, ymin, ymax, zmin, zmax")
+    return Box(tuple(corners[0].tolist()), tuple(corners[1].tolist()), sides)
+
+
+def _extruded(spec: dict) -> Extruded:
+    ext = spec["extrude"]
+    if not isinstance(ext, dict):
+        raise SceneError("domain.extrude: give {depth: D, ends: [front, back]}", key="domain.extrude")
+    unknown = sorted(set(ext) - {"depth", "ends"})
+    if unknown:
+        raise SceneError(f"domain.extrude.{unknown[0]}: unknown key; valid keys: depth, ends",
+                         key=f"domain.extrude.{unknown[0]}")
+    if "depth" not in ext:
+        raise SceneError("domain.extrude.depth is missing; give the extrusion depth along z",
+                         key="domain.extrude.depth")
+    try:
+        depth = float(ext["depth"])
+    except (TypeError, ValueError):
+        depth = float("nan")
+    if not (math.isfinite(depth) and depth > 0) or isinstance(ext["depth"], bool):
+        raise SceneError(f"domain.extrude.depth = {ext['depth']!r}: give a positive number", key="domain.extrude.depth")
+    ends = _names(ext.get("ends", list(DEFAULT_ENDS)), 2, "domain.extrude.ends", "the faces z = 0 and z = depth")
+    base = {k: v for k, v in spec.items() if k != "extrude"}
+    try:
+        domain = domain_from_spec(base)
+    except SceneError:
+        raise
+    except InputError as error:
+        raise SceneError(str(error), key=error.key) from None
+    return Extruded(domain, depth, ends)
+
+
+def cells_per_length3d(domain, n=None, h=None, cells=None, cells_per_cube: float = 1.0):
+    """n (cells per unit length) from exactly one of n, h = 1/n and cells (about n³ x volume x
+    ``cells_per_cube`` of them); whole numbers come back as int."""
+    given = [(key, value) for key, value in (("n", n), ("h", h), ("cells", cells)) if value is not None]
+    if len(given) != 1:
+        named = ", ".join(f"{k} = {v}" for k, v in given) or "none"
+        raise SceneError(f"discretization.mesh: give exactly one of n, h and cells (given: {named})",
+                         key="discretization.mesh")
+    key, value = given[0]
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if not (math.isfinite(value) and value > 0):
+        raise SceneError(f"discretization.mesh.{key} = {given[0][1]!r}: give a positive number",
+                         key=f"discretization.mesh.{key}")
+    if key == "h":
+        value = 1.0 / value
+    elif key == "cells":
+        value = (value / (cells_per_cube * domain.volume)) ** (1.0 / 3.0)
+    near = round(value)
+    return int(near) if near >= 1 and abs(value - near) <= 1e-9 * value else value

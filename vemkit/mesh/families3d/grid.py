@@ -1,0 +1,94 @@
+"""Box meshes on a Cartesian grid (SPEC §10): ``hex`` (n x m x l hexahedra) and ``tet`` (each hexahedron
+cut into the 6 Kuhn tetrahedra around its diagonal from the lowest to the highest corner: the same
+cut in every box, so neighbouring boxes agree on their shared faces' diagonals).
+
+The box is ``[lower, upper]``; its faces x = x0, x = x1, y = y0, y = y1, z = z0, z = z1 are named by
+``sides`` (default ``left, right, front, back, bottom, top``). The grid has ``max(1, round(n L))``
+cells along an edge of length L (``n`` cells per unit length), or exactly ``shape`` = (nx, ny, nz).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vemkit.mesh.polyhedral import PolyhedralMesh
+from vemkit.mesh.polyhedral_build import from_face_soup, tag_box_faces
+
+UNIT_BOX = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+BOX_SIDES = ("left", "right", "front", "back", "bottom", "top")
+
+#: the cube's corners (bit 0: x, bit 1: y, bit 2: z, in the order 0 1 3 2 4 5 7 6 of the bits) ...
+CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+#: ... and its faces, outward, in the order xmin, xmax, ymin, ymax, zmin, zmax
+HEX_FACES = np.array([[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4], [3, 7, 6, 2], [0, 3, 2, 1], [4, 5, 6, 7]])
+#: the 6 Kuhn tetrahedra: paths 0 -> 6 along the axes in every order
+KUHN = np.array([[0, 1, 2, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 7, 6], [0, 4, 5, 6], [0, 1, 5, 6]])
+#: the faces of a positively oriented tetrahedron (a, b, c, d), outward
+TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+
+
+def grid_shape(n, box, shape=None) -> tuple:
+    """(nx, ny, nz): ``shape`` if given, else max(1, round(n L)) along each edge."""
+    if shape is not None:
+        shape = tuple(int(s) for s in shape)
+        if len(shape) != 3 or min(shape) < 1:
+            raise ValueError(f"shape = {shape}: give three cell counts >= 1")
+        return shape
+    if not n > 0:
+        raise ValueError(f"mesh n = {n}: the number of cells per unit length must be > 0")
+    lengths = np.subtract(box[1], box[0])
+    return tuple(max(1, int(round(float(n) * L))) for L in lengths)
+
+
+def check_box(box) -> tuple:
+    lower, upper = (np.asarray(b, dtype=float) for b in box)
+    if lower.shape != (3,) or upper.shape != (3,) or not (upper > lower).all():
+        raise ValueError(f"box = {box}: give [[x0, y0, z0], [x1, y1, z1]] with x1 > x0, y1 > y0, z1 > z0")
+    return lower, upper
+
+
+def lattice(shape, box):
+    """Vertex coordinates of the (nx+1)(ny+1)(nz+1) grid (x fastest) and the corner ids of every cell."""
+    lower, upper = check_box(box)
+    nx, ny, nz = shape
+    axes = [lower[a] + (upper[a] - lower[a]) * np.arange(s + 1) / s for a, s in enumerate(shape)]
+    z, y, x = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
+    vertices = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    k, j, i = (t.ravel() for t in np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij"))
+    c = CORNERS
+    ids = ((k[:, None] + c[:, 2]) * (ny + 1) + j[:, None] + c[:, 1]) * (nx + 1) + i[:, None] + c[:, 0]
+    return vertices, ids
+
+
+def hex(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
+    """The grid of hexahedra of the box (module doc)."""
+    shape = grid_shape(n, box, shape)
+    vertices, ids = lattice(shape, box)
+    faces = ids[:, HEX_FACES].reshape(-1, 4)
+    m = ids.shape[0]
+    labels = np.tile(np.arange(6), m)
+    mesh = from_face_soup(vertices, np.full(m, 6), np.full(6 * m, 4), faces.ravel(), labels, tuple(sides),
+                          {"family": "hex", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()})
+    return _merge_repeated_names(mesh, sides)
+
+
+def tet(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
+    """The Kuhn tetrahedra of the grid of the box: 6 per hexahedron (module doc)."""
+    shape = grid_shape(n, box, shape)
+    vertices, ids = lattice(shape, box)
+    tets = ids[:, KUHN].reshape(-1, 4)
+    p = vertices[tets]
+    det = np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]))
+    tets[det < 0] = tets[det < 0][:, [0, 2, 1, 3]]
+    m = tets.shape[0]
+    faces = tets[:, TET_FACES].reshape(-1, 3)
+    mesh = from_face_soup(vertices, np.full(m, 4), np.full(4 * m, 3), faces.ravel(), None, (),
+                          {"family": "tet", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()})
+    return tag_box_faces(mesh, *check_box(box), sides)
+
+
+def _merge_repeated_names(mesh: PolyhedralMesh, sides) -> PolyhedralMesh:
+    """from_face_soup with a name given twice already joins the parts; keep the sides' order."""
+    parts = {name: mesh.boundary.get(name, np.zeros(0, np.int64)) for name in dict.fromkeys(sides)}
+    return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
+                          parts, mesh.meta)
