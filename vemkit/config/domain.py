@@ -235,21 +235,25 @@ def cells_per_length(domain: Domain, n=None, h=None, cells=None, cells_per_squar
     """The mesh density n (cells per unit length, SPEC §7) from exactly one of n, h (n = 1/h) and
     cells (about that many cells; a family with ``cells_per_square`` cells per n x n square, such
     as triangles with 2, gets n = √(cells / (cells_per_square · area))). Whole numbers come back as int."""
+    return mesh_density(n, h, cells, lambda count: math.sqrt(count / (cells_per_square * domain.exact_area)))
+
+
+def mesh_density(n, h, cells, from_cells, error=InputError, where: str | None = None):
+    """n from exactly one of n, h = 1/n and cells (``from_cells(cells) -> n``, the body's own rule);
+    whole numbers come back as int. Errors name ``where`` (e.g. ``discretization.mesh``) or "mesh size"."""
     given = [(key, value) for key, value in (("n", n), ("h", h), ("cells", cells)) if value is not None]
     if len(given) != 1:
         named = ", ".join(f"{k} = {v}" for k, v in given) or "none"
-        raise InputError(f"mesh size: give exactly one of n, h and cells (given: {named})", key="n")
+        raise error(f"{where or 'mesh size'}: give exactly one of n, h and cells (given: {named})", key=where or "n")
     key, value = given[0]
     try:
         value = float(value)
     except (TypeError, ValueError):
         value = float("nan")
     if not (math.isfinite(value) and value > 0):
-        raise InputError(f"mesh size {key} = {given[0][1]!r}: give a positive number", key=key)
-    if key == "h":
-        value = 1.0 / value
-    elif key == "cells":
-        value = math.sqrt(value / (cells_per_square * domain.exact_area))
+        name = f"{where}.{key}" if where else f"mesh size {key}"
+        raise error(f"{name} = {given[0][1]!r}: give a positive number", key=f"{where}.{key}" if where else key)
+    value = 1.0 / value if key == "h" else from_cells(value) if key == "cells" else value
     near = round(value)
     return int(near) if near >= 1 and abs(value - near) <= 1e-9 * value else value
 

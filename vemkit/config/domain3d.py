@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vemkit.config.domain import SIDE_NAME, Domain, domain_from_spec
+from vemkit.config.domain import SIDE_NAME, Domain, domain_from_spec, mesh_density
 from vemkit.exceptions import InputError, SceneError
 
 BOX_SIDES = ("left", "right", "front", "back", "bottom", "top")
@@ -35,13 +35,12 @@ BOX_FAMILIES = ("hex", "tet", "octree", "voronoi")
 
 @dataclass(frozen=True)
 class Box:
+    """An axis-aligned box [lower, upper] with its six sides named (xmin, xmax, ymin, ymax, zmin, zmax)."""
+
     lower: tuple
     upper: tuple
     sides: tuple = BOX_SIDES
-
-    @property
-    def volume(self) -> float:
-        return float(np.prod(np.subtract(self.upper, self.lower)))
+    volume = property(lambda self: float(np.prod(np.subtract(self.upper, self.lower))), doc="its volume")
 
     @property
     def side_names(self) -> tuple:
@@ -50,13 +49,12 @@ class Box:
 
 @dataclass(frozen=True)
 class Extruded:
+    """A SPEC §7 domain extruded along z to ``depth``, its end faces named ``ends`` (z = 0, z = depth)."""
+
     base: Domain
     depth: float
     ends: tuple = DEFAULT_ENDS
-
-    @property
-    def volume(self) -> float:
-        return self.depth * self.base.exact_area
+    volume = property(lambda self: self.depth * self.base.exact_area, doc="its volume")
 
     @property
     def side_names(self) -> tuple:
@@ -144,22 +142,5 @@ def _extruded(spec: dict) -> Extruded:
 def cells_per_length3d(domain, n=None, h=None, cells=None, cells_per_cube: float = 1.0):
     """n (cells per unit length) from exactly one of n, h = 1/n and cells (about n³ x volume x
     ``cells_per_cube`` of them); whole numbers come back as int."""
-    given = [(key, value) for key, value in (("n", n), ("h", h), ("cells", cells)) if value is not None]
-    if len(given) != 1:
-        named = ", ".join(f"{k} = {v}" for k, v in given) or "none"
-        raise SceneError(f"discretization.mesh: give exactly one of n, h and cells (given: {named})",
-                         key="discretization.mesh")
-    key, value = given[0]
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        value = float("nan")
-    if not (math.isfinite(value) and value > 0):
-        raise SceneError(f"discretization.mesh.{key} = {given[0][1]!r}: give a positive number",
-                         key=f"discretization.mesh.{key}")
-    if key == "h":
-        value = 1.0 / value
-    elif key == "cells":
-        value = (value / (cells_per_cube * domain.volume)) ** (1.0 / 3.0)
-    near = round(value)
-    return int(near) if near >= 1 and abs(value - near) <= 1e-9 * value else value
+    return mesh_density(n, h, cells, lambda count: (count / (cells_per_cube * domain.volume)) ** (1.0 / 3.0),
+                        SceneError, "discretization.mesh")

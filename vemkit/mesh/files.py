@@ -77,7 +77,7 @@ def mesh_to_ugrid_dataset(mesh: Mesh) -> xr.Dataset:
                    "start_index": 0, "mesh": TOPOLOGY},
         )
     ds[TOPOLOGY].attrs["vemkit_boundary_parts"] = json.dumps(names)
-    ds[TOPOLOGY].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=_json_scalar)
+    ds[TOPOLOGY].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=json_scalar)
     return ds
 
 
@@ -151,7 +151,8 @@ def _three_components(values: np.ndarray, count: int, what: str) -> np.ndarray:
     return values
 
 
-def _json_scalar(value):
+def json_scalar(value):
+    """A numpy value of a mesh's meta as plain JSON (for json.dumps(default=...))."""
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):

@@ -38,6 +38,7 @@ import xarray as xr
 from vemkit.config.domain import SIDE_NAME
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
+from vemkit.mesh.files import json_scalar
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import csr_rows, from_face_soup
 
@@ -66,7 +67,7 @@ def mesh3d_to_dataset(mesh: PolyhedralMesh) -> xr.Dataset:
     ds[t] = xr.DataArray(np.int32(0), attrs={
         "cf_role": "mesh_topology", "topology_dimension": 3,
         "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z", "face_node_connectivity": f"{t}_face_nodes",
-        "volume_face_connectivity": f"{t}_volume_faces", "vemkit_meta": json.dumps(mesh.meta, default=_json_scalar),
+        "volume_face_connectivity": f"{t}_volume_faces", "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
         "vemkit_boundary_parts": json.dumps(list(mesh.boundary))})
     return ds
 
@@ -127,14 +128,6 @@ def _validated(mesh: PolyhedralMesh, path: Path) -> PolyhedralMesh:
     except MeshError as error:
         raise MeshError(f"{path.name}: {error}", key=str(path)) from None
     return mesh
-
-
-def _json_scalar(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"mesh meta value {value!r} cannot be stored as JSON")
 
 
 # -- VTU ------------------------------------------------------------------------------------------
