@@ -86,9 +86,7 @@ def add_tresca_friction(model, mesh, mim_c, region, p):
     lam_t in Sign(u.T) as the fixed point lam_t = P_[-1,1](lam_t + r u.T), tested with P1.
     Under IM_NC(2,1) (trapezoid) both terms are vertex by vertex: vemkit's nodal problem.
     """
-    mf_l = gf.MeshFem(mesh, 1)
-    mf_l.set_fem(gf.Fem("FEM_PK(2,1)"))
-    model.add_filtered_fem_variable("lam_t", mf_l, region)
+    model.add_fem_variable("lam_t", multiplier_fem(mesh, region, p))
     model.add_initialized_data("kt", [p["kt"]])
     model.add_initialized_data("r_t", [p["r_friction"]])
     tangent = "[-Normal(2), Normal(1)]"   # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
@@ -109,11 +107,32 @@ def linear_solver(requested):
         return "superlu"
 
 
+_KEEP_ALIVE = []
+
+
+def multiplier_fem(mesh, region, p):
+    """P1 on the contact side's vertices, less those on a Dirichlet side.
+
+    u is fixed there, so their friction rows would be empty (a singular tangent matrix); vemkit
+    eliminates the same vertices, their friction terms never reach the solved equations.
+    """
+    full = gf.MeshFem(mesh, 1)
+    full.set_fem(gf.Fem("FEM_PK(2,1)"))
+    dofs = set(full.basic_dof_on_region(region))
+    for side_region in p["dirichlet_regions"]:
+        dofs -= set(full.basic_dof_on_region(side_region))
+    partial = gf.MeshFem("partial", full, np.array(sorted(dofs), dtype=np.int32))
+    _KEEP_ALIVE.append(full)   # the partial MeshFem refers to it: freeing it would crash GetFEM
+    return partial
+
+
 def solve(model, p, lsolver):
     """GetFEM's Newton (with its default line search) and the given linear solver."""
     options = ["max_res", p["max_res"], "max_iter", 100, "lsolver", lsolver]
     start = time.perf_counter()
-    iterations = model.solve(*options)
+    iterations, converged = model.solve(*options)
+    if not converged:
+        sys.exit(f"getfem_solve: Newton did not converge in {iterations} iterations")
     return time.perf_counter() - start, iterations
 
 
@@ -123,6 +142,7 @@ def main(case_path, out_path):
     p = json.loads(str(case["params"]))
     mesh, to_gf, regions = build_mesh(case)
     model, mf = build_model(mesh, regions, p)
+    p["dirichlet_regions"] = [regions[side] for side in p["dirichlet"]]
     if p["problem"] != "elasticity":
         add_contact(model, mesh, regions, p)
     lsolver = linear_solver(p["lsolver"])
