@@ -43,6 +43,7 @@ E, NU = 2000.0, 0.4
 LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))   # the paper's plane-stress C (SPEC §1)
 TRACTION_LEFT = [[1000.0, 0.0, -200.0], [-200.0, 0.0, 0.0]]   # (200 (5 - y), -200) as a + b x + c y
 PROBLEMS = ("elasticity", "compliance", "friction")
+FRICTION_K = 450.0   # the paper's k_tau (m_tau = 0): every Gamma_C vertex slides
 SKFEM_DIRECT_MAX_DOFS = 200_000   # spsolve up to here, pyamg SA + CG above (scikit-fem's docs)
 
 
@@ -87,20 +88,28 @@ def mesh_case(mesh_path: Path) -> dict:
     return case
 
 
-def peer_params(problem: str, n_dofs: int) -> dict:
+def peer_params(problem: str, n_dofs: int, friction_k: float = FRICTION_K) -> dict:
     """The discrete problem as the peers state it (see the module docstring)."""
     return {"problem": problem, "lam": LAM, "mu": MU, "traction_affine": TRACTION_LEFT,
             "neumann": "left", "dirichlet": ["right"], "contact": "bottom", "gap": 0.1,
-            "kn": 10.0, "kt": 450.0, "r_friction": 100.0,
+            "kn": 10.0, "kt": friction_k, "r_friction": 100.0,
             "quadrature": "nodal" if problem == "friction" else "gauss", "gauss_points": 3,
             "max_res": 1e-9, "lsolver": "auto",
             "solver": "direct" if n_dofs <= SKFEM_DIRECT_MAX_DOFS else "amg", "cg_rtol": 1e-12}
 
 
-def vemkit_scene(problem: str, mesh_path: Path) -> dict:
-    """The paper scene on the mesh file, as each problem needs it."""
+def case_from_mesh(mesh) -> dict:
+    """The same arrays from a vemkit Mesh in memory (a triangle mesh of the unit square)."""
+    case = {"vertices": mesh.vertices, "triangles": mesh.cell_vertices.reshape(-1, 3).astype(np.int64)}
+    return case | {f"side_{side}": np.asarray(mesh.boundary[side], dtype=np.int64)
+                   for side in ("bottom", "right", "top", "left")}
+
+
+def vemkit_scene(problem: str, mesh_entry: dict, friction_k: float = FRICTION_K) -> dict:
+    """The paper scene on the given `discretization.mesh` entry, as each problem needs it."""
     scene = yaml.safe_load((ROOT / "config" / "scenes" / "paper.yaml").read_text())
-    scene["discretization"]["mesh"] = {"file": str(mesh_path)}
+    scene["discretization"]["mesh"] = mesh_entry
+    scene["contact"]["friction"]["k"] = friction_k
     scene["solver"]["tol"] = 1e-12
     if problem == "elasticity":
         del scene["boundary"]["contact"], scene["contact"]
@@ -112,7 +121,7 @@ def vemkit_scene(problem: str, mesh_path: Path) -> dict:
 
 def run_vemkit(problem: str, mesh_path: Path, work: Path) -> tuple[np.ndarray, dict]:
     scene_path, out = work / f"{problem}.yaml", work / f"{problem}-vemkit.nc"
-    scene_path.write_text(yaml.safe_dump(vemkit_scene(problem, mesh_path)))
+    scene_path.write_text(yaml.safe_dump(vemkit_scene(problem, {"file": str(mesh_path)})))
     record = measured([str(VEMKIT), "solve", str(scene_path), "-o", str(out)])
     with xr.open_dataset(out) as ds:
         u = np.stack([ds.u1.values, ds.u2.values], axis=1)
@@ -122,10 +131,11 @@ def run_vemkit(problem: str, mesh_path: Path, work: Path) -> tuple[np.ndarray, d
     return u, record | {"node_xy": xy}
 
 
-def run_peer(peer: str, problem: str, case: dict, work: Path) -> tuple[np.ndarray, dict]:
-    n_dofs = 2 * len(case["vertices"])
+def run_peer(peer: str, problem: str, case: dict, work: Path, params: dict | None = None):
+    """u at the case's vertices and the process record of one peer's solve."""
+    params = params or peer_params(problem, 2 * len(case["vertices"]))
     case_path, out = work / f"{problem}-{peer}-case.npz", work / f"{problem}-{peer}.npz"
-    np.savez(case_path, params=json.dumps(peer_params(problem, n_dofs)), **case)
+    np.savez(case_path, params=json.dumps(params), **case)
     python = SYSTEM_PYTHON if peer == "getfem" else sys.executable
     record = measured([python, str(PEERS / f"{peer}_solve.py"), str(case_path), str(out)])
     with np.load(out) as result:
