@@ -233,13 +233,13 @@ def main() -> None:
         for n in ns:
             for problem in args.problems:
                 rows += compare_case(kind, n, problem, peers_for(problem, getfem_reason), work)
-                print(json.dumps(rows[-1]), flush=True)
+                report(rows, getfem_reason, quiet=True)   # after every case: a stopped run keeps its rows
     if not args.keep:
         shutil.rmtree(work)
     report(rows, getfem_reason)
 
 
-def report(rows: list[dict], getfem_reason: str | None) -> None:
+def report(rows: list[dict], getfem_reason: str | None, quiet: bool = False) -> None:
     load = os.getloadavg()
     header = ["# vemkit k = 1 against scikit-fem and GetFEM P1 (benchmarks/peers.py)", "",
               f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {load[0]:.1f} at the end "
@@ -251,8 +251,14 @@ def report(rows: list[dict], getfem_reason: str | None) -> None:
               "and model set-up.", ""]
     OUT.mkdir(parents=True, exist_ok=True)
     record = {"machine": MACHINE, "load_average": load, "getfem": getfem_reason or "installed", "rows": rows}
-    write_report("peers", record, table_lines(rows, header))
-    figure(rows, OUT / "peers.png")
+    lines = table_lines(rows, header)
+    if quiet:
+        (OUT / "peers.json").write_text(json.dumps(record, indent=2))
+        (OUT / "peers.md").write_text("\n".join(lines) + "\n")
+        print(lines[-1], flush=True)
+    else:
+        write_report("peers", record, lines)
+        figure(rows, OUT / "peers.png")
 
 
 if __name__ == "__main__":
