@@ -168,9 +168,11 @@ def compare_case(kind: str, n: int, problem: str, peers: list[str], work: Path) 
     return rows
 
 
-def peers_for(problem: str, getfem_reason: str | None) -> list[str]:
+def peers_for(problem: str, dofs: int, getfem_reason: str | None, getfem_contact_max: int) -> list[str]:
+    """scikit-fem on elasticity; GetFEM unless missing, or a contact problem above the limit."""
     peers = ["skfem"] if problem == "elasticity" else []
-    return peers + ([] if getfem_reason else ["getfem"])
+    too_big = problem != "elasticity" and dofs > getfem_contact_max
+    return peers + ([] if getfem_reason or too_big else ["getfem"])
 
 
 def warm_up(work: Path, problems) -> None:
@@ -221,18 +223,24 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[32, 128, 512, 708])
     parser.add_argument("--delaunay-sizes", type=int, nargs="*", default=[32, 128])
     parser.add_argument("--problems", nargs="+", default=list(PROBLEMS), choices=PROBLEMS)
+    parser.add_argument("--getfem-contact-max-dofs", type=int, default=10**9,
+                        help="no GetFEM contact solves above this (its Newton refactorizes every step)")
     parser.add_argument("--keep", type=Path, help="keep the meshes and solutions in this folder")
+    parser.add_argument("--resume", action="store_true", help="keep the cases of benchmarks/out/peers.json")
     args = parser.parse_args()
     sizes, delaunay = ([8, 16], [8]) if args.quick else (args.sizes, args.delaunay_sizes)
     getfem_reason = getfem_missing()
     work = Path(args.keep or tempfile.mkdtemp(prefix="vemkit-peers-"))
     work.mkdir(parents=True, exist_ok=True)
     warm_up(work, args.problems)
-    rows = []
+    rows = json.loads((OUT / "peers.json").read_text())["rows"] if args.resume else []
+    done = {(r["mesh"], r["n"], r["problem"]) for r in rows}
     for kind, ns in (("structured", sizes), ("delaunay", delaunay)):
         for n in ns:
-            for problem in args.problems:
-                rows += compare_case(kind, n, problem, peers_for(problem, getfem_reason), work)
+            for problem in (p for p in args.problems if (kind, n, p) not in done):
+                dofs = 2 * (n + 1) ** 2
+                chosen = peers_for(problem, dofs, getfem_reason, args.getfem_contact_max_dofs)
+                rows += compare_case(kind, n, problem, chosen, work)
                 report(rows, getfem_reason, quiet=True)   # after every case: a stopped run keeps its rows
     if not args.keep:
         shutil.rmtree(work)
