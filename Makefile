@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: reproduce test install bench clean-results clean-numba-cache
+.PHONY: reproduce test install bench peers getfem clean-results clean-numba-cache
 
 # Numba's on-disk cache (cache=True) keys a kernel on its own source file only: a kernel that inlines
 # one from another module keeps the old compiled code after that module changes. So the compiled
@@ -41,6 +41,16 @@ bench: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python benchmarks/sweep.py
 	$(BIN)/python benchmarks/meshing.py
 	$(BIN)/python benchmarks/assembly_k2.py
+
+# vemkit k = 1 against scikit-fem and GetFEM P1 on the same triangle meshes (benchmarks/peers.py,
+# README "Side by side with GetFEM and scikit-fem"). GetFEM: python3-getfem for /usr/bin/python3,
+# installed here when missing and root, else skipped with one line. PEERS_ARGS=--quick: a smoke test.
+PEERS_ARGS ?=
+getfem:
+	@bash benchmarks/peers/install_getfem.sh
+
+peers: $(STAMP) $(NUMBA_STAMP) getfem
+	$(BIN)/python benchmarks/peers.py $(PEERS_ARGS)
 
 clean-results:
 	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs

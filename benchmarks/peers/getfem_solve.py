@@ -1,0 +1,171 @@
+"""GetFEM P1 peer of vemkit (runs under the system /usr/bin/python3 with python3-getfem).
+
+    /usr/bin/python3 benchmarks/peers/getfem_solve.py CASE.npz OUT.npz
+
+CASE.npz (written by benchmarks/peers.py from the mesh file vemkit wrote): `vertices` (n, 2),
+`triangles` (m, 3), one (k, 2) array of vertex pairs per boundary side (`side_<name>`), and
+`params` (JSON text): problem "elasticity" | "compliance" | "friction", lam, mu,
+traction_affine [[a, b, c], [a, b, c]] (t_i = a + b x + c y on the side `neumann`), dirichlet,
+contact, gap, kn, kt, r_friction, quadrature ("gauss" with gauss_points, or "nodal"), max_res,
+lsolver ("mumps", "superlu" or "auto": MUMPS when this GetFEM has it, else SuperLU). OUT.npz: `u` (n, 2) at the CASE vertices,
+`info` (JSON text: times, Newton iterations, linear solver).
+
+Only numpy, scipy and getfem: the system python has no netCDF4.
+"""
+
+import json
+import sys
+import time
+
+import numpy as np
+import getfem as gf
+from scipy.spatial import cKDTree
+
+# IM_TRIANGLE(k) restricted to an edge is a Gauss-Legendre rule: 2 points for k = 2, 3, 3 points
+# for k = 4, 5, 4 points for k = 6, 7, 5 points for k = 9 (checked by its face_pts); IM_NC(2, 1)
+# restricted to an edge is the trapezoid rule (vemkit's `nodal` contact quadrature).
+GAUSS_EDGE_RULE = {1: "IM_TRIANGLE(1)", 2: "IM_TRIANGLE(3)", 3: "IM_TRIANGLE(5)",
+                   4: "IM_TRIANGLE(7)", 5: "IM_TRIANGLE(9)"}
+
+
+def build_mesh(case):
+    """The mesh with the CASE's vertices and triangles, and each side as a boundary region."""
+    vertices, triangles = case["vertices"], case["triangles"]
+    mesh = gf.Mesh("pt2D", vertices.T.copy(), triangles.T.astype(np.int32).copy())
+    to_gf = _vertex_map(vertices, mesh.pts().T)
+    outer = {tuple(face) for face in mesh.outer_faces().T}
+    regions = {}
+    for number, name in enumerate(sorted(k[5:] for k in case.files if k.startswith("side_")), 1):
+        pids = np.unique(to_gf[case[f"side_{name}"]])
+        faces = [f for f in mesh.faces_from_pid(pids).T if tuple(f) in outer]
+        mesh.set_region(number, np.array(faces, dtype=np.int32).T)
+        regions[name] = number
+    return mesh, to_gf, regions
+
+
+def _vertex_map(vertices, gf_points):
+    """GetFEM point id of every CASE vertex (by coordinates: 'pt2D' may renumber)."""
+    distance, index = cKDTree(gf_points).query(vertices)
+    assert distance.max() < 1e-12 * max(1.0, np.abs(vertices).max()), "vertex lost by GetFEM"
+    return index
+
+
+def build_model(mesh, regions, p):
+    """Displacement P1, the linearized elasticity brick, u = 0 on the Dirichlet side, the traction."""
+    mf = gf.MeshFem(mesh, 2)
+    mf.set_fem(gf.Fem("FEM_PK(2,1)"))
+    mim = gf.MeshIm(mesh, gf.Integ("IM_TRIANGLE(5)"))
+    model = gf.Model("real")
+    model.add_fem_variable("u", mf)
+    model.add_initialized_data("lambda", [p["lam"]])
+    model.add_initialized_data("mu", [p["mu"]])
+    model.add_isotropic_linearized_elasticity_brick(mim, "u", "lambda", "mu")
+    for side in p["dirichlet"]:
+        model.add_Dirichlet_condition_with_simplification("u", regions[side])
+    traction = ", ".join(f"{a!r} + {b!r}*X(1) + {c!r}*X(2)" for a, b, c in p["traction_affine"])
+    model.add_source_term_generic_assembly_brick(mim, f"[{traction}].Test_u", regions[p["neumann"]])
+    return model, mf
+
+
+def add_contact(model, mesh, regions, p):
+    """Normal compliance p_nu(t) = kn t_+ (m = 1) and, for "friction", the Tresca-type term."""
+    rule = GAUSS_EDGE_RULE[p["gauss_points"]] if p["quadrature"] == "gauss" else "IM_NC(2,1)"
+    mim_c = gf.MeshIm(mesh, gf.Integ(rule))
+    region = regions[p["contact"]]
+    model.add_initialized_data("kn", [p["kn"]])
+    model.add_initialized_data("gap", [p["gap"]])
+    model.add_nonlinear_term(mim_c, "kn*pos_part(u.Normal - gap)*(Test_u.Normal)", region)
+    if p["problem"] == "friction":
+        add_tresca_friction(model, mesh, mim_c, region, p)
+
+
+def add_tresca_friction(model, mesh, mim_c, region, p):
+    """The friction bound kt independent of u (vemkit's m_tau = 0), with a nodal multiplier.
+
+    lam_t in [-1, 1] on the contact side (P1 trace), friction stress kt*lam_t; the inclusion
+    lam_t in Sign(u.T) as the fixed point lam_t = P_[-1,1](lam_t + r u.T), tested with P1.
+    Under IM_NC(2,1) (trapezoid) both terms are vertex by vertex: vemkit's nodal problem.
+    """
+    model.add_fem_variable("lam_t", multiplier_fem(mesh, region, p))
+    model.add_initialized_data("kt", [p["kt"]])
+    model.add_initialized_data("r_t", [p["r_friction"]])
+    tangent = "[-Normal(2), Normal(1)]"   # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
+    model.add_nonlinear_term(mim_c, f"kt*lam_t*(Test_u.{tangent})", region)
+    z = f"(lam_t + r_t*(u.{tangent}))"
+    projected = f"({z} - pos_part({z} - 1) + pos_part(-{z} - 1))"
+    model.add_nonlinear_term(mim_c, f"(lam_t - {projected})*Test_lam_t/r_t", region)
+
+
+def linear_solver(requested):
+    """MUMPS if requested or ("auto") if this GetFEM was built with it, else SuperLU."""
+    if requested != "auto":
+        return requested
+    try:
+        gf.linsolve_mumps(gf.Spmat("identity", 2), np.ones(2))
+        return "mumps"
+    except Exception:   # GetFEM raises its own error type when MUMPS is not compiled in
+        return "superlu"
+
+
+_KEEP_ALIVE = []
+
+
+def multiplier_fem(mesh, region, p):
+    """P1 on the contact side's vertices, less those on a Dirichlet side.
+
+    u is fixed there, so their friction rows would be empty (a singular tangent matrix); vemkit
+    eliminates the same vertices, their friction terms never reach the solved equations.
+    """
+    full = gf.MeshFem(mesh, 1)
+    full.set_fem(gf.Fem("FEM_PK(2,1)"))
+    dofs = set(full.basic_dof_on_region(region))
+    for side_region in p["dirichlet_regions"]:
+        dofs -= set(full.basic_dof_on_region(side_region))
+    partial = gf.MeshFem("partial", full, np.array(sorted(dofs), dtype=np.int32))
+    _KEEP_ALIVE.append(full)   # the partial MeshFem refers to it: freeing it would crash GetFEM
+    return partial
+
+
+def solve(model, p, lsolver):
+    """GetFEM's Newton (with its default line search) and the given linear solver."""
+    options = ["max_res", p["max_res"], "max_iter", 100, "lsolver", lsolver]
+    start = time.perf_counter()
+    iterations, converged = model.solve(*options)
+    if not converged:
+        sys.exit(f"getfem_solve: Newton did not converge in {iterations} iterations")
+    return time.perf_counter() - start, iterations
+
+
+def main(case_path, out_path):
+    start = time.perf_counter()
+    case = np.load(case_path)
+    p = json.loads(str(case["params"]))
+    mesh, to_gf, regions = build_mesh(case)
+    model, mf = build_model(mesh, regions, p)
+    p["dirichlet_regions"] = [regions[side] for side in p["dirichlet"]]
+    if p["problem"] != "elasticity":
+        add_contact(model, mesh, regions, p)
+    lsolver = linear_solver(p["lsolver"])
+    setup_s = time.perf_counter() - start
+    solve_s, iterations = solve(model, p, lsolver)
+    u = nodal_displacement(model, mf, mesh, to_gf)
+    info = {"setup_s": setup_s, "solve_s": solve_s, "lsolver": lsolver,
+            "iterations": _as_int(iterations), "n_dofs": int(mf.nbdof()), "getfem": getattr(gf, "__version__", str(getattr(gf, "__revision__", "?")))}
+    np.savez(out_path, u=u, info=json.dumps(info))
+
+
+def nodal_displacement(model, mf, mesh, to_gf):
+    """u at every CASE vertex (P1: one dof per component at each mesh point)."""
+    values = model.variable("u").reshape(-1, 2)
+    nodes = mf.basic_dof_nodes()[:, ::2].T
+    at_point = np.empty_like(values)
+    at_point[_vertex_map(nodes, mesh.pts().T)] = values
+    return at_point[to_gf]
+
+
+def _as_int(value):
+    return int(np.ravel(value)[0]) if np.size(value) else -1
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:3])

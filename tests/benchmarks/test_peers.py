@@ -1,0 +1,83 @@
+"""vemkit k = 1 on triangles is the P1 finite element method: the same discrete problem as
+scikit-fem and GetFEM (benchmarks/peers.py, issue 22), pinned on small meshes.
+
+GetFEM runs under the system /usr/bin/python3 (Debian python3-getfem; `make peers` and .ci/run
+install it when root); without it those cases are skipped with the reason.
+"""
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import vemkit
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+sys.path.append(str(BENCHMARKS))   # appended: the benchmark scripts' names shadow nothing
+peers = pytest.importorskip("peers", reason="benchmarks/peers.py")
+
+STICKING_K = 4000.0
+MESHES = {"structured": dict(kind="structured"), "delaunay": dict(kind="delaunay", seed=1)}
+
+
+def _module(path: Path, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def vemkit_displacement(problem, mesh, mesh_entry, tmp_path, friction_k=peers.FRICTION_K):
+    scene_path = tmp_path / f"{problem}.yaml"
+    scene_path.write_text(yaml.safe_dump(peers.vemkit_scene(problem, mesh_entry, friction_k)))
+    scene = vemkit.load_scene(scene_path)
+    discrete = vemkit.scene_problem(scene, mesh)
+    ds = vemkit.solution_dataset(discrete, vemkit.solve(discrete, scene.solver_options))
+    return np.stack([ds.u1.values, ds.u2.values], axis=1)
+
+
+def small_case(kind: str, n: int = 8):
+    mesh = vemkit.build_mesh("triangle", n, **MESHES[kind])
+    return mesh, {"family": "triangle", "n": n, **MESHES[kind]}, peers.case_from_mesh(mesh)
+
+
+@pytest.mark.parametrize("kind", sorted(MESHES))
+def test_elasticity_equals_scikit_fem_p1(kind, tmp_path):
+    pytest.importorskip("skfem")
+    mesh, entry, case = small_case(kind)
+    u_vem = vemkit_displacement("elasticity", mesh, entry, tmp_path)
+    skfem_solve = _module(BENCHMARKS / "peers" / "skfem_solve.py", "skfem_solve")
+    np.savez(tmp_path / "case.npz", params=peers.json.dumps(peers.peer_params("elasticity", 100)), **case)
+    skfem_solve.main(tmp_path / "case.npz", tmp_path / "out.npz")
+    u_skfem = np.load(tmp_path / "out.npz")["u"]
+    assert np.abs(u_vem).max() > 1e-3
+    assert peers.relative_difference(u_skfem, u_vem) <= 1e-10
+
+
+@pytest.mark.parametrize("problem", peers.PROBLEMS)
+@pytest.mark.parametrize("kind", sorted(MESHES))
+def test_getfem_solves_the_same_discrete_problem(kind, problem, tmp_path):
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    mesh, entry, case = small_case(kind)
+    u_vem = vemkit_displacement(problem, mesh, entry, tmp_path)
+    u_getfem, record = peers.run_peer("getfem", problem, case, tmp_path)
+    assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
+
+
+def test_getfem_friction_with_sticking_vertices(tmp_path):
+    """A friction bound large enough that part of Gamma_C sticks: both branches of the law."""
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    mesh, entry, case = small_case("structured")
+    u_vem = vemkit_displacement("friction", mesh, entry, tmp_path, friction_k=STICKING_K)
+    params = peers.peer_params("friction", 100, friction_k=STICKING_K)
+    u_getfem, record = peers.run_peer("getfem", "friction", case, tmp_path, params)
+    bottom = np.unique(case["side_bottom"])
+    assert np.sum(np.abs(u_vem[bottom, 0]) < 1e-12) >= 3   # sticking vertices besides the clamped one
+    assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
