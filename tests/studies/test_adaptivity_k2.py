@@ -42,7 +42,7 @@ def test_k2_adaptivity_converges_faster_per_dof_than_k1(runs):
 
 def test_k2_estimate_tracks_the_true_error_and_every_step_is_warm_started(runs):
     effectivity = np.array([r["effectivity"] for r in runs[2].history])
-    assert np.all((effectivity > 0.5) & (effectivity < 3.0)), effectivity
+    assert np.all((effectivity > 1.0) & (effectivity < 5.0)), effectivity  # measured 2.6-2.9 (k = 1: 3.2-4.3)
     assert all(r["warm_start"] == 1 for r in runs[2].history[1:])
     assert runs[2].problem.order == 2 and runs[2].indicators["indicator"].shape == (runs[2].problem.mesh.n_cells,)
 
