@@ -100,11 +100,12 @@ def condense_interior(K, size):
             K[i, j] -= w0 * K[c, j] + w1 * K[c + 1, j]
 
 
-@numba.njit(cache=True)
-def _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data, dim):
-    """data += the rows of K whose node rows lie in [row_lo, row_hi): the cell's free columns are
-    sorted once, then each CSR row is found by one merge walk along its sorted column list (the
-    entries d c of the scalar row d r, d = dim)."""
+def add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
+    """*Template.* data += the rows of K whose node rows lie in [row_lo, row_hi): the cell's free
+    columns are sorted once, then each CSR row is found by one merge walk along its sorted column
+    list (the entries d c of the scalar row d r, d = DIM, a compile-time constant: the d x d blocks
+    unroll)."""
+    dim = DIM  # noqa: F821 (bound by ``specialized``)
     count = 0
     for j in range(size):  # insertion sort of the free local columns by global row
         if rows[j] < 0:
@@ -142,7 +143,7 @@ def scatter_rows(row_lo, row_hi, geometry, offsets, nodes, free_index, free_node
         K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
         if condense:
             condense_interior(K, size)
-        _add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data, DIM)  # noqa: F821
+        add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)  # noqa: F821 (specialized)
 
 
 def scatter_stiffness(geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab,
@@ -157,7 +158,7 @@ def scatter_stiffness(geometry, offsets, nodes, free_index, free_nodes, nc_ptr, 
 
 def scatter_kernel(element: Element):
     """The parallel scatter of ``element`` (``scatter_stiffness`` specialized)."""
-    rows = specialized(scatter_rows, element)
+    rows = specialized(scatter_rows, element, add_rows=specialized(add_rows, element))
     return specialized(scatter_stiffness, element, parallel=True, scatter_rows=rows)
 
 
