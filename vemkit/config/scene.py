@@ -24,6 +24,7 @@ import yaml
 from vemkit.config.boundary_conditions import (boundary_expressions, check_contact,
                                                check_mesh_size, check_rigid_motions, check_sides,
                                                compile_checked, evaluate_checked, inside_points)
+from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.config.material import lame_parameters
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
 from vemkit.config.expressions import Expression
@@ -299,9 +300,6 @@ def _normalized(value, node: dict):
     return value
 
 
-#: the body-force load of k = 2 when the scene names none (issue 18, item 9: p1 gives k = 2 its L2
-#: order 3; p0, the paper's, caps it at 2). At order 1 the key is irrelevant and stays unset.
-DEFAULT_BODY_FORCE_PROJECTION_K2 = "p1"
 
 
 def _check_order_options(discretization: dict) -> None:

@@ -1,10 +1,12 @@
 """Point location in a polygonal mesh: the cell that contains each point (binned bounding boxes,
-then a crossing-number test; points on an edge count as inside)."""
+then a crossing-number test; points on an edge count as inside), and the nearest cell of points
+outside every cell (slivers between two discretizations of a curved side)."""
 
 from __future__ import annotations
 
 import numba
 import numpy as np
+from scipy.spatial import cKDTree
 
 from vemkit.mesh.geometry import bin_boxes
 from vemkit.mesh.mesh import Mesh
@@ -80,3 +82,14 @@ def locate_points(mesh: Mesh, points: np.ndarray) -> np.ndarray:
     out = np.empty(points.shape[0], dtype=np.int64)
     _locate(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, lo, inv, nb, count, members, points, out)
     return out
+
+
+def nearest_cells(mesh: Mesh, points: np.ndarray, within_diameter: bool = True) -> np.ndarray:
+    """The cell whose vertex mean is nearest each point; with ``within_diameter``, -1 where that is
+    farther than the cell's diameter."""
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    if points.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    means = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
+    distance, nearest = cKDTree(means).query(points)
+    return np.where(distance <= mesh.cell_diameters[nearest], nearest, -1) if within_diameter else nearest

@@ -126,40 +126,37 @@ def prolongated_start(refined, problem, solution, new_problem):
     otherwise the new degrees of freedom interpolate Π u_h of the coarse solution, and each new contact
     point takes the multiplier of the nearest old one."""
     dofs = new_problem.dofs
-    if len(new_problem.space.element.layout) == 1:
-        P = refined.prolongation
-        u0 = dofs.restrict(P @ problem.dofs.expand(solution.u))
+    if _vertex_values_only(new_problem):
+        u0 = dofs.restrict(refined.prolongation @ problem.dofs.expand(solution.u))
     else:
         u0 = dofs.unknowns(new_problem.space.interpolate(_coarse_field(problem, solution)))
     u0[dofs.fixed_dofs] = dofs.fixed_values  # prescribed displacements at their exact values
     return u0, _prolongated_multiplier(refined, problem, solution, new_problem)
 
 
+def _vertex_values_only(problem) -> bool:
+    """The space's nodes are the mesh vertices: the refinement's prolongation carries them."""
+    return tuple(problem.space.element.layout) == ("vertex",)
+
+
 def _coarse_field(problem, solution):
     """Π u_h of a coarse solution as a field(x, y) -> (u1, u2) anywhere on its mesh."""
-    from vemkit.mesh.locate import locate_points
+    from vemkit.mesh.locate import locate_points, nearest_cells
 
     projection = problem.projected(solution.u)
 
     def field(x, y):
         points = np.stack([np.ravel(x), np.ravel(y)], axis=1)
         cells = locate_points(problem.mesh, points)
-        cells[cells < 0] = _nearest_cells(problem.mesh, points[cells < 0])
+        cells[cells < 0] = nearest_cells(problem.mesh, points[cells < 0], within_diameter=False)
         values = projection.evaluate(cells, points)
         return values[:, 0].reshape(np.shape(x)), values[:, 1].reshape(np.shape(x))
     return field
 
 
-def _nearest_cells(mesh, points):
-    from scipy.spatial import cKDTree
-
-    centre = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
-    return cKDTree(centre).query(points)[1] if points.size else np.zeros(0, np.int64)
-
-
 def _prolongated_multiplier(refined, problem, solution, new_problem):
     old, new = problem.contact, new_problem.contact
-    if len(new_problem.space.element.layout) == 1:
+    if _vertex_values_only(new_problem):
         P = refined.prolongation
         multiplier, on_contact = np.zeros(problem.mesh.n_vertices), np.zeros(problem.mesh.n_vertices)
         multiplier[old.vertices], on_contact[old.vertices] = solution.multiplier, 1.0

@@ -22,14 +22,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.reference_file import read_reference_file
 from vemkit.studies.tradeoff import check_reference_scene
-from vemkit.mesh.locate import locate_points
+from vemkit.mesh.locate import locate_points, nearest_cells
 from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import relative_exact_errors
 from vemkit.vem.quadrature import reference_quadrature
@@ -40,7 +39,7 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     points, weights, ref_cells = reference.quadrature
     cells = locate_points(mesh, points)
     if np.any(cells < 0):
-        cells[cells < 0] = _nearest_cells(mesh, points[cells < 0])
+        cells[cells < 0] = nearest_cells(mesh, points[cells < 0])
     if np.any(cells < 0):
         raise InputError("adaptivity.reference: the reference mesh covers points outside the adapted mesh "
                          "(another body?); give a solution file of this scene", key="adaptivity.reference")
@@ -55,13 +54,6 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     keep = ~split[ref_cells]
     return (np.concatenate([points[keep], fine_points[take]]), np.concatenate([weights[keep], fine_weights[take]]),
             np.concatenate([cells[keep], fine_cells[take]]), np.concatenate([ref_cells[keep], fine_ref[take]]))
-
-
-def _nearest_cells(mesh, points):
-    """The cell whose vertex mean is nearest each point, −1 where that is farther than its diameter."""
-    means = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
-    distance, nearest = cKDTree(means).query(points)
-    return np.where(distance <= mesh.cell_diameters[nearest], nearest, -1)
 
 
 def reference_errors(mesh, mine, reference: ReferenceSolution) -> dict:

@@ -41,7 +41,7 @@ from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly import largest_cell, specialized
 from vemkit.vem.elements import stabilization_code
 from vemkit.vem.elements.k1_kernel import cell_coordinates, element_stiffness
-from vemkit.vem.projection import stress
+from vemkit.vem.projection import strain_of, stress
 from vemkit.vem.quadrature import reference_quadrature
 from vemkit.vem.space import VirtualElementSpace
 
@@ -111,8 +111,7 @@ def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, s
     specialized(cell_energies, space.element)(mesh.vertices, offsets, nodes, u, float(lam), float(mu),
                                               stabilization_code(stabilization), total)
     points, weights, cells = reference_quadrature(mesh, degree=2)
-    g = projection.gradient_at(cells, points)
-    strain = np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1)
+    strain = strain_of(projection.gradient_at(cells, points))
     sig = stress(strain, lam, mu)
     density = sig[:, 0] * strain[:, 0] + sig[:, 1] * strain[:, 1] + 2.0 * sig[:, 2] * strain[:, 2]
     return total, np.bincount(cells, weights * density, mesh.n_cells)
@@ -120,8 +119,7 @@ def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, s
 
 def stress_at(projection, cells, points, lam, mu) -> np.ndarray:
     """(P, 3) σ11, σ22, σ12 of C ε(Π u) at points, each in the given cell."""
-    g = projection.gradient_at(cells, points)
-    return stress(np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1), lam, mu)
+    return stress(strain_of(projection.gradient_at(cells, points)), lam, mu)
 
 
 def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarray:

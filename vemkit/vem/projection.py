@@ -7,6 +7,12 @@ from __future__ import annotations
 import numpy as np
 
 
+def strain_of(gradient: np.ndarray) -> np.ndarray:
+    """(P, 3) eps11, eps22, eps12 of displacement gradients (P, 2, 2) [i, j] = d u_i / d x_j."""
+    g = gradient
+    return np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1)
+
+
 def stress(strain: np.ndarray, lam: float, mu: float) -> np.ndarray:
     """(M, 3) sigma11, sigma22, sigma12 = C eps (SPEC §1) from (eps11, eps22, eps12)."""
     tr = strain[:, 0] + strain[:, 1]

@@ -42,8 +42,12 @@ class VirtualElementSpace:
         return self.element.order
 
     @cached_property
+    def _node_ranges(self) -> dict:
+        return self.element.node_ranges(self.element.entity_counts(self.mesh))
+
+    @property
     def n_nodes(self) -> int:
-        return self.element.n_nodes(self.mesh)
+        return self._node_ranges["cell"].stop
 
     @property
     def n_dofs(self) -> int:
@@ -62,11 +66,7 @@ class VirtualElementSpace:
 
     def node_range(self, entity: str) -> slice:
         """The global node numbers on one kind of entity ("vertex", "edge", "cell")."""
-        first = self.element.first_node(self.mesh, entity)
-        if entity not in self.element.layout:
-            return slice(first, first)
-        count = {"vertex": self.mesh.n_vertices, "edge": self.mesh.edges.shape[0], "cell": self.mesh.n_cells}[entity]
-        return slice(first, first + self.element.layout[entity] * count)
+        return self._node_ranges[entity]
 
     # -- numbering and constraints ---------------------------------------------------------
     @cached_property

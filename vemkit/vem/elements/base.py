@@ -98,23 +98,27 @@ class Element:
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"
 
+    def entity_counts(self, mesh) -> dict:
+        """{entity: how many the mesh has}, in node order (edges counted only where the element has
+        nodes on them: a mesh's edge table is built on demand)."""
+        return {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
+                "cell": mesh.n_cells}
+
+    def node_ranges(self, counts: dict) -> dict:
+        """{entity: slice of the global node numbers on it} for entity ``counts`` (vertices, edges, cells)."""
+        ranges, first = {}, 0
+        for entity in ENTITIES:
+            stop = first + self.layout.get(entity, 0) * int(counts[entity])
+            ranges[entity], first = slice(first, stop), stop
+        return ranges
+
     def n_nodes(self, mesh) -> int:
-        counts = {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
-                  "cell": mesh.n_cells}
-        return sum(self.layout.get(entity, 0) * counts[entity] for entity in ENTITIES)
+        return self.node_ranges(self.entity_counts(mesh))["cell"].stop
 
     def first_node(self, mesh, entity: str) -> int:
         """The global number of the first node on ``entity`` (nodes run vertices, edges, cells)."""
-        total = 0
-        for other in ENTITIES:
-            if other == entity:
-                return total
-            count = {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
-                     "cell": mesh.n_cells}[other]
-            total += self.layout.get(other, 0) * count
-        raise ValueError(entity)
+        return self.node_ranges(self.entity_counts(mesh))[entity].start
 
     def count_dofs(self, vertices: int, edges: int, cells: int) -> int:
         """Scalar degrees of freedom of the space on a mesh with these entity counts (resource checks)."""
-        counts = {"vertex": vertices, "edge": edges, "cell": cells}
-        return self.dimension * sum(self.layout.get(e, 0) * counts[e] for e in ENTITIES)
+        return self.dimension * self.node_ranges({"vertex": vertices, "edge": edges, "cell": cells})["cell"].stop

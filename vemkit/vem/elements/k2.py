@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.vem.elements.base import Element
-
-BODY_FORCE_PROJECTIONS = ("p0", "p1")
 
 
 class SecondOrder(Element):
@@ -20,8 +19,8 @@ class SecondOrder(Element):
     layout = {"vertex": 1, "edge": 1, "cell": 1}
     condensed_nodes = 1
     numbering = "cells"
-    # P_1 f1 against Pi_2 v: L2 order 3 (the paper's P_0 f1 caps it at 2; README "Order 2", scene default)
-    default_body_force_projection = "p1"
+    # P_1 f1 against Pi_2 v: L2 order 3 (the paper's P_0 f1 caps it at 2; README "Order 2"); the scene's default
+    default_body_force_projection = DEFAULT_BODY_FORCE_PROJECTION_K2
     # Simpson's rule at the trace nodes: |e|/6 at each vertex, 4|e|/6 at the midpoint (vemkit.contact.boundary)
     contact_rule = ((0.0, 1.0 / 6.0), (1.0, 1.0 / 6.0), (0.5, 4.0 / 6.0))
 

@@ -36,6 +36,7 @@ from vemkit.vem.elements.k1_fields import component_values
 from vemkit.vem.elements.k1_fields import dirichlet_components as vertex_dirichlet_components
 from vemkit.vem.elements.k2_kernel import (N_BASIS, cell_frame, cell_projection, cell_vertex_coordinates,
                                            largest_cell, projection_workspace)
+from vemkit.vem.projection import strain_of
 from vemkit.vem.quadrature import body_force_averages, edge_quadrature, reference_quadrature, traction_samples
 
 _CELL_NODES: "weakref.WeakKeyDictionary[Mesh, tuple]" = weakref.WeakKeyDictionary()
@@ -208,7 +209,7 @@ class ProjectedSolutionK2:
     def cell_mean_strain(self) -> np.ndarray:
         """(M, 3) eps11, eps22, eps12: the cell mean of eps(Pi_2 u_h) (linear: its value at the centroid)."""
         g = self.gradient_at(np.arange(self.frame.shape[0]), self.frame[:, :2])
-        return np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1)
+        return strain_of(g)
 
     def gradient_at(self, cells: np.ndarray, points: np.ndarray) -> np.ndarray:
         """(P, 2, 2) gradient of Pi_2 u at points: [i, j] = d u_i / d x_j."""
