@@ -141,14 +141,14 @@ def _compiled_entries(data: dict, probes, dimension: int):
         yield key, tuple(compile_checked(f"{key}[{i}]", v, dimension) for i, v in enumerate(value)), inside
 
 
-def boundary_expressions(data: dict, domain: Domain | None, probes=None) -> dict:
-    """The compiled boundary and exact expressions by key, each test-evaluated on its points
-    (``domain`` None: the mesh comes from a file, the points are unknown yet; ``probes``: the
-    points of a 3D body, ``vemkit.config.scene3d.BodyProbes``)."""
+def boundary_expressions(data: dict, domain: Domain | None, probes=None, dimension: int = 2) -> dict:
+    """The compiled boundary and exact expressions by key (vectors of ``dimension`` components), each
+    test-evaluated on its points (``domain`` and ``probes`` None: the mesh comes from a file, the
+    points are unknown yet; ``probes``: the points of a 3D body, ``vemkit.config.scene3d.BodyProbes``)."""
     if probes is None and domain is not None:
         probes = PlaneProbes(domain)
     compiled = {}
-    for key, value, points in _compiled_entries(data, probes, 2 if probes is None else probes.dimension):
+    for key, value, points in _compiled_entries(data, probes, dimension):
         compiled[key] = value
         for expression in (value if isinstance(value, tuple) else (value,)):
             if expression is not None and points is not None:

@@ -140,7 +140,7 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
         _check_family(data["discretization"]["mesh"], body)
     check_sides(data, None if body is None else body.side_names)
     probes = None if body is None else BodyProbes(body)
-    compiled = boundary_expressions(data, None, probes)
+    compiled = boundary_expressions(data, None, probes, DIMENSION)
     if probes is not None:
         _check_rigid_motions(data, probes)
     force = data["body_force"]

@@ -77,3 +77,41 @@ def _refined(options: dict, shape, sides, count: int) -> int:
         return int(round(float(options.get("fraction", 0.3)) * count))
     axis = list(sides).index(options.get("contact_side", "bottom")) // 2
     return int(np.prod(np.delete(np.asarray(shape), axis)))
+
+
+def scene_resources3d(scene):
+    """Cells, DOFs and peak memory of solving the 3D ``scene`` (``vemkit.config.limits.Resources``),
+    predicted before any mesh is built: ``estimate_mesh3d`` on a box; on an extruded body the 2D
+    estimate of the base (``vemkit.config.limits.estimate_mesh``, the n of the 3D size) times the
+    layers. None for a mesh file (its size is checked once it is read)."""
+    from vemkit.config.limits import estimate_mesh, estimate_resources3d
+
+    options = scene.mesh_options
+    if "family" not in options:
+        return None
+    family = options.pop("family")
+    sizes = {key: options.pop(key) for key in ("n", "h", "cells") if key in options}
+    layers = options.pop("layers", None)
+    body = domain3d_from_spec(scene.domain)
+    if isinstance(body, Box):
+        counts = estimate_mesh3d(family, body, **sizes, **options)
+        return estimate_resources3d(counts.cells, counts.vertices, counts.faces)
+    n = cells_per_length3d(body, cells_per_cube=2.0 if family == "triangle" else 1.0, **sizes)
+    cells, vertices = estimate_mesh({"family": family, "n": n, **options}, body.base.exact_area)
+    layers = int(layers) if layers is not None else max(1, int(round(body.depth * n)))
+    edges = cells + vertices  # Euler: about V + C edges in the base
+    return estimate_resources3d(cells * layers, vertices * (layers + 1), cells * (layers + 1) + edges * layers)
+
+
+def check_scene_resources3d(scene, max_dofs):
+    """The prediction of :func:`scene_resources3d`; ResourceLimitError beyond ``max_dofs`` or the
+    machine's memory (as ``vemkit.config.limits.check_scene_resources`` in 2D)."""
+    from vemkit.config.limits import check_resources
+
+    estimate = scene_resources3d(scene)
+    if estimate is not None:
+        options = scene.mesh_options
+        size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
+        check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
+                        fix="a coarser discretization.mesh")
+    return estimate
