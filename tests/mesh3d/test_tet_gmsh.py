@@ -2,9 +2,10 @@
 body, every boundary face named by its side, sized by n / h / cells, predicted before they are built,
 of measured quality, silent, and the 3D element on them equal to P1 finite elements.
 
-Quality (gmsh's Delaunay mesher with its optimizer, measured on the meshes below and on cubes up to
-2 10⁵ cells): radius ratio 3 r_in / r_circ >= 0.30 (median about 0.8), smallest dihedral angle
-about 12-15 degrees, largest about 150-156; the tests bound them by 0.29, 10 and 160 degrees.
+Quality (gmsh's Delaunay mesher with its optimizer), measured: radius ratio 3 r_in / r_circ >= 0.30
+on the small meshes below and >= 0.24 on 10⁵ cells (cube, the plate, the annulus; median about
+0.8), smallest dihedral angle 12-15 degrees, largest 150-159 degrees; the tests bound them by
+0.2, 10 and 165 degrees (margin for other gmsh versions).
 Curved sides: the boundary vertices lie on the circles (to round-off) and the volume differs from
 the exact body's by at most the sum over curved sides of area x e² / (2 r) (e the side's longest
 mesh edge: a few times the chords' sagitta e² / (8 r)); measured: 0.2 % of the volume at n = 8.
@@ -30,7 +31,7 @@ PLATE = {"extrude": {"depth": 0.5, "ends": ["near", "far"]}, "polygon": [[0, 0],
                    {"polygon": [[1.3, 0.3], [1.5, 0.3], [1.4, 0.6]], "sides": ["h1", "h2", "h3"]}]}
 ANNULUS = {"extrude": {"depth": 0.5}, "polygon": [[1, 0], [0, 1], [-1, 0], [0, -1]], "sides": ["outer"] * 4,
            "arcs": [[0, 0]] * 4, "holes": [{"circle": [0.0, 0.0, 0.5], "side": "bore"}]}
-MIN_RADIUS_RATIO, MIN_DIHEDRAL, MAX_DIHEDRAL = 0.29, 10.0, 160.0
+MIN_RADIUS_RATIO, MIN_DIHEDRAL, MAX_DIHEDRAL = 0.2, 10.0, 165.0
 
 
 def tetrahedra(mesh):
@@ -209,8 +210,11 @@ def test_gmsh_is_silent_leaves_no_files_and_no_session(tmp_path, monkeypatch, ca
     gmsh.initialize([], readConfigFiles=False, interruptible=False)  # a caller's own session stays open
     try:
         gmsh.model.add("mine")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 7.0)
+        models = gmsh.model.list()
         build_mesh3d("tet", BOX, n=2)
-        assert gmsh.isInitialized() and "mine" in gmsh.model.list()
+        assert gmsh.isInitialized() and gmsh.model.list() == models and gmsh.model.getCurrent() == "mine"
+        assert gmsh.option.getNumber("Mesh.MeshSizeMax") == 7.0
     finally:
         gmsh.finalize()
 
