@@ -5,7 +5,8 @@ the 3D families, on an extruded domain the prisms over the 2D family's mesh of t
 ``tet``, which is no 2D family) gmsh's Delaunay tetrahedra of the extruded body itself.
 
 ``tet`` takes ``kind``: ``delaunay`` (the default: gmsh's quality Delaunay tetrahedra, about
-6 n³ per unit volume, ``families3d.gmsh_tet``; on boxes and extruded domains) or ``structured``
+6 n³ per unit volume, ``families3d.gmsh_tet``; on boxes and extruded domains; option ``optimize``,
+default true: gmsh's quality optimization, false: its Delaunay mesh as it is) or ``structured``
 (the Kuhn tetrahedra of the n-grid, 6 per cube, ``families3d.grid.tet``; boxes only).
 """
 
@@ -95,7 +96,7 @@ def _tet(body, n, h, cells, layers, options: dict):
     size = tet_cells_per_length(body, n, h, cells, kind)
     if isinstance(body, Box):
         return builder(size, box=(body.lower, body.upper), sides=body.sides, **options)
-    return builder(size, body)
+    return builder(size, body, **options)
 
 
 def _check_options(family: str, builder, options: dict, extra=()) -> None:

@@ -4,9 +4,13 @@
 :class:`~vemkit.config.domain3d.Extruded` body (its base polygon with circle arcs and circular or
 polygonal holes, extruded along z to its depth). gmsh's OpenCASCADE kernel builds the geometry
 (arcs as circle arcs, circles as circles: the mesh's boundary vertices lie on the curved sides),
-its 3D Delaunay mesher fills it and its optimizer improves the worst tetrahedra: measured radius
-ratios (3 x inradius / circumradius) >= 0.24 and dihedral angles within 12 ... 159 degrees on 10⁵
-cells (tests/mesh3d/test_tet_gmsh.py). 10⁵ cells take about 4 s of CPU (gmsh: 85 %).
+its 3D Delaunay mesher fills it and (``optimize=True``, the default) its optimizer improves the
+worst tetrahedra by moves and swaps: measured radius ratios (3 x inradius / circumradius) >= 0.24
+and dihedral angles within 12 ... 159 degrees on 10⁵ cells, at the price of about 1.3 % of the
+interior faces no longer locally Delaunay. ``optimize=False`` keeps gmsh's Delaunay mesh as it is
+(at most 0.03 % of the faces, next to the boundary, not locally Delaunay: the mesh is constrained
+by the boundary triangles) with its slivers (radius ratios down to 0.015, dihedral angles 0.8 ...
+179 degrees). tests/mesh3d/test_tet_gmsh.py checks both. 10⁵ cells take about 4 s of CPU (gmsh: 85 %).
 
 Size: the target edge length is ``EDGE_PER_N / n`` (``EDGE_PER_N`` fitted so that the interior has
 6 n³ tetrahedra per unit volume, as many as the Kuhn tetrahedra of the n-grid); near the boundary
@@ -75,22 +79,22 @@ def import_gmsh():
 SESSION_OPTIONS = {"General.Terminal": 0, "General.Verbosity": 1, "General.NumThreads": 1}
 
 
-def _mesh_options(edge: float) -> dict:
-    return {"Mesh.MeshSizeMax": edge, "Mesh.MeshSizeMin": 0.0, "Mesh.MeshSizeFromPoints": 0,
-            "Mesh.MeshSizeExtendFromBoundary": 1, "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
+def _mesh_options(edge: float, optimize: bool = True) -> dict:
+    return {"Mesh.Optimize": int(bool(optimize)), "Mesh.MeshSizeMax": edge, "Mesh.MeshSizeMin": 0.0,
+            "Mesh.MeshSizeFromPoints": 0, "Mesh.MeshSizeExtendFromBoundary": 1, "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
             "Mesh.Algorithm": 6,  # Frontal-Delaunay surfaces
             "Mesh.Algorithm3D": 1,  # Delaunay
-            "Mesh.Optimize": 1, "Mesh.ElementOrder": 1}
+            "Mesh.ElementOrder": 1}
 
 
 @contextmanager
-def gmsh_session(what: str, edge: float):
+def gmsh_session(what: str, edge: float, optimize: bool = True):
     """A fresh gmsh model, silent, with the mesh options for target edge length ``edge``; every gmsh
     exception inside becomes a one-line MeshError on ``what``."""
     gmsh = import_gmsh()
     owner = not gmsh.isInitialized()
     name = f"vemkit_tet_{next(_models)}"
-    options = {**SESSION_OPTIONS, **_mesh_options(edge)}
+    options = {**SESSION_OPTIONS, **_mesh_options(edge, optimize)}
     saved, previous = {}, None
     try:
         if owner:
@@ -123,6 +127,12 @@ def gmsh_session(what: str, edge: float):
                         gmsh.option.setNumber(key, value)
             except Exception:  # pragma: no cover - nothing left to clean up
                 pass
+
+
+def _flag(optimize) -> bool:
+    if not isinstance(optimize, (bool, np.bool_)):
+        raise MeshError(f"tet option optimize = {optimize!r}: give true or false", key="discretization.mesh.optimize")
+    return bool(optimize)
 
 
 def edge_length(n: float) -> float:
@@ -207,13 +217,14 @@ def _match_rows(rows: np.ndarray, keys: np.ndarray, labels: np.ndarray) -> np.nd
 
 
 def delaunay_tet(n=None, box=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)),
-                 sides=("left", "right", "front", "back", "bottom", "top")) -> PolyhedralMesh:
+                 sides=("left", "right", "front", "back", "bottom", "top"), optimize: bool = True) -> PolyhedralMesh:
     """gmsh's quality Delaunay tetrahedra of the box, at edge length ``EDGE_PER_N / n`` (module doc)."""
+    optimize = _flag(optimize)
     lower, upper = (np.asarray(b, dtype=float) for b in box)
     edge = edge_length(n)
     meta = {"family": "tet", "kind": "delaunay", "n": n, "edge": edge, "box": [lower.tolist(), upper.tolist()],
-            "mesher": "gmsh"}
-    with gmsh_session("mesh family tet on the box", edge) as gmsh:
+            "mesher": "gmsh", "optimize": optimize}
+    with gmsh_session("mesh family tet on the box", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         occ.addBox(*lower.tolist(), *(upper - lower).tolist())
         occ.synchronize()
@@ -244,15 +255,16 @@ def _box_snapped(mesh: PolyhedralMesh, lower, upper, sides) -> PolyhedralMesh:
                           parts, mesh.meta)
 
 
-def delaunay_tet_extruded(n, body) -> PolyhedralMesh:
+def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
     """gmsh's quality Delaunay tetrahedra of an extruded §7 body (``Extruded``; module doc)."""
+    optimize = _flag(optimize)
     from vemkit.config.domain import CircleHole
 
     base, depth, ends = body.base, float(body.depth), tuple(body.ends)
     edge = edge_length(n)
     meta = {"family": "tet", "kind": "delaunay", "n": n, "edge": edge, "depth": depth, "ends": list(ends),
-            "base": base.to_spec(), "mesher": "gmsh"}
-    with gmsh_session("mesh family tet on the extruded domain", edge) as gmsh:
+            "base": base.to_spec(), "mesher": "gmsh", "optimize": optimize}
+    with gmsh_session("mesh family tet on the extruded domain", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         curve_names = {}
 
