@@ -81,7 +81,8 @@ SESSION_OPTIONS = {"General.Terminal": 0, "General.Verbosity": 1, "General.NumTh
 
 def _mesh_options(edge: float, optimize: bool = True) -> dict:
     return {"Mesh.Optimize": int(bool(optimize)), "Mesh.MeshSizeMax": edge, "Mesh.MeshSizeMin": 0.0,
-            "Mesh.MeshSizeFromPoints": 0, "Mesh.MeshSizeExtendFromBoundary": 1, "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
+            "Mesh.MeshSizeFromPoints": 0, "Mesh.MeshSizeExtendFromBoundary": 1,
+            "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
             "Mesh.Algorithm": 6,  # Frontal-Delaunay surfaces
             "Mesh.Algorithm3D": 1,  # Delaunay
             "Mesh.ElementOrder": 1}

@@ -68,8 +68,8 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
             raise SceneError("tet kind structured meshes a box only; use kind delaunay on an extrude domain",
                              key="discretization.mesh.kind")
     if not isinstance(body, Box):
-        raise SceneError("estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh; family tet on both)",
-                         key="domain")
+        raise SceneError("estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh; "
+                         "family tet on both)", key="domain")
     box = (body.lower, body.upper)
     if family == "voronoi":
         count = seed_count(cells_per_length3d(body, n, h, None) if cells is None else None, box, cells)
