@@ -13,7 +13,9 @@ by the boundary triangles) with its slivers (radius ratios down to 0.015, dihedr
 179 degrees). tests/mesh3d/test_tet_gmsh.py checks both. 10⁵ cells take about 4 s of CPU (gmsh: 85 %).
 
 Size: the target edge length is ``EDGE_PER_N / n`` (``EDGE_PER_N`` fitted so that the interior has
-6 n³ tetrahedra per unit volume, as many as the Kuhn tetrahedra of the n-grid); near the boundary
+6 n³ tetrahedra per unit volume, as many as the Kuhn tetrahedra of the n-grid; ``h`` = 1 / n as for
+every 3D family, so the edges are about 0.89 h; a body thinner than that gets flat tetrahedra:
+prefer the prism families there); near the boundary
 the tetrahedra are a little smaller, so a body of volume V and surface A has about
 ``6 n³ V + BOUNDARY_CELLS n² A`` of them (``tet_counts``, the prediction of ``resources.py``).
 Curved sides get at least ``CURVATURE_ELEMENTS`` edges per full circle.
@@ -196,6 +198,10 @@ def _collect(gmsh, surface_names: dict, meta: dict) -> PolyhedralMesh:
     faces = np.sort(csr_rows(mesh.face_offsets, mesh.face_vertices)[bf], axis=1)
     label = _match_rows(faces, np.concatenate(keys) if keys else np.zeros((0, 3), np.int64),
                         np.concatenate(labels) if labels else np.zeros(0, np.int64))
+    if (label < 0).any():
+        f = int(bf[np.flatnonzero(label < 0)[0]])
+        raise MeshError(f"gmsh's mesh has boundary face {f} on no surface of the body (a hole or a crack in its "
+                        "volume mesh); try another mesh size", key="discretization.mesh")
     parts = {name: bf[label == k] for k, name in enumerate(names)}
     return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
                           parts, meta)
