@@ -226,6 +226,12 @@ def test_gmsh_failure_and_missing_gmsh_become_one_line_mesh_errors(monkeypatch):
             build_mesh3d("tet", PLATE, n=2)
         assert "\n" not in str(info.value) and info.value.key == "discretization.mesh"
     assert not gmsh.isInitialized()  # finalized after the failure
+    import vemkit.mesh.families3d.gmsh_tet as gmsh_tet
+
+    with monkeypatch.context() as patch:  # surface triangles that miss the volume mesh's boundary
+        patch.setattr(gmsh_tet, "_match_rows", lambda rows, keys, labels: np.full(rows.shape[0], -1))
+        with pytest.raises(MeshError, match="boundary face [0-9]+ on no surface of the body"):
+            build_mesh3d("tet", BOX, n=2)
     with monkeypatch.context() as patch:
         patch.setitem(sys.modules, "gmsh", None)
         with pytest.raises(MeshError, match="needs the gmsh Python package.*pip install gmsh"):
