@@ -15,7 +15,7 @@ import numpy as np
 from vemkit.config.boundary_conditions import (PROBES, PlaneProbes, _dirichlet, boundary_expressions,
                                                check_mesh_size, check_sides, compile_checked, evaluate_checked,
                                                rigid_motion_error)
-from vemkit.config.domain3d import BOX_FAMILIES, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
+from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
 
@@ -104,9 +104,9 @@ def _refuse_2d_only(data: dict, given: dict) -> None:
 
 def _check_family(mesh: dict, body) -> None:
     family = mesh.get("family")
-    valid = BOX_FAMILIES if isinstance(body, Box) else FAMILIES_2D
+    valid = BOX_FAMILIES if isinstance(body, Box) else FAMILIES_2D + EXTRUDE_FAMILIES_3D
     if family is not None and family not in valid:
-        what = "a box" if isinstance(body, Box) else "an extrude domain (prisms over the 2D mesh of the base)"
+        what = "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
         raise SceneError(f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: "
                          f"{', '.join(valid)}", key="discretization.mesh.family")
     if "layers" in mesh and isinstance(body, Box):
