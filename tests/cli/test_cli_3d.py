@@ -141,3 +141,46 @@ def test_a_3d_scene_solves_on_its_mesh_file_and_a_2d_scene_refuses_it(tmp_path):
     run = vemkit("solve", tmp_path / "f.yaml", "-o", tmp_path / "g.nc", "--set", "model=plane_stress",
                  "--set", "boundary.dirichlet=[bottom]")
     assert run.returncode == 2 and "is a 3D mesh" in run.stderr and not (tmp_path / "g.nc").exists()
+
+
+def _gmsh_box(path):
+    """A gmsh 4.1 file of tetrahedra in [0, 1]² x [0, 0.5], physical surfaces bottom, top and sides."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("box")
+        gmsh.model.occ.addBox(0, 0, 0, 1, 1, 0.5)
+        gmsh.model.occ.synchronize()
+        groups = {}
+        for dim, tag in gmsh.model.getEntities(2):
+            z = gmsh.model.occ.getCenterOfMass(dim, tag)[2]
+            groups.setdefault("bottom" if abs(z) < 1e-9 else "top" if abs(z - 0.5) < 1e-9 else "sides", []).append(tag)
+        for name, tags in groups.items():
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
+        gmsh.model.addPhysicalGroup(3, [1])
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+        gmsh.model.mesh.generate(3)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+
+
+def test_a_gmsh_3d_file_solves_and_its_header_is_checked_first(tmp_path):
+    _gmsh_box(tmp_path / "box.msh")
+    text = scene_text(dirichlet="    bottom: [0, 0, 0]", extra="  neumann: {top: {traction: [0, 0, -1]}}\n")
+    text = text.replace("domain: {box: [[0, 0, 0], [1, 1, 0.5]]}\n", "").replace(
+        "discretization: {mesh: {family: octree, n: 3}}", "discretization: {mesh: {file: box.msh}}")
+    (tmp_path / "g.yaml").write_text(text)
+    run = vemkit("solve", tmp_path / "g.yaml", "-o", tmp_path / "g.nc", "-q")
+    assert run.returncode == 0, run.stderr
+    mesh, ds = read_solution(tmp_path / "g.nc")
+    assert set(mesh.boundary) == {"bottom", "top", "sides"} and np.isclose(mesh.cell_volumes.sum(), 0.5)
+    assert ds["u3"].values.min() < 0 and np.allclose(ds["u3"].values[np.isclose(mesh.vertices[:, 2], 0)], 0)
+    run = vemkit("solve", tmp_path / "g.yaml", "-o", tmp_path / "h.nc", "--set", "boundary.dirichlet=[floor]")
+    assert run.returncode == 2 and "side 'floor' is not in the mesh file box.msh" in run.stderr, run.stderr
+    run = vemkit("solve", tmp_path / "g.yaml", "-o", tmp_path / "h.nc", "--max-dofs", "50")
+    assert run.returncode == 2 and "more than the limit of 50 DOFs" in run.stderr
+    assert not (tmp_path / "h.nc").exists()

@@ -102,12 +102,14 @@ def scene_resources3d(scene):
     """Cells, DOFs and peak memory of solving the 3D ``scene`` (``vemkit.config.limits.Resources``),
     predicted before any mesh is built: ``estimate_mesh3d`` on a box; on an extruded body the 2D
     estimate of the base (``vemkit.config.limits.estimate_mesh``, the n of the 3D size) times the
-    layers. None for a mesh file (its size is checked once it is read)."""
+    layers; a mesh file: the counts its header declares (``vemkit.config.mesh_file_header``)."""
     from vemkit.config.limits import estimate_mesh, estimate_resources3d
+    from vemkit.config.mesh_file_header import mesh_file_header
 
     options = scene.mesh_options
-    if "family" not in options:
-        return None
+    if "family" not in options:  # a mesh file: the counts it declares (tetrahedra: about 2 faces per cell)
+        header = mesh_file_header(scene.mesh_file, dimension=3)
+        return estimate_resources3d(header.cells, header.vertices, 2 * header.cells + header.vertices)
     family = options.pop("family")
     sizes = {key: options.pop(key) for key in ("n", "h", "cells") if key in options}
     layers = options.pop("layers", None)
@@ -127,10 +129,17 @@ def check_scene_resources3d(scene, max_dofs):
     machine's memory (as ``vemkit.config.limits.check_scene_resources`` in 2D)."""
     from vemkit.config.limits import check_resources
 
+    from vemkit.config.boundary_conditions import check_file_sides
+    from vemkit.config.mesh_file_header import mesh_file_header
+
     estimate = scene_resources3d(scene)
-    if estimate is not None:
-        options = scene.mesh_options
-        size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
-        check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
-                        fix="a coarser discretization.mesh")
+    options = scene.mesh_options
+    if "file" in options:
+        check_resources(estimate, max_dofs, what=f"the mesh file {options['file']} ({estimate.vertices:,} "
+                        "vertices)", fix="a coarser mesh")
+        check_file_sides(scene, mesh_file_header(scene.mesh_file, dimension=3))
+        return estimate
+    size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
+    check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
+                    fix="a coarser discretization.mesh")
     return estimate
