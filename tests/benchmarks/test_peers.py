@@ -81,3 +81,11 @@ def test_getfem_friction_with_sticking_vertices(tmp_path):
     bottom = np.unique(case["side_bottom"])
     assert np.sum(np.abs(u_vem[bottom, 0]) < 1e-12) >= 3   # sticking vertices besides the clamped one
     assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
+
+
+def test_vemkit_3d_on_tetrahedra_is_scikit_fem_p1_through_the_benchmark(tmp_path):
+    """benchmarks/peers3d.py's case (issue 22 (d)): the whole path, both processes, one small mesh."""
+    peers3d = pytest.importorskip("peers3d", reason="benchmarks/peers3d.py")
+    vem, skfem_row = peers3d.run_case(3, tmp_path)
+    assert vem["dofs"] == skfem_row["dofs"] == 3 * 4**3
+    assert skfem_row["rel_diff_to_vemkit"] < 1e-10
