@@ -52,6 +52,33 @@ def _local_faces(cell_offsets, cell_faces, face_offsets, face_vertices, offsets,
     return out
 
 
+#: a face is horizontal (vertical) when its unit normal's z component is within this of +-1 (of 0)
+PRISM_TOLERANCE = 1e-10
+
+
+def stabilization_lengths(mesh) -> np.ndarray:
+    """(M,) the length h_K of the 3D dofi-dofi scaling alpha_K = 2 mu h_K (``k1_3d_kernel``): the
+    cell's diameter, except for a right prism along z (exactly two horizontal faces, the others
+    vertical: the cells of an extruded mesh and of the hex grid), where it is half the prism's height
+    t. There a field independent of z with u3 = 0 has the stabilization 2 (mu t) sum_i e_i^2 over the
+    two copies of each base vertex: t times the 2D dofi-2mu term, as its consistency term is t times
+    the 2D one (plane strain), so that an extruded body with u3 = 0 on its end faces solves to the
+    2D plane-strain solution (SPEC §10). t / 2 scales like h_K on shape-regular prisms."""
+    areas = mesh.face_vector_areas
+    nz = areas[:, 2] / np.linalg.norm(areas, axis=1)
+    signed = mesh.cell_faces
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    cell = np.repeat(np.arange(mesh.n_cells), np.diff(mesh.cell_offsets))
+    horizontal = np.abs(np.abs(nz[faces]) - 1.0) < PRISM_TOLERANCE
+    vertical = np.abs(nz[faces]) < PRISM_TOLERANCE
+    prism = (np.bincount(cell, horizontal, mesh.n_cells) == 2) & \
+        (np.bincount(cell, horizontal | vertical, mesh.n_cells) == np.diff(mesh.cell_offsets))
+    offsets, ids = mesh.cell_vertex_lists
+    z = mesh.vertices[ids, 2]
+    height = np.maximum.reduceat(z, offsets[:-1]) - np.minimum.reduceat(z, offsets[:-1])
+    return np.where(prism, 0.5 * height, mesh.cell_diameters)
+
+
 class FirstOrder3D(Element):
     name = "k1_3d"
     order = 1
