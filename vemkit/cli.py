@@ -23,6 +23,7 @@ import sys
 import warnings
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import vemkit
 from vemkit.exceptions import InputError, OutputError, SolveError, VemkitError
@@ -251,7 +252,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    limit = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
+    limit: dict[str, Any] = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
                  help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})")
     solve = sub.add_parser("solve", help="solve a scene and write the solution as netCDF")
     solve.add_argument("scene", help="scene YAML file (see config/scenes/paper.yaml)")
@@ -317,9 +318,9 @@ def _run(argv) -> int:
         return _fail("out of memory although the estimate fitted (please report); use a coarser "
                      "discretization.mesh")
     except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
-        from vemkit.io.output_files import shown
+        from vemkit.io.output_files import shown as shown_path
 
-        where = f"{shown(error.filename)}: " if error.filename else ""
+        where = f"{shown_path(error.filename)}: " if error.filename else ""
         return _fail(f"{where}{error.strerror or error}; nothing was written")
     except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
         return _fail(f"internal error ({type(error).__name__}: {error}); please report",

@@ -18,6 +18,7 @@ is named after the side it lies on.
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable
 
 from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.square import square, structured_triangle
@@ -30,7 +31,7 @@ from vemkit.mesh.mesh import Mesh
 FAMILIES = ("square", "triangle", "voronoi", "hanging")
 TRIANGLE_KINDS = ("delaunay", "structured")
 
-_BUILDERS = {
+_BUILDERS: dict[str | tuple[str, str], Callable[..., Mesh]] = {
     "square": square,
     ("triangle", "delaunay"): delaunay_triangle,
     ("triangle", "structured"): structured_triangle,
@@ -45,7 +46,7 @@ def family_builder(family: str, options: dict):
     if family not in FAMILIES:
         raise MeshError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}",
                         key="family")
-    key = family
+    key: str | tuple[str, str] = family
     if family == "triangle":
         kind = options.pop("kind", "delaunay")
         if kind not in TRIANGLE_KINDS:
