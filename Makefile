@@ -35,6 +35,17 @@ $(STAMP): pyproject.toml $(LOCK)
 
 install: $(STAMP)
 
+# gmsh (a dependency: mesh family tet, kind delaunay): its wheel's library links X11/OpenGL client
+# libraries; tools/install_gmsh_libs.sh installs the Debian packages holding them when gmsh cannot
+# load them and this runs as root (on this project's image they are all there: one line, no change).
+GMSH_STAMP := $(VENV)/.gmsh-libs
+$(GMSH_STAMP): $(STAMP)
+	@bash tools/install_gmsh_libs.sh $(BIN)/python
+	@touch $(GMSH_STAMP)
+install: $(GMSH_STAMP)
+test: $(GMSH_STAMP)
+reproduce: $(GMSH_STAMP)
+
 reproduce: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/snakemake -j$(JOBS) --quiet rules
 

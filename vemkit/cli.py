@@ -97,14 +97,10 @@ def cmd_solve(args) -> int:
     mesh_file = scene.mesh_options.get("file")  # SPEC §8: relative to the scene file
     output, vtu = _outputs(args, [args.scene] + ([Path(args.scene).parent / mesh_file] if mesh_file else []))
 
-    from vemkit.config.limits import check_scene_resources
-    from vemkit.vem.elements import element_for
-
-    check_scene_resources(scene, args.max_dofs, element_for(scene.order).layout)  # before anything is built
+    _check_resources(scene, args.max_dofs)  # before anything is built
 
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite
-    from vemkit.mesh.files import write_vtu
     from vemkit.studies.scene_solve import solve_scene
 
     progress = _Progress(not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
@@ -116,13 +112,39 @@ def cmd_solve(args) -> int:
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
         if vtu_part is not None:
-            u = problem.dofs.expand(solution.u)
-            cells = {k: ds[k].values for k in ("stress_11", "stress_22", "stress_12", "shear_energy_density")}
-            write_vtu(problem.mesh, vtu_part, point_data={"displacement": u}, cell_data=cells)
+            _write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:
         print(f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
               f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})")
     return 0
+
+
+def _check_resources(scene, max_dofs):
+    """The predicted cells, DOFs and memory of the scene's solve, refused beyond the limits."""
+    if scene.dimension == 3:
+        from vemkit.mesh.families3d.resources import check_scene_resources3d
+
+        return check_scene_resources3d(scene, max_dofs)
+    from vemkit.config.limits import check_scene_resources
+    from vemkit.vem.elements import element_for
+
+    return check_scene_resources(scene, max_dofs, element_for(scene.order).layout)
+
+
+#: the cell fields of a solution's VTU file (2D, 3D)
+VTU_CELL_FIELDS = {2: ("stress_11", "stress_22", "stress_12", "shear_energy_density"),
+                   3: ("stress_11", "stress_22", "stress_33", "stress_12", "stress_13", "stress_23", "von_mises")}
+
+
+def _write_solution_vtu(problem, solution, ds, path) -> None:
+    """The displacement at the vertices and the cell stresses as VTU (3D: VTK polyhedra, type 42)."""
+    dimension = problem.space.element.dimension
+    if dimension == 3:
+        from vemkit.mesh.files3d import write_vtu3d as write_vtu
+    else:
+        from vemkit.mesh.files import write_vtu
+    cells = {k: ds[k].values for k in VTU_CELL_FIELDS[dimension]}
+    write_vtu(problem.mesh, path, point_data={"displacement": problem.dofs.expand(solution.u)}, cell_data=cells)
 
 
 def _adapt_inputs(args):
@@ -135,6 +157,9 @@ def _adapt_inputs(args):
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
+    if scene.dimension == 3:
+        raise InputError(f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
+                         "(SPEC §9); solve it with vemkit solve", key="model")
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
     targets = _outputs(args, inputs)
@@ -198,7 +223,6 @@ def _family_mesh(args):
 
 def _scene_mesh(args):
     """The mesh a scene's discretization.mesh and domain ask for (SPEC §8: vemkit mesh --scene)."""
-    from vemkit.config.limits import check_scene_resources
     from vemkit.config.scene import load_scene
 
     if args.family is not None or args.n is not None or args.option:
@@ -207,7 +231,7 @@ def _scene_mesh(args):
     scene = load_scene(args.scene, args.set or ())
     if scene.mesh_file is not None:  # never write over the mesh file the scene reads
         _outputs(args, [args.scene, scene.mesh_file])
-    check_scene_resources(scene, args.max_dofs)
+    _check_resources(scene, args.max_dofs)
     from vemkit.mesh.families import scene_mesh
 
     return scene_mesh(scene), scene.mesh_options.get("family", "file")
@@ -218,8 +242,11 @@ def cmd_mesh(args) -> int:
     mesh, family = _scene_mesh(args) if args.scene else _family_mesh(args)
 
     from vemkit.io.output_files import atomic_outputs
-    from vemkit.mesh.files import write_ugrid, write_vtu
 
+    if getattr(mesh, "dimension", 2) == 3:
+        from vemkit.mesh.files3d import write_ugrid3d as write_ugrid, write_vtu3d as write_vtu
+    else:
+        from vemkit.mesh.files import write_ugrid, write_vtu
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_ugrid(mesh, output_part)
         if vtu_part is not None:

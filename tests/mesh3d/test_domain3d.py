@@ -59,7 +59,7 @@ def test_sizes():
         cells_per_length3d(box, h=0)
 
 
-@pytest.mark.parametrize("family, size, cells", [("hex", {"n": 4}, 32), ("tet", {"h": 0.5}, 24),
+@pytest.mark.parametrize("family, size, cells", [("hex", {"n": 4}, 32), ("tet", {"h": 0.5, "kind": "structured"}, 24),
                                                  ("octree", {"n": 2}, 4 + 7 * 4), ("voronoi", {"cells": 40}, 40)])
 def test_box_meshes(family, size, cells):
     mesh = build_mesh3d(family, BOX, **size)

@@ -11,6 +11,7 @@ from vemkit.mesh.families3d import extrude, hex, octree, tet, voronoi
 from vemkit.mesh.families3d.grid import lattice
 from vemkit.mesh.files3d import VOLUME_FILL, read_mesh3d, read_ugrid3d, write_ugrid3d, write_vtu3d
 from vemkit.mesh.polyhedral_build import csr_rows
+from vtu_reading import canonical, outward_cycles, stream_cycles, vtu_arrays
 
 
 def same_mesh(a, b):
@@ -54,49 +55,6 @@ def test_a_broken_netcdf_file_is_refused(tmp_path):
         read_mesh3d(tmp_path / "x.nc")
     with pytest.raises(MeshError, match="no such mesh file"):
         read_mesh3d(tmp_path / "none.msh")
-
-
-def outward_cycles(mesh, c):
-    rows = csr_rows(mesh.face_offsets, mesh.face_vertices)
-    out = []
-    for s in mesh.cell_face_list(c):
-        f = rows[s if s >= 0 else -s - 1]
-        f = f[f >= 0]
-        out.append(canonical(f if s >= 0 else f[::-1]))
-    return sorted(out)
-
-
-def canonical(cycle):
-    cycle = [int(v) for v in cycle]
-    i = cycle.index(min(cycle))
-    return tuple(cycle[i:] + cycle[:i])
-
-
-def vtu_arrays(path):
-    """Every DataArray of a binary VTU file (UInt64 headers), decoded independently of vemkit."""
-    import base64
-    import re
-
-    kinds = {"Float64": np.float64, "Int64": np.int64, "UInt8": np.uint8}
-    out = {}
-    for kind, name, text in re.findall(r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>',
-                                       path.read_text()):
-        raw = base64.b64decode(text)
-        out[name] = np.frombuffer(raw[8:8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
-    return out
-
-
-def stream_cycles(faces, faceoffsets):
-    cells, start = [], 0
-    for end in faceoffsets:
-        count, at, cycles = faces[start], start + 1, []
-        for _ in range(count):
-            cycles.append(canonical(faces[at + 1:at + 1 + faces[at]]))
-            at += 1 + faces[at]
-        assert at == end
-        cells.append(sorted(cycles))
-        start = end
-    return cells
 
 
 def test_vtu_polyhedra_read_back(tmp_path):

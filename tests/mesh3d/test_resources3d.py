@@ -9,7 +9,7 @@ from vemkit.mesh.families3d.resources import estimate_mesh3d
 BOX = {"box": [[0, 0, 0], [2, 1, 1]]}
 
 
-@pytest.mark.parametrize("family, size", [("hex", {"n": 3}), ("tet", {"h": 0.5}), ("hex", {"cells": 250})])
+@pytest.mark.parametrize("family, size", [("hex", {"n": 3}), ("tet", {"h": 0.5, "kind": "structured"}), ("hex", {"cells": 250})])
 def test_grids_are_predicted_exactly(family, size):
     est = estimate_mesh3d(family, BOX, **size)
     mesh = build_mesh3d(family, BOX, **size)

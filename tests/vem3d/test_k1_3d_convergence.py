@@ -8,6 +8,7 @@ import scipy.sparse.linalg as spla
 import sympy
 from polyhedra3d import boundary_vertices, hex_grid
 
+from vemkit.mesh.families3d import build_mesh3d
 from vemkit.solvers.linear import AMGSolver
 from vemkit.vem.assembly import dirichlet_lift
 from vemkit.vem.elasticity import rigid_body_modes
@@ -17,6 +18,7 @@ from vemkit.vem.space import VirtualElementSpace
 LAM, MU = 1.2, 0.8
 STAB = "dofi-2mu"
 X = sympy.symbols("x y z")
+CUBE = {"box": [[0, 0, 0], [1, 1, 1]]}
 
 
 def manufactured():
@@ -84,3 +86,29 @@ def test_amg_with_the_six_rigid_motions_solves_the_3d_system():
     print(stats)
     assert stats["levels"] > 1 and stats["residual"] < 1e-10 and stats["iterations"] < 40  # measured: 16
     assert np.abs(u_amg - u_direct).max() < 1e-8 * np.abs(u_direct).max()
+
+
+FAMILY_MESHES = {  # every 3D family of SPEC §10 on the unit cube, as a scene would build it
+    "tet": lambda n: build_mesh3d("tet", CUBE, n=n),
+    "octree": lambda n: build_mesh3d("octree", CUBE, n=n, rule="random", fraction=0.3, seed=1),
+    "voronoi": lambda n: build_mesh3d("voronoi", CUBE, n=n, seed=2),
+    "extruded-voronoi": lambda n: build_mesh3d("voronoi", {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                                                           "sides": ["bottom", "right", "top", "left"],
+                                                           "extrude": {"depth": 1.0}}, n=n),
+}
+
+
+@pytest.mark.parametrize("family", list(FAMILY_MESHES))
+def test_manufactured_solution_converges_on_every_family(family):
+    """Orders against the mean cell size h = (|Omega| / cells)^(1/3), over the two finest of three sizes."""
+    h, h1, l2 = [], [], []
+    for n in (4, 6, 9):
+        mesh = FAMILY_MESHES[family](n)
+        space, u = solve(mesh)
+        e1, e0 = errors(space, u)
+        h.append(mesh.n_cells ** (-1.0 / 3.0))
+        h1.append(e1)
+        l2.append(e0)
+    rate = lambda e: np.log(e[-2] / e[-1]) / np.log(h[-2] / h[-1])  # noqa: E731
+    print(family, "h", h, "h1", h1, "l2", l2, "rates", rate(h1), rate(l2))
+    assert rate(h1) >= 0.95 and rate(l2) >= 1.9

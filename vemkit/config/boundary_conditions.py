@@ -59,13 +59,14 @@ def inside_points(domain: Domain):
     return x0 + (x1 - x0) * x, y0 + (y1 - y0) * y
 
 
-def compile_checked(key: str, value) -> Expression:
-    """The expression of scene key ``key``; a 2D scene's expressions take x and y only (SPEC §10)."""
+def compile_checked(key: str, value, dimension: int = 2) -> Expression:
+    """The expression of scene key ``key``; a 2D scene's expressions take x and y only, a 3D scene's
+    x, y and z (SPEC §10)."""
     try:
         expression = compile_expression(value, name=key)
     except ExpressionError as error:
         raise SceneError(str(error), key=key) from None
-    if "z" in expression.variables:
+    if dimension == 2 and "z" in expression.variables:
         raise SceneError(f"{key} = {shorten(expression.text)!r}: uses z, but this scene is 2D (its expressions take "
                          "x and y); remove z", key=key)
     return expression
@@ -78,26 +79,52 @@ def evaluate_checked(expression: Expression, points) -> np.ndarray:
         raise SceneError(str(error)) from None
 
 
-def _dirichlet(boundary: dict) -> dict:
-    """side -> [u1 | None, u2 | None] (the list form: u = 0 on every listed side)."""
+def _dirichlet(boundary: dict, dimension: int = 2) -> dict:
+    """side -> [u1 | None, u2 | None (, u3 | None)] (the list form: u = 0 on every listed side)."""
     entries = boundary["dirichlet"]
     if isinstance(entries, list):
-        return {side: [0.0, 0.0] for side in entries}
+        return {side: [0.0] * dimension for side in entries}
     return entries
 
 
-def _compiled_entries(data: dict, domain: Domain | None):
-    """(key, expression(s), points | None) of every boundary and exact expression of the scene."""
-    s = (np.arange(PROBES) + 0.5) / PROBES
-    at_side = (lambda side: side_points(domain, side, s)) if domain is not None else (lambda side: None)
-    inside = inside_points(domain) if domain is not None else None
-    for side, components in _dirichlet(data["boundary"]).items():
+class PlaneProbes:
+    """Where a 2D scene's expressions are test-evaluated: PROBES points on each edge of a side, a
+    PROBES x PROBES grid over the body's bounding box (``vemkit.config.scene3d`` has the 3D ones)."""
+
+    dimension = 2
+
+    def __init__(self, domain: Domain):
+        self.domain = domain
+
+    def side(self, side: str, s=None):
+        return side_points(self.domain, side, (np.arange(PROBES) + 0.5) / PROBES if s is None else s)
+
+    def inside(self):
+        return inside_points(self.domain)
+
+
+def _components(key: str, value, dimension: int) -> list:
+    """The list of a vector entry, which has one component per dimension (SPEC §10)."""
+    if len(value) != dimension:
+        names = ", ".join(f"u{i + 1}" if "dirichlet" in key or "exact" in key else f"f_{'xyz'[i]}"
+                          for i in range(dimension))
+        raise SceneError(f"{key} has {len(value)} components; this {dimension}D scene needs {dimension} "
+                         f"([{names}]); fix the scene", key=key)
+    return list(value)
+
+
+def _compiled_entries(data: dict, probes, dimension: int):
+    """(key, expression(s), points | None) of every boundary and exact expression of the scene
+    (``probes`` None: a mesh file's body, the points are unknown yet)."""
+    at_side = probes.side if probes is not None else (lambda side: None)
+    inside = probes.inside() if probes is not None else None
+    for side, components in _dirichlet(data["boundary"], dimension).items():
         key = f"boundary.dirichlet.{side}"
-        pair = tuple(None if value is None else compile_checked(f"{key}[{i}]", value)
-                     for i, value in enumerate(components))
-        if pair == (None, None):
-            raise SceneError(f"{key} = [null, null]: prescribes nothing; give a value for at least one "
-                             "component or move the side to neumann", key=key)
+        pair = tuple(None if value is None else compile_checked(f"{key}[{i}]", value, dimension)
+                     for i, value in enumerate(_components(key, components, dimension)))
+        if pair == (None,) * dimension:
+            raise SceneError(f"{key} = [{', '.join(['null'] * dimension)}]: prescribes nothing; give a value for "
+                             "at least one component or move the side to neumann", key=key)
         yield key, pair, at_side(side)
     for side, entry in data["boundary"]["neumann"].items():
         if len(entry) != 1:
@@ -105,19 +132,23 @@ def _compiled_entries(data: dict, domain: Domain | None):
                              "pressure: p; fix the scene", key=f"boundary.neumann.{side}")
         kind, value = next(iter(entry.items()))
         key = f"boundary.neumann.{side}.{kind}"
-        compiled = compile_checked(key, value) if kind == "pressure" else \
-            tuple(compile_checked(f"{key}[{i}]", value[i]) for i in (0, 1))
+        compiled = compile_checked(key, value, dimension) if kind == "pressure" else \
+            tuple(compile_checked(f"{key}[{i}]", v, dimension) for i, v in enumerate(_components(key, value, dimension)))
         yield key, compiled, at_side(side)
     if "exact" in data:
         key = "exact.displacement"
-        yield key, tuple(compile_checked(f"{key}[{i}]", data["exact"]["displacement"][i]) for i in (0, 1)), inside
+        value = _components(key, data["exact"]["displacement"], dimension)
+        yield key, tuple(compile_checked(f"{key}[{i}]", v, dimension) for i, v in enumerate(value)), inside
 
 
-def boundary_expressions(data: dict, domain: Domain | None) -> dict:
-    """The compiled boundary and exact expressions by key, each test-evaluated on its points
-    (``domain`` None: the mesh comes from a file, the points are unknown yet)."""
+def boundary_expressions(data: dict, domain: Domain | None, probes=None, dimension: int = 2) -> dict:
+    """The compiled boundary and exact expressions by key (vectors of ``dimension`` components), each
+    test-evaluated on its points (``domain`` and ``probes`` None: the mesh comes from a file, the
+    points are unknown yet; ``probes``: the points of a 3D body, ``vemkit.config.scene3d.BodyProbes``)."""
+    if probes is None and domain is not None:
+        probes = PlaneProbes(domain)
     compiled = {}
-    for key, value, points in _compiled_entries(data, domain):
+    for key, value, points in _compiled_entries(data, probes, dimension):
         compiled[key] = value
         for expression in (value if isinstance(value, tuple) else (value,)):
             if expression is not None and points is not None:
@@ -257,13 +288,15 @@ def check_expressions_on_mesh(scene, mesh) -> None:
     before meshing missed, or any point of a mesh file's body): tractions and pressures on their
     sides, the body force and the exact solution everywhere. The gap and the Dirichlet values are
     evaluated at their vertices when they are used."""
-    x, y = mesh.vertices[:, 0], mesh.vertices[:, 1]
+    coordinates = tuple(mesh.vertices.T)  # x, y (and z)
     for side in scene.neumann_sides:
         if side not in mesh.boundary:
             continue  # the problem names the missing side
-        on_side = np.unique(mesh.boundary[side])
+        parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
+        on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else
+                            np.concatenate([mesh.face(f) for f in parts] or [np.zeros(0, np.int64)]))
         pressure = scene.pressure(side)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
-            evaluate_checked(expression, (x[on_side], y[on_side]))
+            evaluate_checked(expression, tuple(c[on_side] for c in coordinates))
     for expression in (*scene.body_force, *(scene.exact_displacement or ())):
-        evaluate_checked(expression, (x, y))
+        evaluate_checked(expression, coordinates)

@@ -13,8 +13,12 @@ domain:
 with a one-line ``SceneError`` whose ``key`` names it. ``vemkit.mesh.families3d.build_mesh3d(family,
 domain, n=/h=/cells=)`` meshes it: on a box the 3D families ``hex``, ``tet``, ``octree``, ``voronoi``;
 on an extruded domain the prisms over the 2D family's mesh of the base (exactly ``build_mesh(family, ...)`` of the same
-keys) in ``layers`` layers (default ``max(1, round(depth n))``, about depth / h).
-Sizes: ``n`` cells per unit length (about n³ cells per unit volume), ``h = 1 / n`` or ``cells``.
+keys) in ``layers`` layers (default ``max(1, round(depth n))``, about depth / h), or ``tet``: a 3D
+family, not a 2D one, so on an extruded domain it means gmsh's Delaunay tetrahedra of the extruded
+body (lateral faces named by the §7 sides, end faces by ``ends``), not prisms.
+``tet`` has ``kind: delaunay`` (the default, gmsh; boxes and extruded domains) or ``kind: structured``
+(the Kuhn tetrahedra of the hex grid, boxes only).
+Sizes: ``n`` cells per unit length (about n³ cells per unit volume; tet: about 6 n³), ``h = 1 / n`` or ``cells``.
 """
 
 from __future__ import annotations
@@ -31,6 +35,10 @@ BOX_SIDES = ("left", "right", "front", "back", "bottom", "top")
 DEFAULT_ENDS = ("front", "back")
 FAMILIES_2D = ("square", "triangle", "voronoi", "hanging")
 BOX_FAMILIES = ("hex", "tet", "octree", "voronoi")
+#: 3D families that mesh an extruded body itself (not prisms over a 2D mesh)
+EXTRUDE_FAMILIES_3D = ("tet",)
+#: how the tet family makes its tetrahedra: gmsh's Delaunay mesher, or the Kuhn cut of the hex grid
+TET_KINDS = ("delaunay", "structured")
 
 
 @dataclass(frozen=True)

@@ -127,8 +127,9 @@ def compile_expression(value, *, name: str = "expression") -> Expression:
 
 class VectorField:
     """Expressions (f1, f2, ...) as one field: ``field(x, y)`` -> (f1(x, y), f2(x, y), ...) (each
-    broadcast to x, y); ``field.gradient(x, y)`` -> array (components, 2, *shape) of the exact
-    derivatives [i, j] = d f_i / d x_j (x_1 = x, x_2 = y)."""
+    broadcast to x, y; 3D: ``field(x, y, z)``); ``field.gradient(x, y)`` -> array (components, 2,
+    *shape) of the exact derivatives [i, j] = d f_i / d x_j (x_1 = x, x_2 = y; 3D: (components, 3,
+    *shape) from ``field.gradient(x, y, z)``)."""
 
     __slots__ = ("components", "_derivatives")
 
@@ -136,13 +137,15 @@ class VectorField:
         self.components = tuple(expressions)
         self._derivatives = None  # compiled on the first gradient
 
-    def __call__(self, x, y):
-        return tuple(f(x, y) for f in self.components)
+    def __call__(self, x, y, z=None):
+        return tuple(f(x, y, z) for f in self.components)
 
-    def gradient(self, x, y) -> np.ndarray:
-        if self._derivatives is None:
-            self._derivatives = [[f.derivative(v) for v in ("x", "y")] for f in self.components]
-        return np.array([[d(x, y) for d in row] for row in self._derivatives], dtype=np.float64)
+    def gradient(self, x, y, z=None) -> np.ndarray:
+        """(components, d, *shape): d = 2 for points (x, y), 3 for (x, y, z)."""
+        variables = ("x", "y") if z is None else ("x", "y", "z")
+        if self._derivatives is None or len(self._derivatives[0]) != len(variables):
+            self._derivatives = [[f.derivative(v) for v in variables] for f in self.components]
+        return np.array([[d(x, y, z) for d in row] for row in self._derivatives], dtype=np.float64)
 
     def __reduce__(self):
         return (VectorField, (self.components,))

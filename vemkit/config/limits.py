@@ -32,7 +32,7 @@ from vemkit.exceptions import ResourceLimitError
 
 __all__ = ["BASE_BYTES", "BYTES_PER_DOF", "DEFAULT_MAX_DOFS", "MEMORY_FRACTION", "Resources",
            "available_memory", "check_resources", "check_scene_resources", "domain_area", "estimate_mesh",
-           "estimate_resources", "memory_budget", "scene_resources"]
+           "estimate_resources", "estimate_resources3d", "memory_budget", "scene_resources"]
 
 DEFAULT_MAX_DOFS = 4_000_000  # the paper's finest level (n = 1024) has 2.1 million on squares
 BASE_BYTES = 400 * 2**20  # Python with numpy, scipy, numba, xarray, netCDF4 loaded
@@ -62,6 +62,18 @@ def estimate_resources(cells: int, vertices: int) -> Resources:
     """The prediction for a mesh of ``cells`` and ``vertices`` (2 DOFs per vertex, an upper bound)."""
     dofs = 2 * int(vertices)
     return Resources(int(cells), int(vertices), dofs, BASE_BYTES + BYTES_PER_DOF * dofs)
+
+
+#: 3D (k = 1, three DOFs per vertex): a hexahedral grid couples every vertex with 27, so the
+#: stiffness holds about 81 entries per row against about 18 in 2D; provisional, refitted by
+#: ``benchmarks/elasticity3d.py``
+BYTES_PER_DOF_3D = 5_000
+
+
+def estimate_resources3d(cells: int, vertices: int, faces: int) -> Resources:
+    """The prediction for a polyhedral mesh (3 DOFs per vertex; ``faces`` kept for the face tables)."""
+    dofs = 3 * int(vertices)
+    return Resources(int(cells), int(vertices), dofs, BASE_BYTES + BYTES_PER_DOF_3D * dofs + 64 * int(faces))
 
 
 def domain_area(domain) -> float:

@@ -76,9 +76,15 @@ def open_regular_file(path, what: str = "mesh file") -> int:
     return fd
 
 
-def mesh_file_header(path) -> MeshFileHeader:
+#: most cells per vertex a mesh can have: a plane mesh (Euler: 2 V + 2 faces), a 3D mesh (tetrahedra:
+#: about 6.5 per vertex in quality meshes, 6 in the Kuhn cubes; 10 leaves a margin)
+CELLS_PER_VERTEX = {2: 2, 3: 10}
+
+
+def mesh_file_header(path, dimension: int = 2) -> MeshFileHeader:
     """The counts and sides the mesh file ``path`` declares (see the module doc); MeshError if
-    the file cannot be a mesh vemkit reads."""
+    the file cannot be a mesh vemkit reads. ``dimension`` 3: a 3D mesh (SPEC §10; gmsh physical
+    surfaces as sides, a ``mesh3d`` netCDF file)."""
     path = Path(path)
     if path.suffix not in MESH_SUFFIXES:
         raise MeshError(f"{path}: unknown mesh file type {path.suffix!r}; give a gmsh .msh or a UGRID .nc file",
@@ -86,12 +92,15 @@ def mesh_file_header(path) -> MeshFileHeader:
     fd = open_regular_file(path)
     try:
         size = os.fstat(fd).st_size
-        header = _gmsh_header(fd, path, size) if path.suffix == ".msh" else _ugrid_header(path, size)
+        header = _gmsh_header(fd, path, size, dimension) if path.suffix == ".msh" else \
+            _ugrid_header(path, size, dimension)
     finally:
         os.close(fd)
-    if header.cells > 2 * header.vertices + 2:
-        raise _fail(path, f"declares {header.cells:,} cells on {header.vertices:,} vertices, more than a plane mesh "
-                          "can have (2 per vertex); the file is broken")
+    most = CELLS_PER_VERTEX[dimension]
+    if header.cells > most * header.vertices + 2:
+        kind = "a plane mesh" if dimension == 2 else "a 3D mesh"
+        raise _fail(path, f"declares {header.cells:,} cells on {header.vertices:,} vertices, more than {kind} "
+                          f"can have ({most} per vertex); the file is broken")
     return header
 
 
@@ -115,7 +124,7 @@ def _find_section(fd: int, name: str, start: int, stop: int) -> int | None:
     return None
 
 
-def _gmsh_header(fd: int, path: Path, size: int) -> MeshFileHeader:
+def _gmsh_header(fd: int, path: Path, size: int, dimension: int = 2) -> MeshFileHeader:
     start = _read_at(fd, 0, 4096).lstrip()
     while start.startswith(b"$Comments"):  # gmsh allows comment blocks before $MeshFormat
         end = start.find(b"$EndComments")
@@ -134,17 +143,18 @@ def _gmsh_header(fd: int, path: Path, size: int) -> MeshFileHeader:
     nodes = _gmsh_count(fd, at_nodes, version, binary, word, path, "$Nodes")
     if nodes * MIN_NODE_BYTES > size:
         raise _fail(path, f"declares {nodes:,} nodes but has only {size:,} bytes; the file is broken")
-    if size > MAX_BYTES_PER_ITEM * (7 * nodes + 16) + (1 << 20):  # elements: < 2 V cells + 3 V lines + V points
+    per_node = 7 if dimension == 2 else 17  # elements: 2D < 2 V cells + 3 V lines + V points; 3D < 10 V + 6 V faces
+    if size > MAX_BYTES_PER_ITEM * (per_node * nodes + 16) + (1 << 20):
         raise _fail(path, f"is {size:,} bytes long for {nodes:,} nodes; the file is broken or not a mesh")
     at_elements = _find_section(fd, "Elements", at_nodes, size)
     if at_elements is None:
         raise _fail(path, "cannot be read as gmsh: no $Elements section")
     elements = _gmsh_count(fd, at_elements, version, binary, word, path, "$Elements")
-    if elements > 6 * nodes + 16:
-        raise _fail(path, f"declares {elements:,} elements on {nodes:,} nodes, more than a plane mesh has; "
-                          "the file is broken")
-    names = _physical_line_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path)
-    return MeshFileHeader(nodes, min(elements, 2 * nodes + 2), names, False, size)
+    if elements > (per_node - 1) * nodes + 16:
+        raise _fail(path, f"declares {elements:,} elements on {nodes:,} nodes, more than a "
+                          f"{'plane' if dimension == 2 else '3D'} mesh has; the file is broken")
+    names = _physical_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path, dimension - 1)
+    return MeshFileHeader(nodes, min(elements, CELLS_PER_VERTEX[dimension] * nodes + 2), names, False, size)
 
 
 def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
@@ -163,7 +173,8 @@ def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
     return count
 
 
-def _physical_line_names(fd, offset, path) -> tuple:
+def _physical_names(fd, offset, path, dimension: int = 1) -> tuple:
+    """The names of the physical groups of ``dimension`` (the sides: lines in 2D, surfaces in 3D)."""
     if offset is None:
         return ()
     text = _read_at(fd, offset, 1 << 20).decode("utf-8", errors="replace").split("\n")
@@ -174,7 +185,7 @@ def _physical_line_names(fd, offset, path) -> tuple:
     names = []
     for line in text[1:1 + count]:
         parts = line.split(None, 2)
-        if len(parts) == 3 and parts[0] == "1":
+        if len(parts) == 3 and parts[0] == str(dimension):
             names.append(parts[2].strip().strip('"'))
     return tuple(names)
 
@@ -185,7 +196,7 @@ def _show(data: bytes) -> str:
 
 
 # -- UGRID --------------------------------------------------------------------------------------
-def _ugrid_header(path: Path, size: int) -> MeshFileHeader:
+def _ugrid_header(path: Path, size: int, dimension: int = 2) -> MeshFileHeader:
     import netCDF4
 
     try:
@@ -194,7 +205,7 @@ def _ugrid_header(path: Path, size: int) -> MeshFileHeader:
         raise _fail(path, f"cannot be read as UGRID netCDF: not a netCDF file ({error.strerror or error})") from None
     try:
         nc.set_auto_mask(False)
-        return _ugrid_counts(nc, path, size)
+        return _ugrid_counts(nc, path, size) if dimension == 2 else _mesh3d_counts(nc, path, size)
     finally:
         nc.close()
 
@@ -216,6 +227,8 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
                           f"{len(topologies)}")
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
+    if str(getattr(topology, "topology_dimension", "2")) == "3":
+        raise _fail(path, "is a 3D mesh (mesh3d, SPEC §10) but the scene is 2D; set model: 3d")
     if len(coordinates) != 2:
         raise _fail(path, "cannot be read as UGRID netCDF: node_coordinates must name two variables (x y)")
     x, y = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
@@ -230,6 +243,26 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
                           "the file is broken")
     sides = _ugrid_sides(nc, getattr(topology, "vemkit_boundary_parts", "[]"), vertices, path)
     return MeshFileHeader(vertices, cells, sides, True, size)
+
+
+def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
+    """The counts and sides of a ``mesh3d`` file (SPEC §10) from its dimensions and attributes."""
+    topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
+    if len(topologies) != 1 or str(getattr(topologies[0], "topology_dimension", "")) != "3":
+        raise _fail(path, "cannot be read as a mesh3d netCDF file: expected one 3D mesh topology variable "
+                          "(topology_dimension = 3)")
+    volumes = _ugrid_variable(nc, getattr(topologies[0], "volume_face_connectivity", None), path,
+                              "volume_face_connectivity", 2)
+    coordinates = str(getattr(topologies[0], "node_coordinates", "")).split()
+    x = _ugrid_variable(nc, coordinates[0] if coordinates else None, path, "node coordinate", 1)
+    try:
+        names = json.loads(getattr(topologies[0], "vemkit_boundary_parts", "[]"))
+    except ValueError:
+        names = None
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise _fail(path, "cannot be read as a mesh3d netCDF file: the attribute vemkit_boundary_parts must be a "
+                          "JSON list of side names")
+    return MeshFileHeader(x.shape[0], volumes.shape[0], tuple(names), True, size)
 
 
 def _ugrid_sides(nc, text, vertices: int, path: Path) -> tuple:

@@ -27,9 +27,11 @@ from vemkit.config.boundary_conditions import (boundary_expressions, check_conta
 from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.config.material import lame_parameters
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
+from vemkit.config.domain3d import domain3d_from_spec
 from vemkit.config.expressions import Expression
 from vemkit.config.mesh_resolution import check_mesh_resolution
 from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
+from vemkit.config.scene3d import check_model_domain, semantic_checks_3d
 from vemkit.exceptions import SceneError
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
@@ -320,6 +322,9 @@ def _check_order_options(discretization: dict) -> None:
 def _semantic_checks(data: dict, given: dict) -> dict:
     """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
     written (before the defaults were filled in)."""
+    check_model_domain(data)
+    if data["model"] == "3d":
+        return semantic_checks_3d(data, given)
     check_mesh_size(data["discretization"]["mesh"])
     _check_order_options(data["discretization"])
     domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
@@ -386,7 +391,7 @@ class Scene:
 
     name = _field("name")
     domain = _field("domain")
-    model = _field("model", doc="the mechanical model: plane_stress (the paper's) or plane_strain (SPEC §10)")
+    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d (SPEC §10)")
     E = _field("material", "E", doc="Young's modulus")
     nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
     dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
@@ -410,13 +415,20 @@ class Scene:
     adaptivity_options = _field("adaptivity", convert=copy.deepcopy,
                                 doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)")
     body_force = property(lambda self: self._expressions["body_force"],
-                          doc="(Expression, Expression): the volume force f1")
+                          doc="(Expression, Expression) (3D: three): the volume force f1")
     gap_expression = property(lambda self: self._expressions.get("contact.gap"),
                               doc="Expression of the initial gap g_a; None without contact section")
 
     @property
+    def dimension(self) -> int:
+        """3 for a ``model: 3d`` scene (SPEC §10), 2 otherwise."""
+        return 3 if self.model == "3d" else 2
+
+    @property
     def sides(self) -> tuple:
         """All sides of the domain; sides not listed under boundary are traction-free."""
+        if self.dimension == 3:
+            return domain3d_from_spec(self.domain).side_names
         domain = domain_from_spec(self.domain)
         return UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
 
@@ -439,7 +451,8 @@ class Scene:
 
     @property
     def dirichlet(self) -> dict:
-        """side -> (u1, u2) prescribed on Gamma_D: Expressions, None for a free component (SPEC §7)."""
+        """side -> (u1, u2) (3D: (u1, u2, u3)) prescribed on Gamma_D: Expressions, None for a free
+        component (SPEC §7, §10)."""
         return {side: self._expressions[f"boundary.dirichlet.{side}"] for side in self.dirichlet_sides}
 
     @property

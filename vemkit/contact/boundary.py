@@ -257,6 +257,8 @@ def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
 
 def check_quadrature(space, quadrature: str) -> None:
     """SceneError unless the quadrature suits the element: ``gauss`` needs linear traces (k = 1)."""
+    if space.element.dimension != 2:
+        return  # no contact on 3D bodies yet (``_without_contact``)
     if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
         raise SceneError(f"discretization.contact_quadrature = {quadrature!r} is not available with "
                          f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
@@ -286,6 +288,8 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     """The contact points of the named boundary ``parts`` of ``space`` (module docstring); ``dofs``
     must already carry the change of variables of the midpoints (``trace_nodes.midpoint_change``).
     gap(x, y) -> array, or a FoundationLine."""
+    if space.element.dimension != 2:
+        return _without_contact(space, parts)
     check_quadrature(space, quadrature)
     mesh = space.mesh
     edges = contact_edges(mesh, parts)
@@ -305,6 +309,18 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
                                tangent, g, coords, quadrature)
     return _with_edges(ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight, normal, tangent, g,
                                        coords, quadrature), mesh, edges, dofs, gap, length, weighted_normal, gauss_points)
+
+
+def _without_contact(space, parts) -> ContactBoundary:
+    """The empty contact boundary of a 3D body (its d-component arrays); contact on polyhedral meshes
+    is not implemented, so a Gamma_C there is a SceneError."""
+    if len(parts):
+        raise SceneError(f"boundary.contact = {list(parts)}: contact on 3D bodies is not available yet; "
+                         "drop boundary.contact (and the contact section) for a 3D body", key="boundary.contact")
+    d = space.element.dimension
+    empty = np.zeros((0, d))
+    return ContactBoundary(np.zeros(0, np.int64), np.zeros((0, d), np.int64), np.zeros(0), empty, empty,
+                           np.zeros(0), empty.copy())
 
 
 def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):

@@ -111,8 +111,8 @@ def constrained(space: VirtualElementSpace, dirichlet) -> DofMap:
 
 def problem_load(space: VirtualElementSpace, neumann, pressure, body_force, projection: str, lam: float,
                  mu: float) -> np.ndarray:
-    """(n_nodes, 2) load vector: tractions, normal pressures and the body force (3.16)."""
-    f = np.zeros((space.n_nodes, 2))
+    """(n_nodes, d) load vector: tractions, normal pressures and the body force (3.16)."""
+    f = np.zeros((space.n_nodes, space.element.dimension))
     for name, traction in (neumann or {}).items():
         f += space.traction_load(space.mesh.boundary[name], traction)
     for name, p in (pressure or {}).items():

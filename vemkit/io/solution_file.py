@@ -25,9 +25,14 @@ STATE_MEANINGS = "separated stick slip"
 
 
 def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> xr.Dataset:
-    """Everything a user needs from one solve, described by its own attributes."""
+    """Everything a user needs from one solve, described by its own attributes (a 3D body: the
+    ``mesh3d`` file of ``vemkit.io.solution_file3d``)."""
     from vemkit.solvers.solution import contact_state
 
+    if problem.space.element.dimension == 3:
+        from vemkit.io.solution_file3d import solution_dataset3d
+
+        return solution_dataset3d(problem, solution, scene_yaml=scene_yaml, extra_attrs=extra_attrs)
     mesh = problem.mesh
     element_order = problem.space.order  # k of Section 3
     u = problem.vertex_displacement(solution.u)
@@ -77,6 +82,11 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
         )
     if len(problem.space.element.layout) > 1:
         _add_node_fields(ds, problem, solution)
+    return with_solver_record(ds, problem, solution, scene_yaml, extra_attrs)
+
+
+def with_solver_record(ds: xr.Dataset, problem, solution, scene_yaml: str, extra_attrs=None) -> xr.Dataset:
+    """``ds`` with the solver history (``iteration``) and the global attributes of SPEC §6 (2D and 3D)."""
     for key, values in solution.history.items():
         ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
     ds.attrs.update(
@@ -90,7 +100,7 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             "wall_time": float(solution.wall_time),
             "n_dofs": int(problem.n_dofs),
             "stabilization": problem.stabilization,
-            "order": int(element_order),
+            "order": int(problem.space.order),
             "model": str(problem.model),
             "vemkit_version": vemkit.__version__,
         }
@@ -148,7 +158,13 @@ def write_netcdf(ds: xr.Dataset, path) -> Path:
 
 
 def read_solution(path):
-    """(Mesh, Dataset) of a solution file written by ``vemkit solve`` or the workflow."""
+    """(Mesh, Dataset) of a solution file written by ``vemkit solve`` or the workflow: a
+    :class:`~vemkit.mesh.mesh.Mesh` (``mesh2d``) or a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
+    (``mesh3d``, SPEC §10)."""
     with xr.open_dataset(path) as ds:
         ds = ds.load()
+    if "mesh3d" in ds.variables:
+        from vemkit.mesh.files3d import read_ugrid3d
+
+        return read_ugrid3d(path), ds
     return read_ugrid(path), ds

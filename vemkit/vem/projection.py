@@ -7,16 +7,33 @@ from __future__ import annotations
 import numpy as np
 
 
+#: the strain and stress components of a 3D body, in the solution file's order (SPEC §10)
+COMPONENTS_3D = ("11", "22", "33", "12", "13", "23")
+_PAIRS_3D = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+
+
 def strain_of(gradient: np.ndarray) -> np.ndarray:
-    """(P, 3) eps11, eps22, eps12 of displacement gradients (P, 2, 2) [i, j] = d u_i / d x_j."""
+    """(P, 3) eps11, eps22, eps12 of displacement gradients (P, 2, 2) [i, j] = d u_i / d x_j; in 3D
+    (P, 3, 3) -> (P, 6) eps11, eps22, eps33, eps12, eps13, eps23 (``COMPONENTS_3D``)."""
     g = gradient
-    return np.stack([g[:, 0, 0], g[:, 1, 1], 0.5 * (g[:, 0, 1] + g[:, 1, 0])], axis=1)
+    pairs = _PAIRS_3D if g.shape[1] == 3 else ((0, 0), (1, 1), (0, 1))
+    return np.stack([0.5 * (g[:, i, j] + g[:, j, i]) for i, j in pairs], axis=1)
 
 
 def stress(strain: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """(M, 3) sigma11, sigma22, sigma12 = C eps (SPEC §1) from (eps11, eps22, eps12)."""
-    tr = strain[:, 0] + strain[:, 1]
-    return np.stack([lam * tr + 2 * mu * strain[:, 0], lam * tr + 2 * mu * strain[:, 1], 2 * mu * strain[:, 2]], axis=1)
+    """sigma = C eps = lam tr(eps) I + 2 mu eps (SPEC §1): (M, 3) sigma11, sigma22, sigma12 from
+    (eps11, eps22, eps12), or in 3D (M, 6) from (M, 6) in the order of ``COMPONENTS_3D``."""
+    diagonal = 3 if strain.shape[1] == 6 else 2
+    tr = strain[:, :diagonal].sum(axis=1)
+    sigma = 2 * mu * strain
+    sigma[:, :diagonal] += lam * tr[:, None]
+    return sigma
+
+
+def von_mises(sig: np.ndarray) -> np.ndarray:
+    """(M,) the von Mises stress sqrt(3/2 |dev sigma|^2) of 3D stresses (M, 6) (``COMPONENTS_3D``)."""
+    s11, s22, s33, s12, s13, s23 = sig.T
+    return np.sqrt(0.5 * ((s11 - s22) ** 2 + (s22 - s33) ** 2 + (s33 - s11) ** 2) + 3.0 * (s12**2 + s13**2 + s23**2))
 
 
 def shear_energy_density(sig: np.ndarray, lam: float, mu: float, model: str = "plane_stress") -> np.ndarray:

@@ -20,7 +20,6 @@ import numpy as np
 from vemkit.mesh.mesh import Mesh, edge_indices
 from vemkit.vem.dofs import DofMap, cell_order_numbering
 from vemkit.vem.elements import Element, element_for
-from vemkit.vem.quadrature import pressure_traction
 
 
 class VirtualElementSpace:
@@ -146,9 +145,9 @@ class VirtualElementSpace:
         return self.element.traction_load(self.mesh, edges, traction)
 
     def pressure_load(self, edges: np.ndarray, pressure) -> np.ndarray:
-        """(n_nodes, 2) the load of a normal pressure p (traction -p nu, SPEC §7)."""
-        edges, traction = pressure_traction(self.mesh, edges, pressure)
-        return self.element.traction_load(self.mesh, edges, traction)
+        """(n_nodes, d) the load of a normal pressure p (traction -p nu, SPEC §7) on boundary edges
+        (3D: faces)."""
+        return self.element.pressure_load(self.mesh, edges, pressure)
 
     def body_force_load(self, field, lam: float, mu: float, projection: str = "p0") -> np.ndarray:
         """(n_nodes, 2) the body-force load of Section 3.3 (``projection``: the data's projection)."""

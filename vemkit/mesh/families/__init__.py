@@ -89,10 +89,14 @@ __all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "checked_mesh", "scene_me
 
 
 def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
-    """``mesh``, validated (``vemkit.mesh.checks.validate_mesh``); a MeshError naming ``what`` was
-    built and ``fix`` otherwise. Every mesh a command solves or writes passes here or through
+    """``mesh``, validated (``vemkit.mesh.checks.validate_mesh``; a polyhedral mesh by
+    ``vemkit.mesh.checks3d.validate_mesh3d``); a MeshError naming ``what`` was built and ``fix``
+    otherwise. Every mesh a command solves or writes passes here or through
     ``vemkit.mesh.files.read_mesh``: ``vemkit solve``, ``adapt`` and ``mesh`` refuse the same meshes."""
-    from vemkit.mesh.checks import validate_mesh
+    if getattr(mesh, "dimension", 2) == 3:
+        from vemkit.mesh.checks3d import validate_mesh3d as validate_mesh
+    else:
+        from vemkit.mesh.checks import validate_mesh
 
     try:
         validate_mesh(mesh)
@@ -104,14 +108,22 @@ def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
 def scene_mesh(scene) -> Mesh:
     """The validated mesh a scene (``vemkit.config.Scene``) asks for: its family on its domain with
     one of n / h / cells (:func:`checked_mesh`), or its mesh file (SPEC §8, read and validated)."""
+    three_d = scene.dimension == 3
     if scene.mesh_file is not None:
-        from vemkit.mesh.files import read_mesh
+        if three_d:
+            from vemkit.mesh.files3d import read_mesh3d as read_mesh
+        else:
+            from vemkit.mesh.files import read_mesh
 
         return read_mesh(scene.mesh_file)
     opts = scene.mesh_options
     family = opts.pop("family")
     sizes = {key: opts.pop(key) for key in ("n", "h", "cells") if key in opts}
-    # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7)
+    # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7, §10)
     size = ", ".join(f"{key} = {value:g}" for key, value in sizes.items())
-    return checked_mesh(build_mesh(family, domain=scene.domain, **sizes, **opts), f"the {family} mesh ({size})",
+    if three_d:  # the 3D families build on the 2D ones (prisms): imported here, not at the top
+        from vemkit.mesh.families3d import build_mesh3d as build
+    else:
+        build = build_mesh
+    return checked_mesh(build(family, domain=scene.domain, **sizes, **opts), f"the {family} mesh ({size})",
                         "try another discretization.mesh size or family")

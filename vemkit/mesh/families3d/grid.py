@@ -1,6 +1,7 @@
 """Box meshes on a Cartesian grid (SPEC §10): ``hex`` (n x m x l hexahedra) and ``tet`` (each hexahedron
 cut into the 6 Kuhn tetrahedra around its diagonal from the lowest to the highest corner: the same
-cut in every box, so neighbouring boxes agree on their shared faces' diagonals).
+cut in every box, so neighbouring boxes agree on their shared faces' diagonals; the family ``tet``
+with ``kind: structured``, while its default kind, delaunay, is gmsh's: ``gmsh_tet``).
 
 The box is ``[lower, upper]``; its faces x = x0, x = x1, y = y0, y = y1, z = z0, z = z1 are named by
 ``sides`` (default ``left, right, front, back, bottom, top``). The grid has ``max(1, round(n L))``
@@ -83,7 +84,8 @@ def tet(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     m = tets.shape[0]
     faces = tets[:, TET_FACES].reshape(-1, 3)
     mesh = from_face_soup(vertices, np.full(m, 4), np.full(4 * m, 3), faces.ravel(), None, (),
-                          {"family": "tet", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()})
+                          {"family": "tet", "kind": "structured", "n": n, "shape": list(shape),
+                           "box": np.asarray(box, float).tolist()})
     return tag_box_faces(mesh, *check_box(box), sides)
 
 

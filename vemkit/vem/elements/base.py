@@ -107,6 +107,14 @@ class Element:
         """The first argument of ``cell_matrix`` (module docstring): the vertex coordinates."""
         return mesh.vertices
 
+    def pressure_load(self, mesh, edges, pressure):
+        """(n_nodes, d) the load of a normal pressure p on boundary ``edges`` (traction -p nu, SPEC §7):
+        the traction load of -p nu (``vemkit.vem.quadrature.pressure_traction``)."""
+        from vemkit.vem.quadrature import pressure_traction
+
+        edges, traction = pressure_traction(mesh, edges, pressure)
+        return self.traction_load(mesh, edges, traction)
+
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"
 

@@ -90,6 +90,10 @@ class FirstOrder3D(Element):
         """int_F g . v_h ds over boundary ``faces`` (face numbers), v_h as Pi^F v_h on each face."""
         return k1_3d_fields.traction_load(mesh, faces, traction)
 
+    def pressure_load(self, mesh, faces, pressure) -> np.ndarray:
+        """The traction load of -p nu_F on every boundary face F (nu_F its outward unit normal)."""
+        return k1_3d_fields.pressure_load(mesh, faces, pressure)
+
     def project(self, mesh, node_values, lam=None, mu=None):
         return k1_3d_fields.projected_solution(mesh, self.geometry(mesh), node_values)
 

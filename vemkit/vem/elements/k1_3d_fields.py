@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vemkit.vem.elements.k1_3d_kernel import boundary_vectors, projection_coefficients, strain_operator
+from vemkit.vem.projection import strain_of
 
 
 def tetrahedron_rule(points: int = 3):
@@ -100,7 +101,8 @@ class ProjectedSolution3D:
         return self.G[np.asarray(cells)]
 
     def cell_mean_strain(self):
-        return 0.5 * (self.G + np.transpose(self.G, (0, 2, 1)))
+        """(M, 6) eps11, eps22, eps33, eps12, eps13, eps23 of Pi u on every cell (constant there)."""
+        return strain_of(self.G)
 
 
 def projected_solution(mesh, geometry, node_values) -> ProjectedSolution3D:
@@ -171,6 +173,19 @@ def face_trace_weights(p, points):
     return 1.0 / m + (points - xb) @ grad.T
 
 
+def face_rule(mesh, f: int, ref, ref_w):
+    """(vertex ids, vertices p (m, 3), points x (Q, 3), weights w (Q,)): the rule of signed fan
+    triangles from the vertex mean of the planar face f (stored orientation), ``ref`` a triangle rule."""
+    ids = mesh.face(f)
+    p = mesh.vertices[ids]
+    xb = p.mean(axis=0)
+    q = np.roll(p, -1, axis=0)
+    x = xb + ref[None, :, :1] * (p - xb)[:, None] + ref[None, :, 1:] * (q - xb)[:, None]  # (m, Q, 3)
+    c = np.cross(p - xb, q - xb)
+    w = (c @ (c.sum(axis=0) / np.linalg.norm(c.sum(axis=0))))[:, None] * ref_w[None]  # 2 |T| (signed) x weights
+    return ids, p, x.reshape(-1, 3), w.ravel()
+
+
 def traction_load(mesh, faces, traction, points: int = 4) -> np.ndarray:
     """(N, 3) int_F g . phi_i ds over the boundary ``faces`` (stored outward): v_h on a face taken as
     Pi^F v_h, as the face integrals of the projection (exact for v_h linear), by signed fan triangles
@@ -178,14 +193,21 @@ def traction_load(mesh, faces, traction, points: int = 4) -> np.ndarray:
     ref, ref_w = triangle_rule(points)
     out = np.zeros((mesh.n_vertices, 3))
     for f in np.asarray(faces, dtype=np.int64).ravel():
-        ids = mesh.face(f)
-        p = mesh.vertices[ids]
-        xb = p.mean(axis=0)
-        q = np.roll(p, -1, axis=0)
-        x = xb + ref[None, :, :1] * (p - xb)[:, None] + ref[None, :, 1:] * (q - xb)[:, None]  # (m, Q, 3)
-        c = np.cross(p - xb, q - xb)
-        w = (c @ (c.sum(axis=0) / np.linalg.norm(c.sum(axis=0))))[:, None] * ref_w[None]  # 2 |T| (signed) x weights
-        x, w = x.reshape(-1, 3), w.ravel()
+        ids, p, x, w = face_rule(mesh, f, ref, ref_w)
         g = np.stack(np.broadcast_arrays(*traction(x[:, 0], x[:, 1], x[:, 2])), axis=1)  # (Q, 3)
         np.add.at(out, ids, face_trace_weights(p, x).T @ (w[:, None] * g))
+    return out
+
+
+def pressure_load(mesh, faces, pressure, points: int = 4) -> np.ndarray:
+    """(N, 3) the load of a normal pressure p(x, y, z) (or a number) on the boundary ``faces``: the
+    traction -p nu_F of each planar face F, nu_F its outward unit normal (as ``traction_load``)."""
+    ref, ref_w = triangle_rule(points)
+    out = np.zeros((mesh.n_vertices, 3))
+    faces = np.asarray(faces, dtype=np.int64).ravel()
+    areas = mesh.face_vector_areas[faces]
+    for f, nu in zip(faces, areas / np.linalg.norm(areas, axis=1, keepdims=True)):
+        ids, p, x, w = face_rule(mesh, f, ref, ref_w)
+        value = pressure(x[:, 0], x[:, 1], x[:, 2]) if callable(pressure) else float(pressure)
+        np.add.at(out, ids, np.outer(face_trace_weights(p, x).T @ (w * value), -nu))
     return out

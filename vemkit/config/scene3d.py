@@ -1,0 +1,153 @@
+"""The checks of a 3D scene (SPEC §10, ``model: 3d``) beyond the schema, and where its expressions are probed.
+
+A 3D scene is a box, an ``extrude`` domain or a 3D mesh file with ``model: 3d``; its vectors have
+three components and its expressions take x, y and z. Before any mesh is built every expression is
+test-evaluated on its side (:class:`BodyProbes`: a grid on each face of a box; on an extruded body the
+2D probes of a lateral side at several heights, the base's boundary on the end faces), the Dirichlet
+sides are tested for a free rigid motion (SPEC §10 names it), and what 3D does not have yet is refused
+in one line: contact (Gamma_C on polyhedral meshes), order 2, the k = 2 load options.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vemkit.config.boundary_conditions import (PROBES, PlaneProbes, _dirichlet, boundary_expressions,
+                                               check_mesh_size, check_sides, compile_checked, evaluate_checked,
+                                               rigid_motion_error)
+from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
+from vemkit.config.rigid_motions import free_rigid_motion
+from vemkit.exceptions import SceneError
+
+__all__ = ["BodyProbes", "check_model_domain", "semantic_checks_3d"]
+
+DIMENSION = 3
+
+
+class BodyProbes:
+    """Probe points (x, y, z) of a 3D body's sides and inside (module docstring); ``s`` in [0, 1]
+    are the parameters along each direction of a face (default PROBES midpoints)."""
+
+    dimension = DIMENSION
+
+    def __init__(self, body):
+        self.body = body
+
+    def side(self, side: str, s=None):
+        s = (np.arange(PROBES) + 0.5) / PROBES if s is None else np.asarray(s, dtype=float)
+        if isinstance(self.body, Box):
+            return self._box_face(side, s)
+        plane, points = PlaneProbes(self.body.base), []
+        if side in self.body.ends:  # an end face: the base's boundary at z = 0 and/or z = depth
+            rims = [plane.side(name, s) for name in self.body.base.side_names]
+            x, y = np.concatenate([np.ravel(r[0]) for r in rims]), np.concatenate([np.ravel(r[1]) for r in rims])
+            for end, z in zip(self.body.ends, (0.0, self.body.depth)):
+                if end == side:
+                    points.append((x, y, np.full_like(x, z)))
+        if side in self.body.base.side_names:  # a lateral side: its 2D probes at the heights s depth
+            x, y = (np.ravel(c) for c in plane.side(side, s))
+            heights = s * self.body.depth
+            points.append((np.tile(x, heights.size), np.tile(y, heights.size), np.repeat(heights, x.size)))
+        return tuple(np.concatenate(c) for c in zip(*points))
+
+    def _box_face(self, side: str, s):
+        lower, upper = np.asarray(self.body.lower), np.asarray(self.body.upper)
+        xs = []
+        for index, name in enumerate(self.body.sides):
+            if name != side:
+                continue
+            axis, at = index // 2, (lower if index % 2 == 0 else upper)[index // 2]
+            a, b = [k for k in range(3) if k != axis]
+            u, v = np.meshgrid(lower[a] + s * (upper[a] - lower[a]), lower[b] + s * (upper[b] - lower[b]))
+            p = np.empty((u.size, 3))
+            p[:, axis], p[:, a], p[:, b] = at, u.ravel(), v.ravel()
+            xs.append(p)
+        p = np.concatenate(xs)
+        return p[:, 0], p[:, 1], p[:, 2]
+
+    def inside(self):
+        """A PROBES³ grid over the body's bounding box."""
+        if isinstance(self.body, Box):
+            lower, upper = np.asarray(self.body.lower), np.asarray(self.body.upper)
+        else:
+            x0, y0, x1, y1 = self.body.base.bounds
+            lower, upper = np.array([x0, y0, 0.0]), np.array([x1, y1, self.body.depth])
+        s = (np.arange(PROBES) + 0.5) / PROBES
+        grid = np.meshgrid(*(lower[i] + s * (upper[i] - lower[i]) for i in range(3)), indexing="ij")
+        return tuple(g.ravel() for g in grid)
+
+
+def check_model_domain(data: dict) -> None:
+    """A box or extrude domain needs ``model: 3d``; ``model: 3d`` needs one (or a mesh file)."""
+    three_d = is_3d_domain(data["domain"])
+    if three_d and data["model"] != "3d":
+        kind = "box" if "box" in data["domain"] else "extrude"
+        raise SceneError(f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d "
+                         "(or give a 2D domain)", key="model")
+    if data["model"] == "3d" and not three_d and "file" not in data["discretization"]["mesh"]:
+        raise SceneError("model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
+                         "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model", key="domain")
+
+
+def _refuse_2d_only(data: dict, given: dict) -> None:
+    discretization = data["discretization"]
+    if discretization["order"] != 1:
+        raise SceneError(f"discretization.order = {discretization['order']}: 3D bodies have the k = 1 element "
+                         "only; set discretization.order=1", key="discretization.order")
+    if "body_force_projection" in given.get("discretization", {}):
+        raise SceneError("discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean "
+                         "of f1; drop it", key="discretization.body_force_projection")
+    if data["boundary"]["contact"] or "contact" in given:
+        raise SceneError("contact on 3D bodies is not available yet (SPEC §10, a coming release); drop "
+                         "boundary.contact and the contact section", key="boundary.contact")
+
+
+def _check_family(mesh: dict, body) -> None:
+    family = mesh.get("family")
+    valid = BOX_FAMILIES if isinstance(body, Box) else FAMILIES_2D + EXTRUDE_FAMILIES_3D
+    if family is not None and family not in valid:
+        what = "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
+        raise SceneError(f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: "
+                         f"{', '.join(valid)}", key="discretization.mesh.family")
+    if "layers" in mesh and isinstance(body, Box):
+        raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
+                         key="discretization.mesh.layers")
+
+
+def _check_rigid_motions(data: dict, probes: BodyProbes) -> None:
+    """The Dirichlet sides hold the six rigid motions, tested at probe points of their faces (the
+    corners of each face included: s from 0 to 1)."""
+    points, held = [], []
+    for side, components in _dirichlet(data["boundary"], DIMENSION).items():
+        p = np.stack(probes.side(side, np.linspace(0.0, 1.0, 5)), axis=1)
+        points.append(p)
+        held.append(np.tile([c is not None for c in components], (p.shape[0], 1)))
+    motion = free_rigid_motion(np.concatenate(points), np.concatenate(held))
+    if motion is not None:
+        raise rigid_motion_error(motion)
+
+
+def semantic_checks_3d(data: dict, given: dict) -> dict:
+    """The checks of a 3D scene (module docstring); returns the compiled expressions by key (those
+    of a 2D scene, with three components). ``given``: the scene as written."""
+    check_mesh_size(data["discretization"]["mesh"])
+    _refuse_2d_only(data, given)
+    if "body_force" not in given:
+        data["body_force"] = [0.0, 0.0, 0.0]
+    from_file = "file" in data["discretization"]["mesh"]
+    body = None if from_file else domain3d_from_spec(data["domain"])
+    if body is not None:
+        _check_family(data["discretization"]["mesh"], body)
+    check_sides(data, None if body is None else body.side_names)
+    probes = None if body is None else BodyProbes(body)
+    compiled = boundary_expressions(data, None, probes, DIMENSION)
+    if probes is not None:
+        _check_rigid_motions(data, probes)
+    force = data["body_force"]
+    if len(force) != DIMENSION:
+        raise SceneError(f"body_force has {len(force)} components; this 3D scene needs 3 ([f1_x, f1_y, f1_z]); "
+                         "fix the scene", key="body_force")
+    compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", force[i], DIMENSION) for i in range(3))
+    for expression in compiled["body_force"] if probes is not None else ():
+        evaluate_checked(expression, probes.inside())
+    return compiled
