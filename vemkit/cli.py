@@ -21,6 +21,7 @@ import argparse
 import os
 import sys
 import warnings
+from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -139,6 +140,7 @@ VTU_CELL_FIELDS = {2: ("stress_11", "stress_22", "stress_12", "shear_energy_dens
 def _write_solution_vtu(problem, solution, ds, path) -> None:
     """The displacement at the vertices and the cell stresses as VTU (3D: VTK polyhedra, type 42)."""
     dimension = problem.space.element.dimension
+    write_vtu: Callable[..., None]  # the 2D or the 3D writer
     if dimension == 3:
         from vemkit.mesh.files3d import write_vtu3d as write_vtu
     else:
@@ -243,6 +245,8 @@ def cmd_mesh(args) -> int:
 
     from vemkit.io.output_files import atomic_outputs
 
+    write_ugrid: Callable[..., None]  # the 2D or the 3D writers
+    write_vtu: Callable[..., None]
     if getattr(mesh, "dimension", 2) == 3:
         from vemkit.mesh.files3d import write_ugrid3d as write_ugrid, write_vtu3d as write_vtu
     else:

@@ -4,6 +4,7 @@ interpolation, the body force through P_0 f (Section 3.3); and the system is sol
 aggregation AMG + CG with the six rigid motions as near-nullspace."""
 
 import numpy as np
+import pytest
 import scipy.sparse.linalg as spla
 import sympy
 from polyhedra3d import boundary_vertices, hex_grid
