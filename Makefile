@@ -21,10 +21,16 @@ clean-numba-cache:
 	find vemkit -path '*__pycache__*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
 	rm -f $(NUMBA_STAMP)
 
-$(STAMP): pyproject.toml
+# The tested versions: requirements.lock pins every package the extras below pull in (constraints:
+# a dependency added to pyproject.toml and not yet in the lock still installs, unpinned). `make lock`
+# refreshes the lock (see the lock block at the end).
+EXTRAS := report,workflow,slurm,test,lint
+LOCK   := requirements.lock
+
+$(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[report,workflow,slurm,test]"
+	$(BIN)/python -m pip install --quiet -c $(LOCK) -e ".[$(EXTRAS)]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -73,3 +79,52 @@ MODE ?= accounting
 .PHONY: cluster-test
 cluster-test: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python workflow/cluster/cluster_test.py --mode $(MODE)
+
+# ---- lint and format (issue 23 item 8) --------------------------------------------------------
+# `make lint`: ruff check (rules in pyproject.toml [tool.ruff.lint]), ruff format --check, and mypy
+# on the public API (the files in [tool.mypy]); each runs, and lint fails if any of them failed.
+# `make format` rewrites the tree: the import order (ruff's isort rules) and then ruff format.
+.PHONY: lint format
+lint: $(STAMP)
+	@status=0; \
+	echo "ruff check"; $(BIN)/ruff check --output-format concise . || status=1; \
+	echo "ruff format --check"; $(BIN)/ruff format --check --output-format concise . || status=1; \
+	echo "mypy (public API)"; $(BIN)/mypy || status=1; \
+	exit $$status
+
+format: $(STAMP)
+	$(BIN)/ruff check --select I --fix .
+	$(BIN)/ruff format .
+
+# ---- lock (issue 23 item 8) -------------------------------------------------------------------
+# `make lock`: resolve pyproject.toml's dependencies and extras afresh in a throw-away venv (newest
+# versions the package index serves within the bounds) and pin them in requirements.lock (pip freeze,
+# without vemkit itself). Then `make install` (the lock is newer than the venv's stamp) and `make test`
+# before committing the new lock.
+LOCK_VENV := $(VENV)-lock
+.PHONY: lock
+lock:
+	rm -rf $(LOCK_VENV)
+	$(PYTHON) -m venv $(LOCK_VENV)
+	$(LOCK_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(LOCK_VENV)/bin/python -m pip install --quiet ".[$(EXTRAS)]"
+	{ echo "# The tested dependency versions (make lock; make install installs with them as constraints)."; \
+	  echo "# $$($(LOCK_VENV)/bin/python -c 'import platform, sys; print(f"Python {platform.python_version()} on {sys.platform}")'), $$(date -u +%Y-%m-%d)"; \
+	  $(LOCK_VENV)/bin/python -m pip freeze --exclude vemkit; } > $(LOCK).tmp
+	mv $(LOCK).tmp $(LOCK)
+	rm -rf $(LOCK_VENV) build
+	@echo "$(LOCK): $$(grep -vc '^#' $(LOCK)) packages pinned"
+
+# ---- docs-check (issue 23 item 7: the built site in a real browser) ---------------------------
+# Every main page of the built site (DOCS_HTML) opened in headless Chromium (Debian's chromium,
+# installed by docs/tools/install_chromium.sh when missing and root, else the browser part is
+# skipped with one line), one screenshot per page into DOCS_SHOTS; fails on a page that does not
+# load, a missing or undrawn image, a missing stylesheet or script, or an internal link to no file.
+DOCS_HTML  ?= docs/_build/html
+DOCS_SHOTS ?= docs/_build/screenshots
+.PHONY: docs-check chromium
+chromium:
+	@bash docs/tools/install_chromium.sh
+
+docs-check: chromium
+	$(PYTHON) docs/tools/docs_check.py $(DOCS_HTML) --out $(DOCS_SHOTS)

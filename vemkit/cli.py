@@ -21,8 +21,10 @@ import argparse
 import os
 import sys
 import warnings
+from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import vemkit
 from vemkit.exceptions import InputError, OutputError, SolveError, VemkitError
@@ -138,6 +140,7 @@ VTU_CELL_FIELDS = {2: ("stress_11", "stress_22", "stress_12", "shear_energy_dens
 def _write_solution_vtu(problem, solution, ds, path) -> None:
     """The displacement at the vertices and the cell stresses as VTU (3D: VTK polyhedra, type 42)."""
     dimension = problem.space.element.dimension
+    write_vtu: Callable[..., None]  # the 2D or the 3D writer
     if dimension == 3:
         from vemkit.mesh.files3d import write_vtu3d as write_vtu
     else:
@@ -242,6 +245,8 @@ def cmd_mesh(args) -> int:
 
     from vemkit.io.output_files import atomic_outputs
 
+    write_ugrid: Callable[..., None]  # the 2D or the 3D writers
+    write_vtu: Callable[..., None]
     if getattr(mesh, "dimension", 2) == 3:
         from vemkit.mesh.files3d import write_ugrid3d as write_ugrid, write_vtu3d as write_vtu
     else:
@@ -278,7 +283,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    limit = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
+    limit: dict[str, Any] = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
                  help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})")
     solve = sub.add_parser("solve", help="solve a scene and write the solution as netCDF")
     solve.add_argument("scene", help="scene YAML file (see config/scenes/paper.yaml)")
@@ -344,9 +349,9 @@ def _run(argv) -> int:
         return _fail("out of memory although the estimate fitted (please report); use a coarser "
                      "discretization.mesh")
     except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
-        from vemkit.io.output_files import shown
+        from vemkit.io.output_files import shown as shown_path
 
-        where = f"{shown(error.filename)}: " if error.filename else ""
+        where = f"{shown_path(error.filename)}: " if error.filename else ""
         return _fail(f"{where}{error.strerror or error}; nothing was written")
     except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
         return _fail(f"internal error ({type(error).__name__}: {error}); please report",

@@ -3,7 +3,6 @@ the real command (``python -m vemkit.cli`` and the console entry point: the work
 worker, the parent handles the signal, vemkit.io.supervisor): exit 130/143, no ``.part`` left, the
 earlier output untouched. Before, the handler waited until the running kernel returned."""
 
-import os
 import signal
 import subprocess
 import sys

@@ -29,7 +29,7 @@ def _dense_rank(points, prescribed) -> int:
 
 def test_random_small_sets_agree_with_the_dense_rank_2d_and_3d():
     rng = np.random.default_rng(5)
-    for d, trial in itertools.product((2, 3), range(300)):
+    for d, _trial in itertools.product((2, 3), range(300)):
         n = int(rng.integers(1, 6))
         points = rng.integers(-2, 3, size=(n, d)).astype(float) * rng.choice([1.0, 1e-3, 1e4])
         prescribed = rng.random((n, d)) < 0.6

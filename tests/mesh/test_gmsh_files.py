@@ -72,7 +72,7 @@ def check_sides(mesh, names):
     """Each part holds exactly the edges of its side, counter-clockwise; the parts cover the boundary."""
     assert list(mesh.boundary) == list(names)
     lines = {"bottom": (1, 0.0), "load": (0, 3.0), "top": (1, 2.0), "clamped": (0, 0.0)}
-    for name, (side, (axis, value)) in zip(names, lines.items()):
+    for name, (_side, (axis, value)) in zip(names, lines.items()):
         ends = mesh.vertices[mesh.boundary[name]]
         assert (ends[:, :, axis] == value).all()
         assert np.abs(np.diff(ends[:, :, 1 - axis], axis=1)).sum() == (3.0 if axis == 1 else 2.0)

@@ -105,7 +105,7 @@ def gmsh_file(tmp_path, points, kind, cells, faces_by_name, fmt):
         out += ["$Nodes", str(len(points))] + [f"{i + 1} {x!r} {y!r} {z!r}" for i, (x, y, z) in enumerate(points)]
         out += ["$EndNodes", "$Elements", str(count)]
         k = 1
-        for dim, tag, gtype, group in blocks:
+        for _dim, tag, gtype, group in blocks:
             for nodes in group:
                 out.append(f"{k} {gtype} 2 {tag} {tag} " + " ".join(str(int(v) + 1) for v in nodes))
                 k += 1
@@ -153,7 +153,7 @@ def grid_cells(kind):
     mesh = extrude(base, 2, 1.0)
     tri = base.cell_vertices.reshape(-1, 3)
     n = base.n_vertices
-    return mesh, np.concatenate([np.hstack([tri + l * n, tri + (l + 1) * n]) for l in range(2)])
+    return mesh, np.concatenate([np.hstack([tri + layer * n, tri + (layer + 1) * n]) for layer in range(2)])
 
 
 @pytest.mark.parametrize("fmt", ["gmsh22", "gmsh"])

@@ -36,7 +36,7 @@ def _paper_tractions(scale):
     }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def scene(n, law=PAPER_LAW, gap=0.1, E=2000.0, traction_scale=1.0):
     """The paper's scene (SPEC §2) on square(n), with optional changes of law, gap and E."""
     return discrete_problem(
@@ -45,7 +45,7 @@ def scene(n, law=PAPER_LAW, gap=0.1, E=2000.0, traction_scale=1.0):
     )
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def contact_elsewhere(part):
     """Contact on the top edge (pushed up) or on the left edge (pushed left), right edge clamped."""
     if part == "top":

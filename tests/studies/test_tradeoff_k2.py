@@ -3,7 +3,6 @@ DOFs of the whole k = 2 space, k = 2 in the Pareto answer and in the k = 1 / k =
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from vemkit.config.scene import load_scene

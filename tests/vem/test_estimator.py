@@ -34,7 +34,7 @@ def test_the_estimate_vanishes_for_the_exact_solution_of_the_patch_test(case):
     grad = np.outer(c, [1.0, 0.0])
     eps = 0.5 * (grad + grad.T)
     sig = LAM * np.trace(eps) * np.eye(2) + 2 * MU * eps
-    tractions = {side: (lambda x, y, t=sig @ np.array(n, float): (t[0] + 0 * x, t[1] + 0 * x))
+    tractions = {side: (lambda x, y, t=sig @ np.array(n, float): (t[0] + 0 * x, t[1] + 0 * x))  # noqa: B008
                  for side, n in {"left": [-1, 0], "top": [0, 1], "bottom": [0, -1]}.items()}
     pb = discrete_problem(mesh, 2000.0, 0.4, dirichlet=("right",), neumann=tractions)
     u = pb.dofs.expand(linear_solver(pb.stiffness, "direct").solve(pb.load))

@@ -106,7 +106,7 @@ def test_projection_reproduces_linear_fields():
             v = (coords @ G.T + c).ravel()
             assert np.allclose(Pi @ v, v, atol=1e-12 * np.abs(v).max())
         G, c = rng.standard_normal((3, 3)), rng.standard_normal(3)
-        u = ELEMENT.interpolate(mesh, lambda x, y, z: tuple(G @ np.stack([x, y, z]) + c[:, None]))
+        u = ELEMENT.interpolate(mesh, lambda x, y, z: tuple(G @ np.stack([x, y, z]) + c[:, None]))  # noqa: B023 - used in this iteration
         projected = ELEMENT.project(mesh, u)
         cells = np.arange(mesh.n_cells)
         points = rng.standard_normal((mesh.n_cells, 3))

@@ -60,10 +60,15 @@ def _validator() -> jsonschema.Draft202012Validator:
     return jsonschema.Draft202012Validator(scene_schema())
 
 
+def _schema() -> dict:
+    """The validator's schema: the dict of :func:`scene_schema`, read once."""
+    return _validator().schema  # type: ignore[return-value]  # typed as a bool or a Mapping
+
+
 def _resolve(node: dict) -> dict:
     """``node`` with a local ``$ref`` merged in (sibling keywords win)."""
     while "$ref" in node:
-        target = _validator().schema["$defs"][node["$ref"].rsplit("/", 1)[-1]]
+        target = _schema()["$defs"][node["$ref"].rsplit("/", 1)[-1]]
         node = {**target, **{k: v for k, v in node.items() if k != "$ref"}}
     return node
 
@@ -156,7 +161,7 @@ def _apply_override(data: dict, override: str) -> None:
         raise SceneError(f"--set {override}: expected key.path=value, e.g. --set solver.method=uzawa")
     segments = _key_segments(override, key_text.strip())
     value = _parse_yaml(value_text, f"--set {override}")
-    node, container, path = _resolve(_validator().schema), data, []
+    node, container, path = _resolve(_schema()), data, list[str | int]()
     for position, segment in enumerate(segments):
         node = _schema_step(node, segment, container, override, path)
         last = position == len(segments) - 1
@@ -252,7 +257,7 @@ def _schema_error_message(error, fix=_scene_fix) -> str:
                f"--set {_key([*path, missing])}=..."
     if keyword == "minItems" and key == "boundary.dirichlet":
         return f"boundary.dirichlet = []: {NO_DIRICHLET}"
-    if keyword == "pattern" and schema == _validator().schema["$defs"]["side"]:
+    if keyword == "pattern" and schema == _schema()["$defs"]["side"]:
         return f"{key} = {_show(value)}: not a side name (letters, digits, _ and -); fix the scene"
     bound = error.validator_value
     if keyword == "type":
@@ -356,6 +361,9 @@ class Scene:
     """
 
     __slots__ = ("_data", "_expressions", "source")
+    _data: dict
+    _expressions: dict
+    source: str | None
 
     def __init__(self, data: dict, expressions: dict, source: str | None = None):
         object.__setattr__(self, "_data", data)
@@ -371,7 +379,7 @@ class Scene:
     def __eq__(self, other):
         return isinstance(other, Scene) and self._data == other._data
 
-    __hash__ = None
+    __hash__ = None  # type: ignore[assignment]  # equal scenes compare equal: unhashable
 
     def __repr__(self) -> str:
         return f"Scene(name={self.name!r}, source={self.source!r})"
@@ -499,7 +507,7 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
     for override in overrides:
         _apply_override(data, override)
     _validate(data)
-    normalized = _normalized(data, _validator().schema)
+    normalized = _normalized(data, _schema())
     expressions = _semantic_checks(normalized, data)
     return Scene(normalized, expressions, source)
 

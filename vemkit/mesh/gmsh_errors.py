@@ -181,7 +181,7 @@ def _elements_4(lines, start: int, end: int, tags: set) -> None:
 @contextmanager
 def meshio_warnings(notes: list):
     """meshio's gmsh warnings collected in ``notes`` instead of printed on the terminal."""
-    modules = [m for m in vars(meshio.gmsh).values() if hasattr(m, "warn") and callable(getattr(m, "warn"))
+    modules = [m for m in vars(meshio.gmsh).values() if hasattr(m, "warn") and callable(m.warn)
                and getattr(m, "__name__", "").startswith("meshio.gmsh")]
     saved = [(m, m.warn) for m in modules]
     for module in modules:

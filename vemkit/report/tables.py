@@ -137,7 +137,7 @@ def _grid(ds: xr.Dataset, family: str):
     for norm, stab in groups:
         norm_name = NORMS[norm][2]
         by_h = {r["h"]: r for r in rows if r["stabilization"] == stab and r["norm"] == norm}
-        get = lambda key, kind: [_fmt(by_h[h][key], kind) if h in by_h else "–" for h in hs]  # noqa: E731
+        get = lambda key, kind: [_fmt(by_h[h][key], kind) if h in by_h else "–" for h in hs]  # noqa: E731, B023 - used in this iteration
         lines += [(stab, norm_name, "error", get("error", "error")),
                   (stab, norm_name, "ratio to paper", get("ratio", "ratio")),
                   (stab, norm_name, "order", get("order", "order")),

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
+from collections.abc import Callable
 from contextlib import contextmanager, nullcontext
 
 import numpy as np
@@ -21,6 +22,7 @@ import numpy as np
 from vemkit.exceptions import ConvergenceError, SceneError, TimeBudgetExceeded
 
 from vemkit.solvers.ssn import solve_ssn
+from vemkit.solvers.solution import ContactSolution
 from vemkit.solvers.uzawa import solve_uzawa
 
 USER_BLAS_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -79,7 +81,7 @@ def solve(problem, solver_options: dict, progress=None, initial=None):
     if method == "uzawa":
         uzawa_keys = ("rho", "eps_u", "eps_lambda", "stop", "max_iterations")
         kwargs = {k: opts[k] for k in uzawa_keys if opts.get(k) is not None}
-        run = solve_uzawa
+        run: Callable[..., ContactSolution] = solve_uzawa
     elif method == "ssn":
         kwargs = {"max_iterations": opts["max_iterations"]} if opts.get("max_iterations") else {}
         run = solve_ssn

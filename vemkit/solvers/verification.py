@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -140,7 +140,7 @@ def failed(method: str, exc: BaseException, phase: str, wall_time: float = 0.0) 
     return Outcome(method, status, message, wall_time=wall_time, iterations=int(getattr(exc, "iterations", -1)))
 
 
-@lru_cache(maxsize=None)
+@cache
 def prebuilt_linear_supported() -> bool:
     """Whether the contact solvers take a prebuilt ``linear`` solver: both hand ``linear`` to
     ``vemkit.solvers.linear.linear_solver``, which returns a solver built earlier as it is (once it

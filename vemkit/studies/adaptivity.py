@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from vemkit.contact.problem import scene_problem
+from vemkit.contact.problem import DiscreteProblem, scene_problem
 from vemkit.config.limits import check_resources, estimate_resources
 from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
@@ -37,7 +37,7 @@ from vemkit.mesh.families import checked_mesh, scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
-from vemkit.solvers.solution import contact_state
+from vemkit.solvers.solution import ContactSolution, contact_state
 from vemkit.studies.convergence import RECORD_KEYS
 from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
@@ -75,8 +75,8 @@ class AdaptivitySettings:
 
 @dataclass
 class AdaptiveRun:
-    problem: object  # the last DiscreteProblem
-    solution: object  # its ContactSolution
+    problem: DiscreteProblem  # the last one
+    solution: ContactSolution  # its solution
     indicators: dict  # error_indicators of the last solution
     history: list = field(default_factory=list)  # one dict per step (the keys of HISTORY_ATTRS)
     reason: str = ""  # why the loop stopped: target, max_dofs, memory, max_steps, unrefinable

@@ -92,7 +92,7 @@ class VirtualElementSpace:
         if self.element.dimension == 3:
             faces = np.asarray(edges, dtype=np.int64).ravel()
             if faces.size:
-                mask[np.concatenate([self.mesh.face(f) for f in faces])] = True
+                mask[np.concatenate([self.mesh.face(f) for f in faces])] = True  # type: ignore[attr-defined]  # a PolyhedralMesh
             return mask
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if edges.size:

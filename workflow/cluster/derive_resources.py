@@ -149,7 +149,7 @@ def main(argv=None) -> int:
         return 1
     local = local_rules()
     derived = {rule: derive(r, patterns[rule][1]) for rule, r in rows.items() if rule not in local}
-    print(f"| rule | measured | mem_mb | runtime (min) | cpus_per_task |\n|---|---|---|---|---|")
+    print("| rule | measured | mem_mb | runtime (min) | cpus_per_task |\n|---|---|---|---|---|")
     for rule, res in sorted(derived.items()):
         print(f"| {rule} | {res['measured']} | {res['mem_mb']} | {res['runtime']} | {res['cpus_per_task']} |")
     if args.write:

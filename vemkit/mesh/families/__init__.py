@@ -18,6 +18,8 @@ is named after the side it lies on.
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable
+from typing import Any
 
 from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.square import square, structured_triangle
@@ -30,7 +32,7 @@ from vemkit.mesh.mesh import Mesh
 FAMILIES = ("square", "triangle", "voronoi", "hanging")
 TRIANGLE_KINDS = ("delaunay", "structured")
 
-_BUILDERS = {
+_BUILDERS: dict[str | tuple[str, str], Callable[..., Mesh]] = {
     "square": square,
     ("triangle", "delaunay"): delaunay_triangle,
     ("triangle", "structured"): structured_triangle,
@@ -45,7 +47,7 @@ def family_builder(family: str, options: dict):
     if family not in FAMILIES:
         raise MeshError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}",
                         key="family")
-    key = family
+    key: str | tuple[str, str] = family
     if family == "triangle":
         kind = options.pop("kind", "delaunay")
         if kind not in TRIANGLE_KINDS:
@@ -92,6 +94,7 @@ def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
     ``vemkit.mesh.checks3d.validate_mesh3d``); a MeshError naming ``what`` was built and ``fix``
     otherwise. Every mesh a command solves or writes passes here or through
     ``vemkit.mesh.files.read_mesh``: ``vemkit solve``, ``adapt`` and ``mesh`` refuse the same meshes."""
+    validate_mesh: Callable[..., None]  # the 2D or the 3D check
     if getattr(mesh, "dimension", 2) == 3:
         from vemkit.mesh.checks3d import validate_mesh3d as validate_mesh
     else:
@@ -109,6 +112,7 @@ def scene_mesh(scene) -> Mesh:
     one of n / h / cells (:func:`checked_mesh`), or its mesh file (SPEC §8, read and validated)."""
     three_d = scene.dimension == 3
     if scene.mesh_file is not None:
+        read_mesh: Callable[..., Any]  # the 2D or the 3D reader
         if three_d:
             from vemkit.mesh.files3d import read_mesh3d as read_mesh
         else:
@@ -120,6 +124,7 @@ def scene_mesh(scene) -> Mesh:
     sizes = {key: opts.pop(key) for key in ("n", "h", "cells") if key in opts}
     # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7, §10)
     size = ", ".join(f"{key} = {value:g}" for key, value in sizes.items())
+    build: Callable[..., Any]  # build_mesh or build_mesh3d
     if three_d:  # the 3D families build on the 2D ones (prisms): imported here, not at the top
         from vemkit.mesh.families3d import build_mesh3d as build
     else:

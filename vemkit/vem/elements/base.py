@@ -42,7 +42,9 @@ vertices, edges, cells (``layout``). Each element module provides:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib import import_module
+from typing import Any
 
 STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
 
@@ -77,6 +79,16 @@ class Element:
 
     kernel_module: str  # the module of the element's Numba hooks ``workspace`` and ``cell_matrix``
     fields_module: str  # the module of its loads, projected fields and interpolation
+
+    # the hooks every element class defines (module docstring), declared for the type checker
+    cell_nodes: Callable[..., tuple]
+    node_coordinates: Callable[..., Any]
+    dirichlet_components: Callable[..., tuple]
+    interpolate: Callable[..., Any]
+    project: Callable[..., Any]
+    edge_trace: Callable[..., Any]
+    traction_load: Callable[..., Any]
+    body_force_load: Callable[..., Any]
 
     # the kernels and fields are imported on first use: the element's facts (layout, ...) cost no Numba import
     @property
