@@ -27,16 +27,17 @@ def random_polyhedra(seed=0, count=4):
 
 
 def local_matrices(mesh, stabilization="dofi-2mu"):
-    """Yield (coords, faces, K) for every cell: the kernel's local stiffness."""
+    """Yield (coords, faces, K, h_K) for every cell: the kernel's local stiffness and its
+    stabilization length."""
     geometry = ELEMENT.geometry(mesh)
     offsets, ids = ELEMENT.cell_nodes(mesh)
     work = ELEMENT.workspace(int(np.diff(offsets).max()))
-    _, cell_face_ptr, face_ptr, face_local = geometry
+    _, cell_face_ptr, face_ptr, face_local, lengths = geometry
     for c in range(mesh.n_cells):
         n = offsets[c + 1] - offsets[c]
         K = ELEMENT.cell_matrix(c, geometry, offsets, ids, LAM, MU, stabilization_code(stabilization), work)
         faces = [face_local[face_ptr[t]:face_ptr[t + 1]] for t in range(cell_face_ptr[c], cell_face_ptr[c + 1])]
-        yield mesh.vertices[ids[offsets[c]:offsets[c + 1]]], faces, K[:3 * n, :3 * n].copy()
+        yield mesh.vertices[ids[offsets[c]:offsets[c + 1]]], faces, K[:3 * n, :3 * n].copy(), lengths[c]
 
 
 def planar_polygon(rng, m):
@@ -79,15 +80,15 @@ def test_face_weights_integrate_linear_functions_exactly(m):
 def test_kernel_equals_its_numpy_twin(stabilization):
     worst = 0.0
     for mesh in random_polyhedra():
-        for coords, faces, K in local_matrices(mesh, stabilization):
-            K_ref, _ = element_stiffness_reference(coords, faces, LAM, MU, stabilization)
+        for coords, faces, K, length in local_matrices(mesh, stabilization):
+            K_ref, _ = element_stiffness_reference(coords, faces, LAM, MU, stabilization, length)
             worst = max(worst, np.abs(K - K_ref).max() / np.abs(K_ref).max())
     assert worst < 1e-12
 
 
 def test_stiffness_kernel_is_exactly_the_rigid_motions():
     for mesh in random_polyhedra(seed=1, count=2):
-        for coords, _, K in local_matrices(mesh):
+        for coords, _, K, _length in local_matrices(mesh):
             modes = rigid_body_modes(coords)
             assert modes.shape == (3 * len(coords), 6)
             assert np.abs(K @ modes).max() < 1e-12 * np.abs(K).max() * max(1.0, np.abs(coords).max())
@@ -100,7 +101,7 @@ def test_projection_reproduces_linear_fields():
     """Pi v = v for every linear v (the patch test on one cell), on every kind of cell."""
     rng = np.random.default_rng(5)
     for mesh in random_polyhedra(seed=2, count=2):
-        for coords, faces, _ in local_matrices(mesh):
+        for coords, faces, _, _length in local_matrices(mesh):
             _, Pi = element_stiffness_reference(coords, faces, LAM, MU)
             G, c = rng.standard_normal((3, 3)), rng.standard_normal(3)
             v = (coords @ G.T + c).ravel()
@@ -112,3 +113,16 @@ def test_projection_reproduces_linear_fields():
         points = rng.standard_normal((mesh.n_cells, 3))
         assert np.allclose(projected.evaluate(cells, points), points @ G.T + c, atol=1e-12 * np.abs(G).sum() * 10)
         assert np.allclose(projected.gradient_at(cells, points), G[None], atol=1e-12)
+
+
+def test_stabilization_length_is_half_the_height_of_right_prisms_and_the_diameter_otherwise():
+    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.families3d import extrude, voronoi
+    from vemkit.vem.elements.k1_3d import stabilization_lengths
+
+    prisms = extrude(build_mesh("voronoi", 4, seed=1), layers=3, depth=0.6)
+    assert np.allclose(stabilization_lengths(prisms), 0.1, rtol=1e-12)  # layers of height 0.2
+    tilted = mapped(prisms, np.array([[1.0, 0.0, 0.3], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.zeros(3))
+    assert np.array_equal(stabilization_lengths(tilted), tilted.cell_diameters)  # no longer right prisms
+    polyhedra = voronoi(3, seed=2)
+    assert np.array_equal(stabilization_lengths(polyhedra), polyhedra.cell_diameters)

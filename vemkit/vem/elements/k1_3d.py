@@ -97,9 +97,10 @@ class FirstOrder3D(Element):
         return mesh.cell_vertex_lists
 
     def geometry(self, mesh):
-        """(vertices, cell_face_ptr, face_ptr, face_local): what ``cell_matrix`` reads (``local_faces``)."""
+        """(vertices, cell_face_ptr, face_ptr, face_local, stabilization lengths): what ``cell_matrix``
+        reads (``local_faces``, ``stabilization_lengths``)."""
         if mesh not in _FACES:
-            _FACES[mesh] = local_faces(mesh)
+            _FACES[mesh] = local_faces(mesh) + (stabilization_lengths(mesh),)
         return (mesh.vertices,) + _FACES[mesh]
 
     def node_coordinates(self, mesh) -> np.ndarray:

@@ -26,7 +26,8 @@ with the vertex inertia M = mean(|d|^2 I - d d^T) for the axial vector omega of 
 every linear v, so Pi reproduces linear fields, rigid motions included.
 
 The local form (3.9) is a_h^K = |K| B^T D B + alpha_K (I - Pi)^T (I - Pi) (dofi-dofi S_K). The
-scalings are those of 2D times h_K^(d - 2) = h_K (the cell's diameter): alpha_K = h_K (dofi),
+scalings are those of 2D times h_K^(d - 2) = h_K (the cell's diameter; half the height of a right
+prism along z, ``k1_3d.stabilization_lengths``): alpha_K = h_K (dofi),
 2 mu h_K (dofi-2mu), tr(|K| B^T D B) / 3n (trace, which scales by itself). The dofi-dofi form must
 scale like a_K(phi_i, phi_i) ~ |K| / h_K^2 ~ h_K^(d - 2): in 2D that is 1 (the paper's alpha_K),
 in 3D without the factor h_K the stabilization outgrows the consistency as h -> 0 and the
@@ -245,16 +246,19 @@ def diameter(p):
 
 
 @numba.njit(cache=True)
-def element_stiffness(p, face_ptr, face_local, f_lo, f_hi, lam, mu, stab, K, B, P, R, q, w):
+def element_stiffness(p, face_ptr, face_local, f_lo, f_hi, lam, mu, stab, length, K, B, P, R, q, w):
     """Local stiffness (3.9) of the polyhedron with vertices p (n, 3) and outward faces
     face_local[face_ptr[f]:face_ptr[f + 1]] (local vertex numbers), f_lo <= f < f_hi, into K (3n x 3n).
-    stab: 0 dofi (alpha = h_K), 1 dofi-2mu (alpha = 2 mu h_K), 2 trace (alpha = tr(Kc) / 3n). Returns |K|."""
+    stab: 0 dofi (alpha = h_K), 1 dofi-2mu (alpha = 2 mu h_K), 2 trace (alpha = tr(Kc) / 3n), h_K =
+    ``length`` (``k1_3d.stabilization_lengths``: the diameter, half the height of a right prism along
+    z); a negative ``length``: the diameter of p. Returns |K|."""
     m = 3 * p.shape[0]
     volume = boundary_vectors(p, face_ptr, face_local, f_lo, f_hi, q, w)
     strain_operator(q, volume, B)
     xb = projection_coefficients(p, B, P)
     tr = consistency(B, volume, lam, mu, K)
-    alpha = diameter(p) if stab == 0 else (2.0 * mu * diameter(p) if stab == 1 else tr / m)
+    h = length if length >= 0.0 else diameter(p)
+    alpha = h if stab == 0 else (2.0 * mu * h if stab == 1 else tr / m)
     residual_transpose(p, xb, P, R)
     add_stabilization(R, alpha, K)
     return volume
@@ -262,7 +266,7 @@ def element_stiffness(p, face_ptr, face_local, f_lo, f_hi, lam, mu, stab, K, B, 
 
 # --------------------------------------------------------------------------------------------
 # the element's hooks for the one assembly of ``vemkit.vem.assembly``; ``geometry`` is the tuple of
-# ``FirstOrder3D.geometry``: (vertices, cell_face_ptr, face_ptr, face_local)
+# ``FirstOrder3D.geometry``: (vertices, cell_face_ptr, face_ptr, face_local, stabilization lengths)
 # --------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
 def workspace(max_nodes):
@@ -276,7 +280,7 @@ def workspace(max_nodes):
 def cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work):
     """The local stiffness (3.9) of cell c in its vertex order, in the leading 3n x 3n block of the
     returned work matrix."""
-    vertices, cell_face_ptr, face_ptr, face_local = geometry
+    vertices, cell_face_ptr, face_ptr, face_local, lengths = geometry
     K, B, P, R, p, q, w = work
     start = offsets[c]
     n = offsets[c + 1] - start
@@ -284,6 +288,6 @@ def cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work):
         for k in range(3):
             p[i, k] = vertices[nodes[start + i], k]
     m = 3 * n
-    element_stiffness(p[:n], face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], lam, mu, stab,
+    element_stiffness(p[:n], face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], lam, mu, stab, lengths[c],
                       K[:m, :m], B[:, :m], P[:, :m], R[:m, :m], q[:n], w)
     return K

@@ -41,9 +41,9 @@ def face_integral_weights(p):
     return area / m + area * grad @ centroid, normal
 
 
-def element_stiffness_reference(coords, faces, lam, mu, stabilization="dofi-2mu"):
+def element_stiffness_reference(coords, faces, lam, mu, stabilization="dofi-2mu", length=None):
     """(K, Pi_D) of the polyhedron with vertices ``coords`` (n, 3) and outward ``faces`` (lists of
-    local vertex numbers)."""
+    local vertex numbers); ``length``: h_K of the stabilization scaling (default the diameter)."""
     coords = np.asarray(coords, float)
     n = coords.shape[0]
     xb = coords.mean(axis=0)
@@ -77,7 +77,7 @@ def element_stiffness_reference(coords, faces, lam, mu, stabilization="dofi-2mu"
     D = np.stack([v.ravel() for v in values], axis=1)
     Pi = D @ coef
     Kc = coef.T @ G @ coef
-    h = max(np.linalg.norm(a - b) for a in coords for b in coords)  # h_K^(d - 2), d = 3 (``k1_3d_kernel``)
+    h = max(np.linalg.norm(a - b) for a in coords for b in coords) if length is None else length  # h_K^(d - 2)
     alpha_K = {"dofi": h, "dofi-2mu": 2 * mu * h, "trace": np.trace(Kc) / (3 * n)}[stabilization]
     R = np.eye(3 * n) - Pi
     return Kc + alpha_K * R.T @ R, Pi
