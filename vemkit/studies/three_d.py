@@ -26,9 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["base_scene", "boundary_polygons", "convergence_dataset", "lame_displacement", "lame_run",
+__all__ = ["base_scene", "boundary_polygons", "convergence_dataset", "records_dataset", "with_solver", "lame_displacement", "lame_run",
            "load_scene_data", "manufactured_body_force", "manufactured_run", "markdown_table",
-           "observed_rates", "plane_strain_difference", "plane_stress_difference", "vertex_match"]
+           "observed_rates", "plane_strain_difference", "plane_stress_difference", "vertex_match",
+           "write_solution_vtu"]
 
 
 def load_scene_data(path) -> dict:
@@ -36,6 +37,13 @@ def load_scene_data(path) -> dict:
     import yaml
 
     return yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+
+
+def with_solver(data: dict, solver: dict | None) -> dict:
+    """A copy of a scene mapping with ``solver`` (e.g. {linear: amg}) over its solver section."""
+    out = copy.deepcopy(data)
+    out["solver"] = {**out.get("solver", {}), **dict(solver or {})}
+    return out
 
 
 def _with_mesh(data: dict, **mesh) -> dict:
@@ -275,6 +283,32 @@ def markdown_table(records, columns, headers=None, formats=None) -> str:
     lines = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in columns) + "|"]
     lines += ["| " + " | ".join(cell(r, k) for k in columns) + " |" for r in records]
     return "\n".join(lines) + "\n"
+
+
+def records_dataset(records, dims, attrs: dict | None = None):
+    """A Dataset of ``records`` (dicts) on the grid of the distinct values of the keys ``dims`` (in
+    order of first appearance); every other numeric key becomes a variable (NaN where no record)."""
+    import xarray as xr
+
+    coords = {d: list(dict.fromkeys(r[d] for r in records)) for d in dims}
+    shape = tuple(len(coords[d]) for d in dims)
+    names = [k for k in records[0] if k not in dims and isinstance(records[0][k], (int, float))]
+    data = {k: np.full(shape, np.nan) for k in names}
+    for r in records:
+        at = tuple(coords[d].index(r[d]) for d in dims)
+        for k in names:
+            data[k][at] = r[k]
+    return xr.Dataset({k: (tuple(dims), v) for k, v in data.items()}, coords=coords, attrs=dict(attrs or {}))
+
+
+def write_solution_vtu(mesh, ds, path) -> None:
+    """The solution Dataset ``ds`` (mesh3d) on ``mesh`` as VTK polyhedra: point data displacement
+    (n, 3), cell data von_mises and the stress and strain components."""
+    from vemkit.mesh.files3d import write_vtu3d
+
+    u = np.stack([ds[c].values for c in ("u1", "u2", "u3")], axis=1)
+    cells = {k: ds[k].values for k in ds.data_vars if k == "von_mises" or k.startswith(("stress_", "strain_"))}
+    write_vtu3d(mesh, path, point_data={"displacement": u}, cell_data=cells)
 
 
 def boundary_polygons(mesh, displacement=None, scale: float = 1.0):
