@@ -39,3 +39,20 @@ def test_the_norms_of_a_quadratic_field_are_exact():
     by_differences = difference_gradient(plain, 1e-3)(np.array([0.3]), np.array([0.7]), np.array([0.2]))
     np.testing.assert_allclose(by_differences[..., 0], field.gradient(0.3, 0.7, 0.2), atol=1e-10)
     assert relative_exact_errors(mesh, _Zero(3), plain)["error_h1"] == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["box_manufactured", "extruded_manufactured"])
+def test_the_manufactured_scenes_carry_the_exact_body_force(name):
+    """config/scenes/3d/*_manufactured.yaml: f = -div C eps(u) of their exact u (sympy), and the two
+    scenes are the same problem."""
+    from pathlib import Path
+
+    from vemkit.studies.three_d import load_scene_data, manufactured_body_force
+
+    data = load_scene_data(Path(__file__).parents[2] / "config" / "scenes" / "3d" / f"{name}.yaml")
+    assert manufactured_body_force(data["exact"]["displacement"], data["material"]["E"], data["material"]["nu"]) \
+        == data["body_force"]
+    box = load_scene_data(Path(__file__).parents[2] / "config" / "scenes" / "3d" / "box_manufactured.yaml")
+    assert data["body_force"] == box["body_force"] and data["exact"] == box["exact"]
+    held = data["boundary"]["dirichlet"]
+    assert len(held) == 6 and all(v == data["exact"]["displacement"] for v in held.values())
