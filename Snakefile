@@ -3,8 +3,8 @@
 #   snakemake -j2 results/table1.nc      only what Table 1 needs
 #   snakemake --report report.html       the HTML report
 # Layout: workflow/rules/*.smk (rules), workflow/scripts/ (thin scripts calling vemkit),
-# config/config.yaml and config/sweeps.yaml (Snakemake's config; add yours with --configfile),
-# validated against workflow/schemas/{config,sweeps}.schema.yaml in common.smk.
+# config/config.yaml, config/sweeps.yaml, config/adaptivity.yaml, config/three_d.yaml (Snakemake's
+# config; add yours with --configfile), validated against workflow/schemas/*.schema.yaml in common.smk.
 from snakemake.utils import min_version
 
 min_version("8.0")
@@ -13,6 +13,7 @@ min_version("8.0")
 configfile: "config/config.yaml"
 configfile: "config/sweeps.yaml"
 configfile: "config/adaptivity.yaml"
+configfile: "config/three_d.yaml"
 
 
 report: "workflow/report/workflow.rst"
@@ -34,6 +35,9 @@ include: "workflow/rules/order2.smk"
 include: "workflow/rules/adaptivity.smk"
 # the shipped scenes against published references (not in `rule all`): `snakemake -j2 verification`
 include: "workflow/rules/verification.smk"
+# 3D verification: manufactured convergence, Lame, plane strain / plane stress (not in `rule all`):
+# `snakemake -j2 three_d`
+include: "workflow/rules/three_d.smk"
 
 
 rule all:

@@ -32,7 +32,7 @@ from vemkit.vem.interpolation import interpolate
 from vemkit.vem.quadrature import edge_quadrature, reference_quadrature
 
 __all__ = ["difference_gradient", "exact_errors", "nesting_subdivisions", "paper_error", "projection_error",
-           "relative_exact_errors", "seminorm_squared", "trace_error", "trace_errors"]
+           "error_quadrature", "relative_exact_errors", "seminorm_squared", "trace_error", "trace_errors"]
 
 
 def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=None, regions=None) -> dict:
@@ -83,31 +83,60 @@ def paper_error(coarse_mesh: Mesh, u_coarse: np.ndarray, ref_mesh: Mesh, u_ref: 
     return float(np.sqrt(seminorm_squared(areas, difference) / seminorm_squared(areas, ref_projected.gradient)))
 
 
+#: points per direction of the collapsed Gauss rule on every tetrahedron of a 3D cell's fan
+#: (``k1_3d_fields.tetrahedron_rule``: exact for degree 2 points - 3; 4 -> degree 5, as the 2D rule)
+QUADRATURE_POINTS_3D = 4
+#: on a 3D mesh the exact field is evaluated on at most this many quadrature points at once (bounded
+#: memory); 2D sums in one piece, as before
+CHUNK_POINTS_3D = 200_000
+
+
+def error_quadrature(mesh, degree: int = 5):
+    """(points (Q, d), weights (Q,), cells (Q,)) for the exact errors: in 2D the degree-``degree``
+    rule on a triangulation of every cell; on a 3D mesh (``mesh.dimension == 3``) the signed
+    tetrahedral fan of ``k1_3d_fields.cell_quadrature`` with QUADRATURE_POINTS_3D points per direction."""
+    if getattr(mesh, "dimension", 2) == 3:
+        from vemkit.vem.elements.k1_3d_fields import cell_quadrature  # the 3D element's own rule
+        return cell_quadrature(mesh, QUADRATURE_POINTS_3D)
+    return reference_quadrature(mesh, degree=degree)
+
+
 def exact_errors(mesh: Mesh, proj, u_exact, grad_exact, quadrature=None) -> dict:
     """Absolute L2 and H1-seminorm errors of Pi u_h (any projection) against an exact solution.
 
-    u_exact(x, y) -> (u1, u2); grad_exact(x, y) -> ((du1/dx, du1/dy), (du2/dx, du2/dy)).
-    A degree-5 rule on a triangulation of each cell is used unless ``quadrature`` is given.
+    u_exact(x, y) -> (u1, u2); grad_exact(x, y) -> ((du1/dx, du1/dy), (du2/dx, du2/dy)); on a 3D
+    mesh u_exact(x, y, z) -> (u1, u2, u3) and grad_exact(x, y, z) -> (3, 3, ...).
+    The rule of :func:`error_quadrature` is used unless ``quadrature`` is given.
     """
-    points, weights, cells = quadrature if quadrature is not None else reference_quadrature(mesh, degree=5)
-    ue = np.stack(np.broadcast_arrays(*u_exact(points[:, 0], points[:, 1])), axis=1)
-    ge = np.moveaxis(np.asarray(grad_exact(points[:, 0], points[:, 1]), dtype=float), -1, 0)
-    diff = proj.evaluate(cells, points) - ue
-    grad = proj.gradient_at(cells, points) - ge
-    return {
-        "l2": float(np.sqrt(np.sum(weights * np.sum(diff**2, axis=1)))),
-        "h1_semi": float(np.sqrt(np.sum(weights * np.sum(grad**2, axis=(1, 2))))),
-    }
+    points, weights, cells = quadrature if quadrature is not None else error_quadrature(mesh)
+    l2 = semi = 0.0
+    chunk = CHUNK_POINTS_3D if points.shape[1] == 3 else max(points.shape[0], 1)
+    for start in range(0, points.shape[0], chunk):
+        part = slice(start, start + chunk)
+        x, w, c = points[part], weights[part], cells[part]
+        ue = np.stack(np.broadcast_arrays(*u_exact(*x.T)), axis=1).astype(float)
+        ge = np.moveaxis(np.asarray(grad_exact(*x.T), dtype=float), -1, 0)
+        diff = proj.evaluate(c, x) - ue
+        grad = proj.gradient_at(c, x) - ge
+        l2 += float(np.sum(w * np.sum(diff**2, axis=1)))
+        semi += float(np.sum(w * np.sum(grad**2, axis=(1, 2))))
+    return {"l2": float(np.sqrt(l2)), "h1_semi": float(np.sqrt(semi))}
 
 
 def difference_gradient(field, step: float):
-    """grad_exact for :func:`exact_errors` from field(x, y) -> (u1, u2) alone, by fourth-order
-    central differences of width ``step`` (truncation O(step^4), rounding O(eps / step))."""
-    def grad(x, y):
-        out = np.empty((2, 2) + np.shape(x))
-        for axis in (0, 1):
-            shifted = [field(x + s * step, y) if axis == 0 else field(x, y + s * step) for s in (-2, -1, 1, 2)]
-            for c in (0, 1):
+    """grad_exact for :func:`exact_errors` from field(x, y) -> (u1, u2) alone (or, in 3D,
+    field(x, y, z) -> (u1, u2, u3)), by fourth-order central differences of width ``step``
+    (truncation O(step^4), rounding O(eps / step))."""
+    def grad(*x):
+        d = len(x)
+        out = None
+        for axis in range(d):
+            def at(s):
+                return field(*(xi + s * step if i == axis else xi for i, xi in enumerate(x)))
+            shifted = [at(s) for s in (-2, -1, 1, 2)]
+            if out is None:
+                out = np.empty((len(shifted[0]), d) + np.shape(x[0]))
+            for c in range(out.shape[0]):
                 out[c, axis] = (shifted[0][c] - 8.0 * shifted[1][c] + 8.0 * shifted[2][c] - shifted[3][c]) / (12.0 * step)
         return out
     return grad
@@ -118,12 +147,14 @@ def relative_exact_errors(mesh: Mesh, proj, u_exact) -> dict:
     u_exact(x, y) -> (u1, u2): ``error_l2`` = ||Pi u_h - u|| / ||u||, ``error_h1_semi`` = |.|_1 / |u|_1,
     ``error_h1`` with the full H1 norm; a degree-5 rule on a triangulation of every cell, the
     gradient of u exact (``u_exact.gradient``, e.g. of ``vemkit.config.expressions.vector_field``) or,
-    for a plain callable, by :func:`difference_gradient` with a step of 1e-3 times the body's size."""
-    quadrature = reference_quadrature(mesh, degree=5)
+    for a plain callable, by :func:`difference_gradient` with a step of 1e-3 times the body's size.
+    On a 3D mesh (SPEC §10) the same with u_exact(x, y, z) -> (u1, u2, u3) and the tetrahedral-fan
+    rule of :func:`error_quadrature`."""
+    quadrature = error_quadrature(mesh)
     step = 1e-3 * float(np.ptp(mesh.vertices, axis=0).max())
     grad = getattr(u_exact, "gradient", None) or difference_gradient(u_exact, step)  # exact if the field has it
     absolute = exact_errors(mesh, proj, u_exact, grad, quadrature)
-    zero = exact_errors(mesh, _Zero(), u_exact, grad, quadrature)
+    zero = exact_errors(mesh, _Zero(mesh.vertices.shape[1]), u_exact, grad, quadrature)
     tiny = np.finfo(float).tiny
     return {"error_l2": absolute["l2"] / max(zero["l2"], tiny),
             "error_h1_semi": absolute["h1_semi"] / max(zero["h1_semi"], tiny),
@@ -131,13 +162,16 @@ def relative_exact_errors(mesh: Mesh, proj, u_exact) -> dict:
 
 
 class _Zero:
-    """The zero field as a projection: the norms of the exact solution itself."""
+    """The zero field as a projection (in ``dimension`` 2 or 3): the norms of the exact solution itself."""
+
+    def __init__(self, dimension: int = 2):
+        self.dimension = dimension
 
     def evaluate(self, cells, points):
-        return np.zeros((points.shape[0], 2))
+        return np.zeros((points.shape[0], self.dimension))
 
     def gradient_at(self, cells, points):
-        return np.zeros((points.shape[0], 2, 2))
+        return np.zeros((points.shape[0], self.dimension, self.dimension))
 
 
 # --------------------------------------------------------------------------------------------

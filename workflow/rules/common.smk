@@ -17,6 +17,7 @@ CONFIG_PARTS = {
     "paper": ("../schemas/config.schema.yaml", "config/config.yaml"),
     "studies": ("../schemas/sweeps.schema.yaml", "config/sweeps.yaml"),
     "adaptivity": ("../schemas/adaptivity.schema.yaml", "config/adaptivity.yaml"),
+    "three_d": ("../schemas/three_d.schema.yaml", "config/three_d.yaml"),
 }
 
 

@@ -1,0 +1,53 @@
+"""`snakemake three_d` (dry runs: nothing is solved): one job per manufactured case of
+config/three_d.yaml, one per study, a figure per case, not in the default target; bad settings are
+refused naming the key."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[2]
+THREE_D = yaml.safe_load((ROOT / "config" / "three_d.yaml").read_text())["three_d"]
+
+
+def dry_run(*args) -> subprocess.CompletedProcess:
+    exe = Path(sys.executable).with_name("snakemake")
+    exe = str(exe) if exe.exists() else shutil.which("snakemake")
+    if exe is None:
+        pytest.skip("snakemake is not installed")
+    return subprocess.run([exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120)
+
+
+def planned(*args) -> dict:
+    run = dry_run(*args)
+    assert run.returncode == 0, run.stdout + run.stderr
+    stats = run.stdout[run.stdout.index("Job stats:"):]
+    stats = stats[:stats.index("total")]
+    return {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)}
+
+
+def test_three_d_plans_every_case_and_study_and_is_not_in_the_default_target():
+    jobs = planned("three_d")
+    cases = len(THREE_D["manufactured"])
+    assert cases >= 5
+    assert jobs == {"three_d": 1, "three_d_manufactured": cases, "three_d_convergence": 1, "three_d_lame": 1,
+                    "three_d_plane_strain": 1, "three_d_plane_stress": 1, "three_d_figure": cases + 1}
+    assert not any(rule.startswith("three_d") for rule in planned())
+    for case in THREE_D["manufactured"].values():
+        assert (ROOT / case["scene"]).is_file()
+
+
+def test_a_bad_setting_is_refused_naming_the_key(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump({"three_d": {**THREE_D, "lame": {**THREE_D["lame"], "families": ["hex"]}}}))
+    run = dry_run("three_d", "--configfile", str(path))
+    assert run.returncode != 0
+    assert "three_d.lame.families[0]" in run.stdout + run.stderr
