@@ -51,6 +51,14 @@ def verified(problem, solution, solver_options, where: str = "", source: str = "
     return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
 
 
+def mesh_family(mesh) -> str:
+    """The family that made ``mesh``; prisms over a 2D mesh (SPEC §10): ``extrude:`` and the base's family."""
+    family = str(mesh.meta.get("family", ""))
+    if family == "extrude":
+        family += ":" + str(mesh.meta.get("base", {}).get("family", ""))
+    return family
+
+
 def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False):
     """Solve a scene; returns (problem, solution, dataset).
 
@@ -62,7 +70,7 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
         raise MeshError(f"the mesh has {problem.mesh.n_cells} cells and {problem.n_dofs} free DOFs; "
                         "nothing to solve: check discretization.mesh", key="discretization.mesh")
     solution = solve(problem, scene.solver_options, progress=progress)
-    attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
+    attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": mesh_family(problem.mesh)}
     if verify:
         attrs.update(verified(problem, solution, scene.solver_options))
     if scene.exact_displacement is not None:  # SPEC §7: relative errors of Pi u_h against the exact field
