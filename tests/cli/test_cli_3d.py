@@ -184,3 +184,30 @@ def test_a_gmsh_3d_file_solves_and_its_header_is_checked_first(tmp_path):
     run = vemkit("solve", tmp_path / "g.yaml", "-o", tmp_path / "h.nc", "--max-dofs", "50")
     assert run.returncode == 2 and "more than the limit of 50 DOFs" in run.stderr
     assert not (tmp_path / "h.nc").exists()
+
+
+def test_vtk_the_reader_of_paraview_opens_the_polyhedra(tmp_path):
+    """The VTU file as ParaView reads it (vtkXMLUnstructuredGridReader): polyhedron cells with the
+    mesh's faces, volumes (vtkCellSizeFilter) equal to the mesh's, the point and cell data."""
+    vtk = pytest.importorskip("vtk")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    (tmp_path / "s.yaml").write_text(scene_text("voronoi", 4))
+    assert vemkit("solve", tmp_path / "s.yaml", "-o", tmp_path / "s.nc", "--vtu", tmp_path / "s.vtu", "-q").returncode == 0
+    mesh, ds = read_solution(tmp_path / "s.nc")
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(tmp_path / "s.vtu"))
+    reader.Update()
+    grid = reader.GetOutput()
+    assert grid.GetNumberOfCells() == mesh.n_cells and grid.GetNumberOfPoints() == mesh.n_vertices
+    assert {grid.GetCellType(c) for c in range(mesh.n_cells)} == {vtk.VTK_POLYHEDRON}
+    assert [grid.GetCell(c).GetNumberOfFaces() for c in range(mesh.n_cells)] == np.diff(mesh.cell_offsets).tolist()
+    sizes = vtk.vtkCellSizeFilter()
+    sizes.SetInputData(grid)
+    sizes.ComputeVolumeOn()
+    sizes.Update()
+    volumes = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
+    assert np.allclose(volumes, mesh.cell_volumes, rtol=1e-6)  # measured 2e-8: vtk's polyhedron volume
+    u = np.stack([ds[f"u{c}"].values for c in (1, 2, 3)], axis=1)
+    assert np.array_equal(vtk_to_numpy(grid.GetPointData().GetArray("displacement")), u)
+    assert np.array_equal(vtk_to_numpy(grid.GetCellData().GetArray("von_mises")), ds["von_mises"].values)
