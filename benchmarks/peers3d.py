@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 import yaml
+from peers import PEERS, SKFEM_DIRECT_MAX_DOFS, VEMKIT, measured, relative_difference
 
 from _common import MACHINE, write_report
-from peers import PEERS, SKFEM_DIRECT_MAX_DOFS, VEMKIT, measured, relative_difference
 
 E, NU = 1000.0, 0.3
 LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
@@ -35,10 +35,15 @@ TRACTION = [0.0, 0.0, -1.0]
 
 
 def scene(mesh_entry: dict) -> dict:
-    return {"name": "cube", "model": "3d", "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
-            "material": {"E": E, "nu": NU},
-            "boundary": {"dirichlet": ["bottom"], "neumann": {"top": {"traction": TRACTION}}},
-            "discretization": {"mesh": mesh_entry}, "solver": {"tol": 1e-12}}
+    return {
+        "name": "cube",
+        "model": "3d",
+        "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
+        "material": {"E": E, "nu": NU},
+        "boundary": {"dirichlet": ["bottom"], "neumann": {"top": {"traction": TRACTION}}},
+        "discretization": {"mesh": mesh_entry},
+        "solver": {"tol": 1e-12},
+    }
 
 
 def run_case(n: int, work: Path) -> list[dict]:
@@ -51,14 +56,22 @@ def run_case(n: int, work: Path) -> list[dict]:
     with xr.open_dataset(out) as ds:
         u_vem = np.stack([ds[f"u{c}"].values for c in (1, 2, 3)], axis=1)
         vertices = np.stack([ds[f"mesh3d_node_{a}"].values for a in "xyz"], axis=1)
-        vem.update(assembly_s=float(ds.attrs["assembly_time"]), solve_s=float(ds.attrs["wall_time"]),
-                   solver="ssn, linear solver auto")
+        vem.update(
+            assembly_s=float(ds.attrs["assembly_time"]),
+            solve_s=float(ds.attrs["wall_time"]),
+            solver="ssn, linear solver auto",
+        )
         faces = ds["mesh3d_face_nodes"].values.astype(np.int64)  # no fill in a tetrahedral mesh
         volumes = ds["mesh3d_volume_faces"].values.astype(np.int64)
     tets = _tetrahedra(faces, volumes)
     dofs = 3 * vertices.shape[0]
-    params = {"lam": LAM, "mu": MU, "traction": TRACTION, "cg_rtol": 1e-12,
-              "solver": "direct" if dofs <= SKFEM_DIRECT_MAX_DOFS else "amg"}
+    params = {
+        "lam": LAM,
+        "mu": MU,
+        "traction": TRACTION,
+        "cg_rtol": 1e-12,
+        "solver": "direct" if dofs <= SKFEM_DIRECT_MAX_DOFS else "amg",
+    }
     case, result = work / f"case-{n}.npz", work / f"skfem-{n}.npz"
     np.savez(case, vertices=vertices, tetrahedra=tets, params=json.dumps(params))
     peer = measured([sys.executable, str(PEERS / "skfem3d_solve.py"), str(case), str(result)])
@@ -66,9 +79,16 @@ def run_case(n: int, work: Path) -> list[dict]:
         info, u_peer = json.loads(str(r["info"])), r["u"]
     peer.update(assembly_s=info["setup_s"], solve_s=info["solve_s"], solver=info["solver"])
     base = {"n": n, "cells": int(tets.shape[0]), "dofs": dofs}
-    return [base | {"code": "vemkit"} | vem,
-            base | {"code": "skfem", "rel_diff_to_vemkit": relative_difference(u_peer, u_vem),
-                    "vemkit_over_peer_wall": vem["wall_s"] / peer["wall_s"]} | peer]
+    return [
+        base | {"code": "vemkit"} | vem,
+        base
+        | {
+            "code": "skfem",
+            "rel_diff_to_vemkit": relative_difference(u_peer, u_vem),
+            "vemkit_over_peer_wall": vem["wall_s"] / peer["wall_s"],
+        }
+        | peer,
+    ]
 
 
 def _tetrahedra(faces: np.ndarray, volumes: np.ndarray) -> np.ndarray:
@@ -91,20 +111,31 @@ def main() -> None:
     rows = []
     for n in [4, 8] if args.quick else args.sizes:
         rows += run_case(n, work)
-        print(rows[-2]["dofs"], [f"{r['code']} {r['wall_s']:.2f} s" for r in rows[-2:]],
-              f"diff {rows[-1]['rel_diff_to_vemkit']:.1e}", flush=True)
+        print(
+            rows[-2]["dofs"],
+            [f"{r['code']} {r['wall_s']:.2f} s" for r in rows[-2:]],
+            f"diff {rows[-1]['rel_diff_to_vemkit']:.1e}",
+            flush=True,
+        )
     shutil.rmtree(work)
     load = os.getloadavg()[0]
-    lines = ["# vemkit 3D k = 1 against scikit-fem P1 tetrahedra (benchmarks/peers3d.py)", "",
-             f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {load:.1f} at the end.", "",
-             "| n | cells | DOFs | code | solver | rel. diff. | wall s | max RSS MiB | assembly s | solve s "
-             "| vemkit/peer wall |", "|" + "---|" * 11]
+    lines = [
+        "# vemkit 3D k = 1 against scikit-fem P1 tetrahedra (benchmarks/peers3d.py)",
+        "",
+        f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {load:.1f} at the end.",
+        "",
+        "| n | cells | DOFs | code | solver | rel. diff. | wall s | max RSS MiB | assembly s | solve s "
+        "| vemkit/peer wall |",
+        "|" + "---|" * 11,
+    ]
     for r in rows:
         diff = f"{r['rel_diff_to_vemkit']:.1e}" if "rel_diff_to_vemkit" in r else "–"
         ratio = f"{r['vemkit_over_peer_wall']:.2f}" if "vemkit_over_peer_wall" in r else "–"
-        lines.append(f"| {r['n']} | {r['cells']:,} | {r['dofs']:,} | {r['code']} | {r['solver']} | {diff} | "
-                     f"{r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | {r['assembly_s']:.2f} | {r['solve_s']:.2f} "
-                     f"| {ratio} |")
+        lines.append(
+            f"| {r['n']} | {r['cells']:,} | {r['dofs']:,} | {r['code']} | {r['solver']} | {diff} | "
+            f"{r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | {r['assembly_s']:.2f} | {r['solve_s']:.2f} "
+            f"| {ratio} |"
+        )
     write_report("peers3d", {"machine": MACHINE, "load_average": load, "rows": rows}, lines)
 
 

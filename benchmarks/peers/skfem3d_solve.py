@@ -25,8 +25,9 @@ def assemble(case, p):
     basis = skfem.Basis(mesh, element, intorder=2)
     stiffness = skfem.asm(linear_elasticity(p["lam"], p["mu"]), basis)
     z0, z1 = mesh.p[2].min(), mesh.p[2].max()
-    top = skfem.FacetBasis(mesh, element, facets=mesh.facets_satisfying(lambda x: x[2] > z1 - 1e-9 * (z1 - z0)),
-                           intorder=2)
+    top = skfem.FacetBasis(
+        mesh, element, facets=mesh.facets_satisfying(lambda x: x[2] > z1 - 1e-9 * (z1 - z0)), intorder=2
+    )
     traction = np.array(p["traction"], dtype=float)
 
     @skfem.LinearForm
@@ -56,6 +57,7 @@ def linear_solve(stiffness, load, fixed, basis, p):
         return skfem.solve(*skfem.condense(stiffness, load, D=fixed))
     import pyamg
     from scipy.sparse.linalg import cg
+
     A, b, x, interior = skfem.condense(stiffness, load, D=fixed)
     ml = pyamg.smoothed_aggregation_solver(A, B=rigid_modes(basis)[interior], symmetry="symmetric")
     solution, status = cg(A, b, M=ml.aspreconditioner(), rtol=p["cg_rtol"], atol=0.0, maxiter=2000)
@@ -71,8 +73,13 @@ def main(case_path, out_path):
     assembled = time.perf_counter()
     u = linear_solve(stiffness, load, fixed, basis, p)
     solved = time.perf_counter()
-    info = {"setup_s": assembled - start, "solve_s": solved - assembled, "solver": p["solver"],
-            "n_dofs": int(basis.N), "skfem": skfem.__version__}
+    info = {
+        "setup_s": assembled - start,
+        "solve_s": solved - assembled,
+        "solver": p["solver"],
+        "n_dofs": int(basis.N),
+        "skfem": skfem.__version__,
+    }
     np.savez(out_path, u=np.stack([u[d] for d in basis.nodal_dofs], axis=1), info=json.dumps(info))
 
 

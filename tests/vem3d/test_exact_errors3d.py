@@ -15,10 +15,18 @@ LINEAR = ["0.01*x + 0.02*y - 0.03*z", "0.005*y - 0.01*x", "0.02*z + 0.01*x"]
 
 def scene(family, exact, n=2):
     held = {s: list(exact) for s in ("left", "right", "front", "back", "bottom", "top")}
-    return scene_from_dict({"name": "e", "model": "3d", "domain": {"box": [[0, 0, 0], [1, 2, 1]]},
-                            "material": {"E": 1.0, "nu": 0.3}, "boundary": {"dirichlet": held},
-                            "exact": {"displacement": list(exact)},
-                            "discretization": {"mesh": {"family": family, "n": n}}, "solver": {"tol": 1e-12}})
+    return scene_from_dict(
+        {
+            "name": "e",
+            "model": "3d",
+            "domain": {"box": [[0, 0, 0], [1, 2, 1]]},
+            "material": {"E": 1.0, "nu": 0.3},
+            "boundary": {"dirichlet": held},
+            "exact": {"displacement": list(exact)},
+            "discretization": {"mesh": {"family": family, "n": n}},
+            "solver": {"tol": 1e-12},
+        }
+    )
 
 
 @pytest.mark.parametrize("family", ["hex", "tet", "octree", "voronoi"])
@@ -50,8 +58,10 @@ def test_the_manufactured_scenes_carry_the_exact_body_force(name):
     from vemkit.studies.three_d import load_scene_data, manufactured_body_force
 
     data = load_scene_data(Path(__file__).parents[2] / "config" / "scenes" / "3d" / f"{name}.yaml")
-    assert manufactured_body_force(data["exact"]["displacement"], data["material"]["E"], data["material"]["nu"]) \
+    assert (
+        manufactured_body_force(data["exact"]["displacement"], data["material"]["E"], data["material"]["nu"])
         == data["body_force"]
+    )
     box = load_scene_data(Path(__file__).parents[2] / "config" / "scenes" / "3d" / "box_manufactured.yaml")
     assert data["body_force"] == box["body_force"] and data["exact"] == box["exact"]
     held = data["boundary"]["dirichlet"]

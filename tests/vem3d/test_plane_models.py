@@ -25,12 +25,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vemkit.studies.three_d import (base_scene, load_scene_data, plane_strain_difference,
-                                    plane_stress_difference)
+from vemkit.studies.three_d import base_scene, load_scene_data, plane_strain_difference, plane_stress_difference
 
 SCENES = Path(__file__).parents[2] / "config" / "scenes" / "3d"
-PLANE_STRAIN_CASES = [("triangle", 4, 1), ("triangle", 8, 3), ("triangle", 6, 5), ("square", 4, 1),
-                      ("square", 6, 3), ("voronoi", 4, 1), ("voronoi", 5, 3)]
+PLANE_STRAIN_CASES = [
+    ("triangle", 4, 1),
+    ("triangle", 8, 3),
+    ("triangle", 6, 5),
+    ("square", 4, 1),
+    ("square", 6, 3),
+    ("voronoi", 4, 1),
+    ("voronoi", 5, 3),
+]
 
 
 @pytest.fixture(scope="module")
@@ -61,8 +67,9 @@ def test_plane_strain_equals_the_3d_solve_on_extruded_meshes(paper3d, family, n,
 DEPTHS = (0.25, 0.125, 0.0625, 0.03125)
 
 
-@pytest.mark.parametrize(("family", "min_rate", "max_first"), [("square", 0.7, 0.06), ("triangle", 0.65, 0.08),
-                                                              ("voronoi", 0.7, 0.06)])
+@pytest.mark.parametrize(
+    ("family", "min_rate", "max_first"), [("square", 0.7, 0.06), ("triangle", 0.65, 0.08), ("voronoi", 0.7, 0.06)]
+)
 def test_a_thin_plate_tends_to_plane_stress(family, min_rate, max_first):
     data = load_scene_data(SCENES / "thin_plate.yaml")
     diffs = []
@@ -79,7 +86,9 @@ def test_a_thin_plate_tends_to_plane_stress(family, min_rate, max_first):
 
 def test_a_thin_plate_on_a_fixed_base_mesh_tends_to_plane_stress():
     data = load_scene_data(SCENES / "thin_plate.yaml")
-    diffs = [plane_stress_difference(data, "square", depth, n=8, layers=1)[0]["max_difference"]
-             for depth in (0.2, 0.1, 0.05, 0.025)]
+    diffs = [
+        plane_stress_difference(data, "square", depth, n=8, layers=1)[0]["max_difference"]
+        for depth in (0.2, 0.1, 0.05, 0.025)
+    ]
     print("fixed base mesh", diffs)
     assert np.all(np.diff(diffs) < 0) and diffs[-1] < 0.3 * diffs[0]  # measured 0.0374 -> 0.0092

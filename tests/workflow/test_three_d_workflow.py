@@ -22,15 +22,20 @@ def dry_run(*args) -> subprocess.CompletedProcess:
     exe = str(exe) if exe.exists() else shutil.which("snakemake")
     if exe is None:
         pytest.skip("snakemake is not installed")
-    return subprocess.run([exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 def planned(*args) -> dict:
     run = dry_run(*args)
     assert run.returncode == 0, run.stdout + run.stderr
-    stats = run.stdout[run.stdout.index("Job stats:"):]
-    stats = stats[:stats.index("total")]
+    stats = run.stdout[run.stdout.index("Job stats:") :]
+    stats = stats[: stats.index("total")]
     return {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)}
 
 
@@ -38,8 +43,15 @@ def test_three_d_plans_every_case_and_study_and_is_not_in_the_default_target():
     jobs = planned("three_d")
     cases = len(THREE_D["manufactured"])
     assert cases >= 5
-    assert jobs == {"three_d": 1, "three_d_manufactured": cases, "three_d_convergence": 1, "three_d_lame": 1,
-                    "three_d_plane_strain": 1, "three_d_plane_stress": 1, "three_d_figure": cases + 1}
+    assert jobs == {
+        "three_d": 1,
+        "three_d_manufactured": cases,
+        "three_d_convergence": 1,
+        "three_d_lame": 1,
+        "three_d_plane_strain": 1,
+        "three_d_plane_stress": 1,
+        "three_d_figure": cases + 1,
+    }
     assert not any(rule.startswith("three_d") for rule in planned())
     for case in THREE_D["manufactured"].values():
         assert (ROOT / case["scene"]).is_file()

@@ -12,9 +12,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.config.boundary_conditions import (PROBES, PlaneProbes, _dirichlet, boundary_expressions,
-                                               check_mesh_size, check_sides, compile_checked, evaluate_checked,
-                                               rigid_motion_error)
+from vemkit.config.boundary_conditions import (
+    PROBES,
+    PlaneProbes,
+    _dirichlet,
+    boundary_expressions,
+    check_mesh_size,
+    check_sides,
+    compile_checked,
+    evaluate_checked,
+    rigid_motion_error,
+)
 from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
@@ -82,36 +90,54 @@ def check_model_domain(data: dict) -> None:
     three_d = is_3d_domain(data["domain"])
     if three_d and data["model"] != "3d":
         kind = "box" if "box" in data["domain"] else "extrude"
-        raise SceneError(f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d "
-                         "(or give a 2D domain)", key="model")
+        raise SceneError(
+            f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d (or give a 2D domain)",
+            key="model",
+        )
     if data["model"] == "3d" and not three_d and "file" not in data["discretization"]["mesh"]:
-        raise SceneError("model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
-                         "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model", key="domain")
+        raise SceneError(
+            "model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
+            "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model",
+            key="domain",
+        )
 
 
 def _refuse_2d_only(data: dict, given: dict) -> None:
     discretization = data["discretization"]
     if discretization["order"] != 1:
-        raise SceneError(f"discretization.order = {discretization['order']}: 3D bodies have the k = 1 element "
-                         "only; set discretization.order=1", key="discretization.order")
+        raise SceneError(
+            f"discretization.order = {discretization['order']}: 3D bodies have the k = 1 element "
+            "only; set discretization.order=1",
+            key="discretization.order",
+        )
     if "body_force_projection" in given.get("discretization", {}):
-        raise SceneError("discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean "
-                         "of f1; drop it", key="discretization.body_force_projection")
+        raise SceneError(
+            "discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean of f1; drop it",
+            key="discretization.body_force_projection",
+        )
     if data["boundary"]["contact"] or "contact" in given:
-        raise SceneError("contact on 3D bodies is not available yet (SPEC §10, a coming release); drop "
-                         "boundary.contact and the contact section", key="boundary.contact")
+        raise SceneError(
+            "contact on 3D bodies is not available yet (SPEC §10, a coming release); drop "
+            "boundary.contact and the contact section",
+            key="boundary.contact",
+        )
 
 
 def _check_family(mesh: dict, body) -> None:
     family = mesh.get("family")
     valid = BOX_FAMILIES if isinstance(body, Box) else FAMILIES_2D + EXTRUDE_FAMILIES_3D
     if family is not None and family not in valid:
-        what = "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
-        raise SceneError(f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: "
-                         f"{', '.join(valid)}", key="discretization.mesh.family")
+        what = (
+            "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
+        )
+        raise SceneError(
+            f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: {', '.join(valid)}",
+            key="discretization.mesh.family",
+        )
     if "layers" in mesh and isinstance(body, Box):
-        raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
-                         key="discretization.mesh.layers")
+        raise SceneError(
+            "discretization.mesh.layers applies to an extrude domain only; remove it", key="discretization.mesh.layers"
+        )
 
 
 def _check_rigid_motions(data: dict, probes: BodyProbes) -> None:
@@ -145,8 +171,10 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
         _check_rigid_motions(data, probes)
     force = data["body_force"]
     if len(force) != DIMENSION:
-        raise SceneError(f"body_force has {len(force)} components; this 3D scene needs 3 ([f1_x, f1_y, f1_z]); "
-                         "fix the scene", key="body_force")
+        raise SceneError(
+            f"body_force has {len(force)} components; this 3D scene needs 3 ([f1_x, f1_y, f1_z]); fix the scene",
+            key="body_force",
+        )
     compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", force[i], DIMENSION) for i in range(3))
     for expression in compiled["body_force"] if probes is not None else ():
         evaluate_checked(expression, probes.inside())

@@ -28,15 +28,27 @@ def solution_dataset3d(problem, solution, *, scene_yaml: str = "", extra_attrs=N
     ds = mesh3d_to_dataset(problem.mesh)
     node, volume = f"{TOPOLOGY}_nNodes", f"{TOPOLOGY}_nVolumes"
     for c, axis in enumerate(AXES):
-        ds[f"u{c + 1}"] = (node, u[:, c], {"long_name": f"displacement along {axis}", "units": "mm",
-                                            "mesh": TOPOLOGY, "location": "node"})
-    cell = {"mesh": TOPOLOGY, "location": "volume",
-            "comment": "of the projection Pi_1 (3.8): constant per cell (k = 1)"}
+        ds[f"u{c + 1}"] = (
+            node,
+            u[:, c],
+            {"long_name": f"displacement along {axis}", "units": "mm", "mesh": TOPOLOGY, "location": "node"},
+        )
+    cell = {
+        "mesh": TOPOLOGY,
+        "location": "volume",
+        "comment": "of the projection Pi_1 (3.8): constant per cell (k = 1)",
+    }
     for k, ij in enumerate(COMPONENTS_3D):
         ds[f"strain_{ij}"] = (volume, strain[:, k], dict(cell, long_name=f"strain eps{ij} of Pi u", units="1"))
     for k, ij in enumerate(COMPONENTS_3D):
-        ds[f"stress_{ij}"] = (volume, sigma[:, k], dict(cell, long_name=f"stress sigma{ij} = C eps(Pi u)",
-                                                         units="daN/mm2"))
-    ds["von_mises"] = (volume, von_mises(sigma), dict(cell, long_name="von Mises stress sqrt(3/2 |dev sigma|^2)",
-                                                       units="daN/mm2"))
+        ds[f"stress_{ij}"] = (
+            volume,
+            sigma[:, k],
+            dict(cell, long_name=f"stress sigma{ij} = C eps(Pi u)", units="daN/mm2"),
+        )
+    ds["von_mises"] = (
+        volume,
+        von_mises(sigma),
+        dict(cell, long_name="von Mises stress sqrt(3/2 |dev sigma|^2)", units="daN/mm2"),
+    )
     return with_solver_record(ds, problem, solution, scene_yaml, extra_attrs)

@@ -26,10 +26,24 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["base_scene", "boundary_polygons", "convergence_dataset", "records_dataset", "with_solver", "lame_displacement", "lame_run",
-           "load_scene_data", "manufactured_body_force", "manufactured_run", "markdown_table",
-           "observed_rates", "plane_strain_difference", "plane_stress_difference", "vertex_match",
-           "write_solution_vtu"]
+__all__ = [
+    "base_scene",
+    "boundary_polygons",
+    "convergence_dataset",
+    "records_dataset",
+    "with_solver",
+    "lame_displacement",
+    "lame_run",
+    "load_scene_data",
+    "manufactured_body_force",
+    "manufactured_run",
+    "markdown_table",
+    "observed_rates",
+    "plane_strain_difference",
+    "plane_stress_difference",
+    "vertex_match",
+    "write_solution_vtu",
+]
 
 
 def load_scene_data(path) -> dict:
@@ -85,10 +99,18 @@ def manufactured_run(data: dict, family: str, n, options: dict | None = None):
     """One solve of a scene with ``exact:`` on ``family`` at size ``n``: (record, problem, dataset)."""
     run = _with_mesh(data, family=family, n=n, **dict(options or {}))
     problem, solution, ds, wall = _solve(run)
-    record = {"family": family, "n": n, "cells": int(problem.mesh.n_cells), "vertices": int(problem.mesh.n_vertices),
-              "dofs": int(problem.n_dofs), "h_max": float(np.max(problem.mesh.cell_diameters)),
-              "error_h1": float(ds.attrs["error_h1"]), "error_h1_semi": float(ds.attrs["error_h1_semi"]),
-              "error_l2": float(ds.attrs["error_l2"]), "wall_time": wall}
+    record = {
+        "family": family,
+        "n": n,
+        "cells": int(problem.mesh.n_cells),
+        "vertices": int(problem.mesh.n_vertices),
+        "dofs": int(problem.n_dofs),
+        "h_max": float(np.max(problem.mesh.cell_diameters)),
+        "error_h1": float(ds.attrs["error_h1"]),
+        "error_h1_semi": float(ds.attrs["error_h1_semi"]),
+        "error_l2": float(ds.attrs["error_l2"]),
+        "wall_time": wall,
+    }
     return record, problem, ds
 
 
@@ -116,9 +138,14 @@ def convergence_dataset(records, families, attrs: dict | None = None):
     variables = {k: (("family", "level"), v) for k, v in data.items()}
     for norm in ("h1", "l2"):
         e = data[f"error_{norm}"]
-        variables[f"rate_{norm}"] = (("family", "level"), np.stack([observed_rates(e[i], data["n"][i]) for i in range(len(families))]))
-        variables[f"rate_{norm}_dofs"] = (("family", "level"), np.stack(
-            [observed_rates(e[i], data["dofs"][i] ** (1.0 / 3.0)) for i in range(len(families))]))
+        variables[f"rate_{norm}"] = (
+            ("family", "level"),
+            np.stack([observed_rates(e[i], data["n"][i]) for i in range(len(families))]),
+        )
+        variables[f"rate_{norm}_dofs"] = (
+            ("family", "level"),
+            np.stack([observed_rates(e[i], data["dofs"][i] ** (1.0 / 3.0)) for i in range(len(families))]),
+        )
         variables[f"order_{norm}"] = (("family",), variables[f"rate_{norm}"][1][:, -1])
     ds = xr.Dataset(variables, coords={"family": list(families), "level": np.arange(levels)}, attrs=dict(attrs or {}))
     ds["rate_h1"].attrs["long_name"] = "observed order of error_h1 in h = 1/n between consecutive levels"
@@ -138,8 +165,16 @@ def lame_displacement(r, a: float, b: float, p: float, E: float, nu: float):
     return p * a * a * (1 + nu) * ((1 - 2 * nu) * r + b * b / r) / (E * (b * b - a * a))
 
 
-def lame_run(data: dict, family: str, h: float, layers: int | None = 1, a: float = 1.0, b: float = 2.0,
-             p: float = 1.0, seed: int | None = None):
+def lame_run(
+    data: dict,
+    family: str,
+    h: float,
+    layers: int | None = 1,
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 1.0,
+    seed: int | None = None,
+):
     """One solve of the Lamé scene (config/scenes/3d/lame.yaml) at cell size h: (record, problem,
     dataset); the record has the scene's relative errors and ``bore_error``, the largest relative
     error of u_r = (u1 x + u2 y)/r over the bore's vertices (which lie on r = a)."""
@@ -150,10 +185,19 @@ def lame_run(data: dict, family: str, h: float, layers: int | None = 1, a: float
     ur = (ds["u1"].values * x + ds["u2"].values * y) / r
     bore = np.abs(r - a) < 1e-9 * a
     exact = lame_displacement(a, a, b, p, E, nu)
-    record = {"family": family, "h": float(h), "layers": int(layers or 0), "cells": int(problem.mesh.n_cells),
-              "dofs": int(problem.n_dofs), "error_h1": float(ds.attrs["error_h1"]), "error_l2": float(ds.attrs["error_l2"]),
-              "bore_error": float(np.max(np.abs(ur[bore] - exact)) / exact), "bore_vertices": int(bore.sum()),
-              "u3_max": float(np.max(np.abs(ds["u3"].values))), "wall_time": wall}
+    record = {
+        "family": family,
+        "h": float(h),
+        "layers": int(layers or 0),
+        "cells": int(problem.mesh.n_cells),
+        "dofs": int(problem.n_dofs),
+        "error_h1": float(ds.attrs["error_h1"]),
+        "error_l2": float(ds.attrs["error_l2"]),
+        "bore_error": float(np.max(np.abs(ur[bore] - exact)) / exact),
+        "bore_vertices": int(bore.sum()),
+        "u3_max": float(np.max(np.abs(ds["u3"].values))),
+        "wall_time": wall,
+    }
     return record, problem, ds
 
 
@@ -228,8 +272,9 @@ def _compare(ds2, ds3, average: bool):
     return float(np.abs(diff).max() / scale), rms, len(base)
 
 
-def plane_strain_difference(data: dict, family: str, n, layers: int, stabilization: str | None = None,
-                            seed: int | None = None):
+def plane_strain_difference(
+    data: dict, family: str, n, layers: int, stabilization: str | None = None, seed: int | None = None
+):
     """The 3D scene ``data`` (extrude domain, rollers u3 = 0 on both end faces) against its base's
     ``plane_strain`` scene on the same base mesh: record with ``max_difference`` = max over every
     vertex of every layer of |u_3D - u_2D| (u1, u2) / max |u_2D|; and the two Datasets."""
@@ -240,15 +285,25 @@ def plane_strain_difference(data: dict, family: str, n, layers: int, stabilizati
     p2, _, ds2, wall2 = _solve(flat)
     p3, _, ds3, wall3 = _solve(run)
     worst, rms, vertices = _compare(ds2, ds3, average=False)
-    record = {"family": family, "n": n, "layers": layers, "stabilization": run["discretization"].get("stabilization", ""),
-              "cells_2d": int(p2.mesh.n_cells), "cells_3d": int(p3.mesh.n_cells), "dofs_3d": int(p3.n_dofs),
-              "max_difference": worst, "rms_difference": rms, "u3_max": float(np.abs(ds3["u3"].values).max()),
-              "wall_time": wall2 + wall3}
+    record = {
+        "family": family,
+        "n": n,
+        "layers": layers,
+        "stabilization": run["discretization"].get("stabilization", ""),
+        "cells_2d": int(p2.mesh.n_cells),
+        "cells_3d": int(p3.mesh.n_cells),
+        "dofs_3d": int(p3.n_dofs),
+        "max_difference": worst,
+        "rms_difference": rms,
+        "u3_max": float(np.abs(ds3["u3"].values).max()),
+        "wall_time": wall2 + wall3,
+    }
     return record, ds2, ds3
 
 
-def plane_stress_difference(data: dict, family: str, depth: float, cells_per_depth: float = 1.0,
-                            layers: int = 1, n=None):
+def plane_stress_difference(
+    data: dict, family: str, depth: float, cells_per_depth: float = 1.0, layers: int = 1, n=None
+):
     """The 3D scene ``data`` (extrude domain, traction-free end faces) at ``depth`` against its base's
     ``plane_stress`` scene on the same base mesh: the thickness average of u1, u2 per base vertex
     against the 2D solution, relative to max |u_2D|. The base mesh has n = cells_per_depth / depth
@@ -261,8 +316,17 @@ def plane_stress_difference(data: dict, family: str, depth: float, cells_per_dep
     p2, _, ds2, wall2 = _solve(flat)
     p3, _, ds3, wall3 = _solve(run)
     worst, rms, vertices = _compare(ds2, ds3, average=True)
-    record = {"family": family, "depth": float(depth), "n": n, "layers": layers, "cells_3d": int(p3.mesh.n_cells),
-              "dofs_3d": int(p3.n_dofs), "max_difference": worst, "rms_difference": rms, "wall_time": wall2 + wall3}
+    record = {
+        "family": family,
+        "depth": float(depth),
+        "n": n,
+        "layers": layers,
+        "cells_3d": int(p3.mesh.n_cells),
+        "dofs_3d": int(p3.n_dofs),
+        "max_difference": worst,
+        "rms_difference": rms,
+        "wall_time": wall2 + wall3,
+    }
     return record, ds2, ds3
 
 

@@ -24,7 +24,9 @@ with logged(smk):
     norm = matplotlib.colors.Normalize(vmin=float(vm.min()), vmax=float(vm.max()))
     fig = plt.figure(figsize=(6.4, 5.2))
     ax = fig.add_subplot(projection="3d")
-    ax.add_collection3d(Poly3DCollection(polygons, facecolors=plt.cm.viridis(norm(vm)), edgecolors="k", linewidths=0.15))
+    ax.add_collection3d(
+        Poly3DCollection(polygons, facecolors=plt.cm.viridis(norm(vm)), edgecolors="k", linewidths=0.15)
+    )
     points = np.concatenate(polygons)
     lo, hi = points.min(axis=0), points.max(axis=0)
     ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
@@ -35,8 +37,9 @@ with logged(smk):
     fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap="viridis"), ax=ax, shrink=0.7, label="von Mises stress")
     import yaml
 
-    family = (yaml.safe_load(ds.attrs.get("scene", "")) or {}).get("discretization", {}).get("mesh", {}).get("family", "")
-    ax.set_title(f"{smk.wildcards.case}: {mesh.n_cells} cells ({family}), "
-                 f"displacement x {scale:.3g}", fontsize=9)
+    family = (
+        (yaml.safe_load(ds.attrs.get("scene", "")) or {}).get("discretization", {}).get("mesh", {}).get("family", "")
+    )
+    ax.set_title(f"{smk.wildcards.case}: {mesh.n_cells} cells ({family}), displacement x {scale:.3g}", fontsize=9)
     fig.savefig(smk.output[0], dpi=150, bbox_inches="tight")
     print(f"{smk.output[0]}: {len(polygons)} boundary faces, von Mises {vm.min():.3g} ... {vm.max():.3g}")

@@ -5,8 +5,13 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit.studies.three_d import (load_scene_data, markdown_table, plane_strain_difference, records_dataset,
-                                        with_solver)
+    from vemkit.studies.three_d import (
+        load_scene_data,
+        markdown_table,
+        plane_strain_difference,
+        records_dataset,
+        with_solver,
+    )
 
     settings = smk.params.settings
     data = with_solver(load_scene_data(smk.input.scene), smk.params.solver)
@@ -17,16 +22,26 @@ with logged(smk):
                 record, _, _ = plane_strain_difference(data, family, n, layers, seed=1 if family == "voronoi" else None)
                 records.append(record)
                 print(record, flush=True)
-    out = records_dataset(records, ["family", "n", "layers"], attrs={
-        "title": "3D extruded paper body (u3 = 0 on both end faces) against 2D plane strain, same base mesh",
-        "max_difference": "max over every vertex of every layer of |u_3D - u_2D| (u1, u2) / max |u_2D|"})
+    out = records_dataset(
+        records,
+        ["family", "n", "layers"],
+        attrs={
+            "title": "3D extruded paper body (u3 = 0 on both end faces) against 2D plane strain, same base mesh",
+            "max_difference": "max over every vertex of every layer of |u_3D - u_2D| (u1, u2) / max |u_2D|",
+        },
+    )
     out.to_netcdf(smk.output.nc)
-    text = ("# Extruded paper body against 2D plane strain\n\n"
-            "max_difference: max |u_3D - u_2D| (u1, u2, every vertex of every layer) / max |u_2D|. SPEC §10 asks "
-            "for equality; it holds on prisms over triangles only: the 3D dofi-dofi scaling alpha_K = 2 mu h_K "
-            "(k1_3d_kernel.element_stiffness) is not the (d/2) 2 mu that plane strain needs on a prism of depth d "
-            "(tests/vem3d/test_plane_models.py).\n\n"
-            + markdown_table(records, ["family", "n", "layers", "cells_3d", "dofs_3d", "max_difference", "rms_difference"],
-                             formats={"max_difference": ".2e", "rms_difference": ".2e"}))
+    text = (
+        "# Extruded paper body against 2D plane strain\n\n"
+        "max_difference: max |u_3D - u_2D| (u1, u2, every vertex of every layer) / max |u_2D|. SPEC §10 asks "
+        "for equality; it holds on prisms over triangles only: the 3D dofi-dofi scaling alpha_K = 2 mu h_K "
+        "(k1_3d_kernel.element_stiffness) is not the (d/2) 2 mu that plane strain needs on a prism of depth d "
+        "(tests/vem3d/test_plane_models.py).\n\n"
+        + markdown_table(
+            records,
+            ["family", "n", "layers", "cells_3d", "dofs_3d", "max_difference", "rms_difference"],
+            formats={"max_difference": ".2e", "rms_difference": ".2e"},
+        )
+    )
     open(smk.output.md, "w", encoding="utf-8").write(text)
     print(text)
