@@ -1,0 +1,11 @@
+"""The documentation's tests: the generators of docs/_ext/vemkit_docs.py (no Sphinx needed), the
+doctests of the API examples, the docs pages and the README, and the built site (docs/_build/html,
+made by `make docs`, which .ci/run runs before `make test`)."""
+
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
+HTML = DOCS / "_build" / "html"
+sys.path.insert(0, str(DOCS / "_ext"))

@@ -1,0 +1,46 @@
+"""Every example in the documentation runs: the runnable example of each public API name
+(docs/reference/examples/), every `>>>` block of a docs page, and the README's."""
+
+import doctest
+from pathlib import Path
+
+import pytest
+
+import vemkit_docs
+from conftest import DOCS, ROOT
+
+PAGES = sorted(p for p in DOCS.rglob("*.md") if "_build" not in p.parts and "_generated" not in p.parts
+               and ">>>" in p.read_text())
+FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+
+
+def _run(path: Path, monkeypatch):
+    monkeypatch.chdir(ROOT)  # the examples name files from the repository's root
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    result = doctest.testfile(str(path), module_relative=False, optionflags=FLAGS, verbose=False, report=True)
+    assert result.attempted > 0, f"{path}: no example"
+    assert result.failed == 0, f"{path}: {result.failed} of {result.attempted} examples failed (see above)"
+
+
+@pytest.mark.parametrize("path", PAGES, ids=[str(p.relative_to(DOCS)) for p in PAGES])
+def test_docs_examples_run(path, monkeypatch):
+    _run(path, monkeypatch)
+
+
+def test_readme_examples_run(monkeypatch):
+    _run(ROOT / "README.md", monkeypatch)
+
+
+def test_every_public_name_has_a_runnable_example():
+    missing = [f"{module}.{name}" for module, name in vemkit_docs.public_names()
+               if not vemkit_docs.example_file(module, name).exists()]
+    assert not missing, ("public names without an example in docs/reference/examples/<module>.<name>.md: "
+                         f"{missing}")
+    for module, name in vemkit_docs.public_names():
+        assert ">>>" in vemkit_docs.example_file(module, name).read_text(), f"{module}.{name}: no >>> example"
+
+
+def test_no_orphan_examples():
+    names = {f"{module}.{name}" for module, name in vemkit_docs.public_names()}
+    orphans = [p.stem for p in (DOCS / "reference" / "examples").glob("*.md") if p.stem not in names]
+    assert not orphans, f"examples of names that are not public (any more): {orphans}"
