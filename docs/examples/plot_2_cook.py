@@ -14,8 +14,8 @@ from vemkit.report.verification import scene_figure
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.verification import cook_quantities
 
-# the repository's scenes, from its root or from docs/examples (where the docs build runs this)
-SCENES = next(p for p in (Path.cwd(), *Path.cwd().parents) if (p / "config" / "scenes").is_dir()) / "config" / "scenes"
+ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
+SCENES = ROOT / "config" / "scenes"
 scene = vemkit.load_scene(SCENES / "cook.yaml").with_overrides(
     ['discretization.mesh={"family": "voronoi", "h": 2.0, "seed": 1}'])
 problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs: solve, check, errors

@@ -14,8 +14,8 @@ from vemkit.report.verification import scene_figure
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.verification import hertz_quantities
 
-# the repository's scenes, from its root or from docs/examples (where the docs build runs this)
-SCENES = next(p for p in (Path.cwd(), *Path.cwd().parents) if (p / "config" / "scenes").is_dir()) / "config" / "scenes"
+ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
+SCENES = ROOT / "config" / "scenes"
 scene = vemkit.load_scene(SCENES / "hertz.yaml", ["discretization.mesh.h=0.02"])   # as --set
 problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs: solve, check, errors
 q = hertz_quantities(scene, problem, ds, contact_side="contact", symmetry_x=None)

@@ -14,8 +14,8 @@ from pathlib import Path
 import vemkit
 from vemkit.report.figures import contact_figure, deformed_figure
 
-# the repository's scenes, from its root or from docs/examples (where the docs build runs this)
-SCENES = next(p for p in (Path.cwd(), *Path.cwd().parents) if (p / "config" / "scenes").is_dir()) / "config" / "scenes"
+ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
+SCENES = ROOT / "config" / "scenes"
 scene = vemkit.load_scene(SCENES / "paper.yaml").with_overrides(["discretization.mesh.n=16"])
 problem = vemkit.scene_problem(scene)
 solution = vemkit.solve(problem, scene.solver_options)

@@ -13,8 +13,8 @@ import vemkit
 from vemkit.report.verification import scene_figure
 from vemkit.studies.scene_solve import solve_scene
 
-# the repository's scenes, from its root or from docs/examples (where the docs build runs this)
-SCENES = next(p for p in (Path.cwd(), *Path.cwd().parents) if (p / "config" / "scenes").is_dir()) / "config" / "scenes"
+ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
+SCENES = ROOT / "config" / "scenes"
 for h in (0.4, 0.2):
     scene = vemkit.load_scene(SCENES / "kirsch.yaml").with_overrides([f"discretization.mesh.h={h}"])
     problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs
