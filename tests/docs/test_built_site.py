@@ -11,8 +11,8 @@ from urllib.parse import unquote, urlsplit
 
 import pytest
 
-import vemkit_docs
-from conftest import DOCS, HTML, ROOT
+from docs_paths import DOCS, HTML, ROOT
+import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
 
 pytestmark = pytest.mark.skipif(not (HTML / "index.html").exists(),
                                 reason="docs/_build/html not built: run `make docs` (CI does, before make test)")

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-import vemkit_docs
-from conftest import DOCS, ROOT
+from docs_paths import DOCS, ROOT
+import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
 
 PAGES = sorted(p for p in DOCS.rglob("*.md") if "_build" not in p.parts and "_generated" not in p.parts
                and ">>>" in p.read_text())

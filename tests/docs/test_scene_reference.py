@@ -3,8 +3,8 @@ schema must say what it means."""
 
 import json
 
-import vemkit_docs
-from conftest import ROOT
+from docs_paths import ROOT
+import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
 
 SCHEMA = json.loads((ROOT / "vemkit" / "config" / "schemas" / "scene.schema.json").read_text())
 

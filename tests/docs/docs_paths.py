@@ -1,4 +1,7 @@
-"""The documentation's tests: the generators of docs/_ext/vemkit_docs.py (no Sphinx needed), the
+"""Paths of the documentation tests, and docs/_ext on sys.path for its generators (a plain module,
+not a conftest: other test folders import tests/conftest.py as `conftest`).
+
+The documentation's tests: the generators of docs/_ext/vemkit_docs.py (no Sphinx needed), the
 doctests of the API examples, the docs pages and the README, and the built site (docs/_build/html,
 made by `make docs`, which .ci/run runs before `make test`)."""
 
