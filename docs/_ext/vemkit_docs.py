@@ -30,9 +30,20 @@ OUT = DOCS / "_generated"
 SCHEMA = ROOT / "vemkit" / "config" / "schemas" / "scene.schema.json"
 EXAMPLES = DOCS / "reference" / "examples"
 
+def _public_packages() -> tuple[str, ...]:
+    """``vemkit`` and every package of it whose ``__init__.py`` declares ``__all__`` (found in the
+    source, so a package that gains one is documented, and tested, from then on)."""
+    package = ROOT / "vemkit"
+    found = []
+    for init in sorted(package.rglob("__init__.py")):
+        if "__pycache__" in init.parts or not re.search(r"^__all__\s*=", init.read_text(), re.M):
+            continue
+        found.append(".".join(init.parent.relative_to(ROOT).parts))
+    return tuple(sorted(found, key=lambda name: (name != "vemkit", name)))
+
+
 # the public packages: each one's __all__ is documented name by name
-PUBLIC_MODULES = ("vemkit", "vemkit.config", "vemkit.mesh", "vemkit.mesh.families", "vemkit.mesh.families3d",
-                  "vemkit.vem.elements")
+PUBLIC_MODULES = _public_packages()
 
 
 # ---- scene keys
@@ -396,6 +407,8 @@ def generate(app=None) -> None:
     seen: dict = {}
     for module in PUBLIC_MODULES:
         _write(OUT / "api" / f"{module}.md", api_markdown(module, seen))
+    _write(OUT / "api-toctree.md", "```{toctree}\n:maxdepth: 1\n\n"
+           + "".join(f"../_generated/api/{module}\n" for module in PUBLIC_MODULES) + "```\n")
     _write(OUT / "paper" / "table1.md", paper_tables())
     _write(OUT / "paper" / "convergence.md", convergence_tables())
     _write(OUT / "paper" / "figures.md", paper_figures(OUT / "paper"))
