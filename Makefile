@@ -48,7 +48,7 @@ linkcheck: $(DOCS_STAMP) $(NUMBA_STAMP)
 	MPLBACKEND=Agg $(BIN)/sphinx-build -b linkcheck $(SPHINXOPTS) docs docs/_build/linkcheck
 
 clean-docs:
-	rm -rf docs/_build docs/_generated docs/gallery docs/sg_execution_times.rst
+	rm -rf docs/_build docs/_generated docs/api docs/gallery docs/sg_execution_times.rst
 
 reproduce: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/snakemake -j$(JOBS) --quiet rules

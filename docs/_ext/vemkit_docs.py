@@ -4,7 +4,7 @@ At ``builder-inited`` this extension writes ``docs/_generated/`` (not committed)
 
 - ``scene-keys.md``: every key of ``vemkit/config/schemas/scene.schema.json`` with its type, range,
   default and meaning (:func:`scene_key_rows`, :func:`scene_keys_markdown`);
-- ``api/*.md``: one page per public package, an autodoc entry for every name of its ``__all__`` and
+- ``docs/api/*.md`` (beside it): one page per public package, an autodoc entry for every name of its ``__all__`` and
   the name's runnable example (``docs/reference/examples/<module>.<name>.md``, doctested by
   ``tests/docs``);
 - ``paper/``: Table 1 beside the paper's digits and the convergence table from the result files
@@ -29,6 +29,7 @@ ROOT = DOCS.parent
 OUT = DOCS / "_generated"
 SCHEMA = ROOT / "vemkit" / "config" / "schemas" / "scene.schema.json"
 EXAMPLES = DOCS / "reference" / "examples"
+API = DOCS / "api"  # generated pages of their own (not under _generated: site checks skip _folders)
 
 def _public_packages() -> tuple[str, ...]:
     """``vemkit`` and every package of it whose ``__init__.py`` declares ``__all__`` (found in the
@@ -214,7 +215,7 @@ def api_markdown(module: str, seen: dict | None = None) -> str:
             seen.setdefault(id(obj), f"{module}.{name}")
         example = example_file(module, name)
         if example.exists():
-            rel = Path("..") / ".." / example.relative_to(DOCS)
+            rel = Path("..") / example.relative_to(DOCS)
             lines += ["**Example**", "", f"```{{include}} {rel.as_posix()}", "```", ""]
     return "\n".join(lines) + "\n"
 
@@ -406,9 +407,9 @@ def generate(app=None) -> None:
     _write(OUT / "scene-keys.md", scene_keys_markdown())
     seen: dict = {}
     for module in PUBLIC_MODULES:
-        _write(OUT / "api" / f"{module}.md", api_markdown(module, seen))
+        _write(API / f"{module}.md", api_markdown(module, seen))
     _write(OUT / "api-toctree.md", "```{toctree}\n:maxdepth: 1\n\n"
-           + "".join(f"../_generated/api/{module}\n" for module in PUBLIC_MODULES) + "```\n")
+           + "".join(f"../api/{module}\n" for module in PUBLIC_MODULES) + "```\n")
     _write(OUT / "paper" / "table1.md", paper_tables())
     _write(OUT / "paper" / "convergence.md", convergence_tables())
     _write(OUT / "paper" / "figures.md", paper_figures(OUT / "paper"))

@@ -93,7 +93,7 @@ def test_every_cli_option_is_in_the_reference():
 
 def test_every_public_name_is_in_the_api_reference():
     for module, name in vemkit_docs.public_names():
-        page = HTML / "_generated" / "api" / f"{module}.html"
+        page = HTML / "api" / f"{module}.html"
         assert page.exists(), module
         content = page.read_text()
         assert f"{module}.{name}" in content, f"{module}.{name}"
