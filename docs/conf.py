@@ -37,8 +37,16 @@ extensions = [
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
 # included pieces, not pages of their own: the generated tables and figures, the API examples
-exclude_patterns = ["_build", "examples/README.txt", "_generated/*.md", "_generated/paper", "_generated/verification",
-                    "reference/examples", "gallery/*.md5", "gallery/*.json"]
+exclude_patterns = [
+    "_build",
+    "examples/README.txt",
+    "_generated/*.md",
+    "_generated/paper",
+    "_generated/verification",
+    "reference/examples",
+    "gallery/*.md5",
+    "gallery/*.json",
+]
 templates_path = []
 
 # MyST: Markdown prose; $...$ maths, ::: fences, heading anchors for links between pages

@@ -7,9 +7,9 @@ on the right, pushed by a traction on the left and pressed onto a deformable fou
 bottom gap (normal compliance k_ν = 10, friction bound k_τ = 450). Here on 16 x 16 squares.
 """
 
-import matplotlib.pyplot as plt
-
 from pathlib import Path
+
+import matplotlib.pyplot as plt
 
 import vemkit
 from vemkit.report.figures import contact_figure, deformed_figure
@@ -20,8 +20,10 @@ scene = vemkit.load_scene(SCENES / "paper.yaml").with_overrides(["discretization
 problem = vemkit.scene_problem(scene)
 solution = vemkit.solve(problem, scene.solver_options)
 ds = vemkit.solution_dataset(problem, solution)
-print(f"{problem.mesh.n_cells} cells, {problem.n_dofs} unknowns, {ds.attrs['solver']}: "
-      f"{ds.attrs['iterations']} iterations")
+print(
+    f"{problem.mesh.n_cells} cells, {problem.n_dofs} unknowns, {ds.attrs['solver']}: "
+    f"{ds.attrs['iterations']} iterations"
+)
 
 # %%
 # The deformed mesh (true scale), grey the shear energy density, and Γ_C in red where it penetrates

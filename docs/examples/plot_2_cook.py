@@ -17,8 +17,9 @@ from vemkit.studies.verification import cook_quantities
 ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
 SCENES = ROOT / "config" / "scenes"
 scene = vemkit.load_scene(SCENES / "cook.yaml").with_overrides(
-    ['discretization.mesh={"family": "voronoi", "h": 2.0, "seed": 1}'])
-problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs: solve, check, errors
+    ['discretization.mesh={"family": "voronoi", "h": 2.0, "seed": 1}']
+)
+problem, solution, ds = solve_scene(scene, verify=True)  # what `vemkit solve` runs: solve, check, errors
 v = cook_quantities(scene, problem, ds, point=(48.0, 52.0), corner=(48.0, 60.0))["v_mid"]
 print(f"v(48, 52) = {v:.3f} on {problem.mesh.n_cells} Voronoi cells (published: 23.96)")
 

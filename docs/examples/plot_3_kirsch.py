@@ -17,9 +17,11 @@ ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the rep
 SCENES = ROOT / "config" / "scenes"
 for h in (0.4, 0.2):
     scene = vemkit.load_scene(SCENES / "kirsch.yaml").with_overrides([f"discretization.mesh.h={h}"])
-    problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs
-    print(f"h = {h}: {problem.n_dofs} unknowns, relative H1 error {ds.attrs['error_h1']:.4f}, "
-          f"L2 error {ds.attrs['error_l2']:.5f}")
+    problem, solution, ds = solve_scene(scene, verify=True)  # what `vemkit solve` runs
+    print(
+        f"h = {h}: {problem.n_dofs} unknowns, relative H1 error {ds.attrs['error_h1']:.4f}, "
+        f"L2 error {ds.attrs['error_l2']:.5f}"
+    )
 
 # %%
 # Halving h halves the H1 error and quarters the L2 error. The finer solution:

@@ -16,11 +16,13 @@ from vemkit.studies.verification import hertz_quantities
 
 ROOT = Path(".") if Path("config/scenes").is_dir() else Path("../..")  # the repository, or docs/examples
 SCENES = ROOT / "config" / "scenes"
-scene = vemkit.load_scene(SCENES / "hertz.yaml", ["discretization.mesh.h=0.02"])   # as --set
-problem, solution, ds = solve_scene(scene, verify=True)   # what `vemkit solve` runs: solve, check, errors
+scene = vemkit.load_scene(SCENES / "hertz.yaml", ["discretization.mesh.h=0.02"])  # as --set
+problem, solution, ds = solve_scene(scene, verify=True)  # what `vemkit solve` runs: solve, check, errors
 q = hertz_quantities(scene, problem, ds, contact_side="contact", symmetry_x=None)
-print(f"force P = {q['contact_force']:.4g}; half-width a = {q['half_width']:.4f} (Hertz {q['half_width_hertz']:.4f}); "
-      f"peak pressure p0 = {q['peak_pressure']:.4f} (Hertz {q['peak_pressure_hertz']:.4f})")
+print(
+    f"force P = {q['contact_force']:.4g}; half-width a = {q['half_width']:.4f} (Hertz {q['half_width_hertz']:.4f}); "
+    f"peak pressure p0 = {q['peak_pressure']:.4f} (Hertz {q['peak_pressure_hertz']:.4f})"
+)
 
 # %%
 # Mesh, deformed shape, stress; below, a zoom on the contact zone, the remaining gap and the

@@ -10,12 +10,11 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
+from docs_paths import DOCS, HTML, ROOT, vemkit_docs
 
-from docs_paths import DOCS, HTML, ROOT
-import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
-
-pytestmark = pytest.mark.skipif(not (HTML / "index.html").exists(),
-                                reason="docs/_build/html not built: run `make docs` (CI does, before make test)")
+pytestmark = pytest.mark.skipif(
+    not (HTML / "index.html").exists(), reason="docs/_build/html not built: run `make docs` (CI does, before make test)"
+)
 
 
 class _Links(HTMLParser):
@@ -43,11 +42,29 @@ def _text(path: Path) -> str:
 
 
 def test_every_page_was_built():
-    for page in ("index", "getting-started", "gallery/index", "paper", "verification", "architecture",
-                 "reference/scene", "reference/cli", "reference/files", "reference/api", "reference/input-rules",
-                 "tutorials/bodies-and-meshes", "tutorials/boundary-conditions", "tutorials/contact",
-                 "tutorials/solvers", "tutorials/order2", "tutorials/adaptivity", "tutorials/three-d",
-                 "tutorials/sweeps", "tutorials/stability", "tutorials/slurm"):
+    for page in (
+        "index",
+        "getting-started",
+        "gallery/index",
+        "paper",
+        "verification",
+        "architecture",
+        "reference/scene",
+        "reference/cli",
+        "reference/files",
+        "reference/api",
+        "reference/input-rules",
+        "tutorials/bodies-and-meshes",
+        "tutorials/boundary-conditions",
+        "tutorials/contact",
+        "tutorials/solvers",
+        "tutorials/order2",
+        "tutorials/adaptivity",
+        "tutorials/three-d",
+        "tutorials/sweeps",
+        "tutorials/stability",
+        "tutorials/slurm",
+    ):
         assert (HTML / f"{page}.html").exists(), page
 
 

@@ -5,12 +5,11 @@ import doctest
 from pathlib import Path
 
 import pytest
+from docs_paths import DOCS, ROOT, vemkit_docs
 
-from docs_paths import DOCS, ROOT
-import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
-
-PAGES = sorted(p for p in DOCS.rglob("*.md") if "_build" not in p.parts and "_generated" not in p.parts
-               and ">>>" in p.read_text())
+PAGES = sorted(
+    p for p in DOCS.rglob("*.md") if "_build" not in p.parts and "_generated" not in p.parts and ">>>" in p.read_text()
+)
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 
 
@@ -32,10 +31,12 @@ def test_readme_examples_run(monkeypatch):
 
 
 def test_every_public_name_has_a_runnable_example():
-    missing = [f"{module}.{name}" for module, name in vemkit_docs.public_names()
-               if not vemkit_docs.example_file(module, name).exists()]
-    assert not missing, ("public names without an example in docs/reference/examples/<module>.<name>.md: "
-                         f"{missing}")
+    missing = [
+        f"{module}.{name}"
+        for module, name in vemkit_docs.public_names()
+        if not vemkit_docs.example_file(module, name).exists()
+    ]
+    assert not missing, f"public names without an example in docs/reference/examples/<module>.<name>.md: {missing}"
     for module, name in vemkit_docs.public_names():
         assert ">>>" in vemkit_docs.example_file(module, name).read_text(), f"{module}.{name}: no >>> example"
 
@@ -54,8 +55,10 @@ def _public_docstring_tests():
     finder = doctest.DocTestFinder(exclude_empty=True)
     seen, tests = set(), []
     objects = [(module, importlib.import_module(module)) for module in vemkit_docs.PUBLIC_MODULES]
-    objects += [(f"{module}.{name}", getattr(importlib.import_module(module), name))
-                for module, name in vemkit_docs.public_names()]
+    objects += [
+        (f"{module}.{name}", getattr(importlib.import_module(module), name))
+        for module, name in vemkit_docs.public_names()
+    ]
     for label, obj in objects:
         if id(obj) in seen or not isinstance(getattr(obj, "__doc__", None), str):
             continue

@@ -2,8 +2,7 @@
 
 import shutil
 
-from docs_paths import ROOT
-import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
+from docs_paths import ROOT, vemkit_docs
 
 
 def test_verification_page_uses_the_pipeline_file_when_present(tmp_path, monkeypatch):

@@ -3,8 +3,7 @@ schema must say what it means."""
 
 import json
 
-from docs_paths import ROOT
-import vemkit_docs  # docs/_ext/vemkit_docs.py, on sys.path through docs_paths
+from docs_paths import ROOT, vemkit_docs
 
 SCHEMA = json.loads((ROOT / "vemkit" / "config" / "schemas" / "scene.schema.json").read_text())
 
