@@ -12,3 +12,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 HTML = DOCS / "_build" / "html"
 sys.path.insert(0, str(DOCS / "_ext"))
+
+import vemkit_docs  # noqa: E402 - docs/_ext/vemkit_docs.py, importable once docs/_ext is on sys.path
+
+__all__ = ["DOCS", "HTML", "ROOT", "vemkit_docs"]
