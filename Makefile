@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: reproduce test install bench peers getfem clean-results clean-numba-cache
+.PHONY: reproduce test install bench peers getfem clean-results clean-numba-cache docs linkcheck clean-docs
 
 # Numba's on-disk cache (cache=True) keys a kernel on its own source file only: a kernel that inlines
 # one from another module keeps the old compiled code after that module changes. So the compiled
@@ -45,6 +45,27 @@ $(GMSH_STAMP): $(STAMP)
 install: $(GMSH_STAMP)
 test: $(GMSH_STAMP)
 reproduce: $(GMSH_STAMP)
+
+# The documentation site (docs/, Sphinx + MyST + furo, sphinx-gallery): docs/_build/html. Its packages
+# (the `docs` extra) get their own stamp, so `make test` does not install them. -W: a warning fails.
+# Generated at build time: docs/_generated (scene keys, API pages, paper and verification tables and
+# figures) and docs/gallery (the executed examples). CI runs `make docs` (.ci/run).
+DOCS_STAMP := $(VENV)/.installed-docs
+SPHINXOPTS ?= -W --keep-going -q
+
+$(DOCS_STAMP): pyproject.toml | $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP) $(NUMBA_STAMP)
+	MPLBACKEND=Agg $(BIN)/sphinx-build -b html $(SPHINXOPTS) docs docs/_build/html
+
+# the site's own links and anchors (external links are not checked: no network here)
+linkcheck: $(DOCS_STAMP) $(NUMBA_STAMP)
+	MPLBACKEND=Agg $(BIN)/sphinx-build -b linkcheck $(SPHINXOPTS) docs docs/_build/linkcheck
+
+clean-docs:
+	rm -rf docs/_build docs/_generated docs/api docs/gallery docs/sg_execution_times.rst
 
 reproduce: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/snakemake -j$(JOBS) --quiet rules

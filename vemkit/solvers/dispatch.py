@@ -69,12 +69,39 @@ def floating_point_errors_raise():
 def solve(problem, solver_options: dict, progress=None, initial=None):
     """Run the configured contact solver; raises ConvergenceError on failure.
 
-    ``initial``: None (each solver's own start) or (u0 free-dof vector, multiplier per contact
-    vertex), a warm start (e.g. a coarser solution prolongated to this mesh).
+    Parameters
+    ----------
+    problem : DiscreteProblem
+        The assembled problem (``vemkit.scene_problem`` or ``vemkit.discrete_problem``).
+    solver_options : dict
+        The scene's ``solver`` block (``Scene.solver_options``): ``method`` (``ssn`` or ``uzawa``),
+        ``tol`` and the method's own keys.
+    progress : callable, optional
+        Called after every iteration (a progress display).
+    initial : tuple, optional
+        None (each solver's own start) or (u0 free-dof vector, multiplier per contact vertex), a
+        warm start (e.g. a coarser solution prolongated to this mesh).
 
-    ``solver_options["time_budget"]`` (seconds, optional): TimeBudgetExceeded once the solve has
-    run longer (checked after every iteration). A floating-point overflow, invalid operation or
-    division by zero inside the solve is a ConvergenceError (reason ``diverged``), never a result.
+    Returns
+    -------
+    ContactSolution
+        The displacement, the friction multiplier, the iterations and the history.
+
+    Raises
+    ------
+    ConvergenceError
+        When the solver does not converge. ``solver_options["time_budget"]`` (seconds, optional):
+        TimeBudgetExceeded once the solve has run longer (checked after every iteration). A
+        floating-point overflow, invalid operation or division by zero inside the solve is a
+        ConvergenceError (reason ``diverged``), never a result.
+
+    Examples
+    --------
+    >>> import vemkit
+    >>> scene = vemkit.load_scene("config/scenes/paper.yaml", ["discretization.mesh.n=4"])
+    >>> solution = vemkit.solve(vemkit.scene_problem(scene), scene.solver_options)
+    >>> solution.method, solution.iterations > 0
+    ('ssn', True)
     """
     opts = dict(solver_options)
     method = opts.pop("method")
