@@ -32,7 +32,7 @@ from vemkit.exceptions import ResourceLimitError
 
 __all__ = ["BASE_BYTES", "BYTES_PER_DOF", "DEFAULT_MAX_DOFS", "MEMORY_FRACTION", "Resources",
            "available_memory", "check_resources", "check_scene_resources", "domain_area", "estimate_mesh",
-           "estimate_resources", "memory_budget", "scene_resources"]
+           "estimate_resources", "estimate_resources3d", "memory_budget", "scene_resources"]
 
 DEFAULT_MAX_DOFS = 4_000_000  # the paper's finest level (n = 1024) has 2.1 million on squares
 BASE_BYTES = 400 * 2**20  # Python with numpy, scipy, numba, xarray, netCDF4 loaded
@@ -62,6 +62,21 @@ def estimate_resources(cells: int, vertices: int) -> Resources:
     """The prediction for a mesh of ``cells`` and ``vertices`` (2 DOFs per vertex, an upper bound)."""
     dofs = 2 * int(vertices)
     return Resources(int(cells), int(vertices), dofs, BASE_BYTES + BYTES_PER_DOF * dofs)
+
+
+BYTES_PER_NONZERO_3D = 12  # float64 value + int32 column of the free-DOF stiffness matrix
+BYTES_PER_DOF_3D = 400  # placeholder, fitted below
+BYTES_PER_FACE_3D = 0
+BYTES_PER_CELL_3D = 0
+
+
+def estimate_resources3d(cells: int, vertices: int, faces: int) -> Resources:
+    """The prediction for a 3D k = 1 mesh (3 DOFs per vertex, an upper bound): placeholder."""
+    dofs = 3 * int(vertices)
+    nonzeros = 3 * dofs * 27
+    peak = BASE_BYTES + BYTES_PER_NONZERO_3D * nonzeros + BYTES_PER_DOF_3D * dofs + BYTES_PER_FACE_3D * int(faces) \
+        + BYTES_PER_CELL_3D * int(cells)
+    return Resources(int(cells), int(vertices), dofs, int(peak))
 
 
 def domain_area(domain) -> float:
