@@ -63,7 +63,8 @@ class AMGSolver:
         # Settings measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR aggregation with
         # the rigid-body modes converges in as few CG iterations as 2 x 2 BSR blocks and its
         # Gauss-Seidel sweeps are cheaper; improving the candidates doubles the setup for nothing.
-        three_d = near_nullspace is not None and np.shape(near_nullspace)[1] == 6  # the six rigid motions of 3D
+        # the six rigid motions of 3D, three dofs per node
+        three_d = near_nullspace is not None and np.shape(near_nullspace)[1] == 6 and self.A.shape[0] % 3 == 0
         self.hierarchy = pyamg.smoothed_aggregation_solver(
             self.A.tobsr(blocksize=(3, 3)) if three_d else self.A,
             B=near_nullspace,
