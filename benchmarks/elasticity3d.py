@@ -18,6 +18,7 @@ import resource
 import time
 
 import numpy as np
+
 from _common import MACHINE, quick_parser, targets_line, write_report
 
 CUBE = {"box": [[0, 0, 0], [1, 1, 1]]}
@@ -55,9 +56,20 @@ def run(n: int) -> dict:
     amg = step("amg_setup", lambda: AMGSolver(K, near_nullspace=modes, tol=TOL))
     u = step("solve", lambda: amg.solve(load))
     seconds["wall"], cpu["wall"] = time.perf_counter() - start, time.process_time() - start_cpu
-    return {"n": n, "cells": mesh.n_cells, "vertices": mesh.n_vertices, "faces": mesh.n_faces, "dofs": int(K.shape[0]),
-            "nnz": int(K.nnz), "seconds": seconds, "cpu_seconds": cpu, "iterations": amg.iterations, "residual": amg.residual,
-            "levels": len(amg.hierarchy.levels), "top_deflection": float(-u[2::3].min())}
+    return {
+        "n": n,
+        "cells": mesh.n_cells,
+        "vertices": mesh.n_vertices,
+        "faces": mesh.n_faces,
+        "dofs": int(K.shape[0]),
+        "nnz": int(K.nnz),
+        "seconds": seconds,
+        "cpu_seconds": cpu,
+        "iterations": amg.iterations,
+        "residual": amg.residual,
+        "levels": len(amg.hierarchy.levels),
+        "top_deflection": float(-u[2::3].min()),
+    }
 
 
 def main():
@@ -72,25 +84,49 @@ def main():
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     predicted = estimate_resources3d(record["cells"], record["vertices"], record["faces"])
     s, c = record["seconds"], record["cpu_seconds"]
-    record.update(command="python benchmarks/elasticity3d.py" + (" --quick" if args.quick else "")
-                  + (f" --n {args.n}" if args.n else ""), machine=MACHINE, peak_bytes=peak,
-                  predicted_bytes=predicted.peak_bytes, load_average=[round(x, 2) for x in os.getloadavg()])
+    record.update(
+        command="python benchmarks/elasticity3d.py"
+        + (" --quick" if args.quick else "")
+        + (f" --n {args.n}" if args.n else ""),
+        machine=MACHINE,
+        peak_bytes=peak,
+        predicted_bytes=predicted.peak_bytes,
+        load_average=[round(x, 2) for x in os.getloadavg()],
+    )
     full = n >= 69
-    record["targets"] = {"assembly <= 10 s": full and s["assembly"] <= 10.0, "all <= 60 s wall": full and s["wall"] <= 60.0,
-                         "peak <= 6 GiB": full and peak <= 6 * 2**30,
-                         "peak <= predicted <= 1.5 peak": peak <= predicted.peak_bytes <= 1.5 * peak}
+    record["targets"] = {
+        "assembly <= 10 s": full and s["assembly"] <= 10.0,
+        "all <= 60 s wall": full and s["wall"] <= 60.0,
+        "peak <= 6 GiB": full and peak <= 6 * 2**30,
+        "peak <= predicted <= 1.5 peak": peak <= predicted.peak_bytes <= 1.5 * peak,
+    }
     gib = 2.0**30
-    lines = ["# 3D elasticity benchmark (k = 1, hexahedra)", "", f"`{record['command']}` on {record['machine']}", "",
-             f"{record['cells']:,} cells, {record['vertices']:,} vertices, {record['dofs']:,} DOFs, "
-             f"{record['nnz']:,} nonzeros; AMG {record['levels']} levels, {record['iterations']} CG iterations "
-             f"to {record['residual']:.1e}", "",
-             "| seconds | mesh | assembly | load | AMG set-up | CG | all |", "|---|---|---|---|---|---|---|",
-             *(f"| {label} | " + " | ".join(f"{t[k]:.2f}" for k in ("mesh", "assembly", "load", "amg_setup", "solve", "wall"))
-               + " |" for label, t in (("wall", s), ("CPU (process, all threads)", c))), "",
-             f"Peak memory (ru_maxrss) {peak / gib:.2f} GiB, predicted (``estimate_resources3d``) "
-             f"{predicted.peak_bytes / gib:.2f} GiB.", "",
-             f"Load average at the end (1, 5, 15 min): {record['load_average']} (2 cores, shared: the wall times "
-             "include waiting for a core).", "", targets_line(record["targets"])]
+    lines = [
+        "# 3D elasticity benchmark (k = 1, hexahedra)",
+        "",
+        f"`{record['command']}` on {record['machine']}",
+        "",
+        f"{record['cells']:,} cells, {record['vertices']:,} vertices, {record['dofs']:,} DOFs, "
+        f"{record['nnz']:,} nonzeros; AMG {record['levels']} levels, {record['iterations']} CG iterations "
+        f"to {record['residual']:.1e}",
+        "",
+        "| seconds | mesh | assembly | load | AMG set-up | CG | all |",
+        "|---|---|---|---|---|---|---|",
+        *(
+            f"| {label} | "
+            + " | ".join(f"{t[k]:.2f}" for k in ("mesh", "assembly", "load", "amg_setup", "solve", "wall"))
+            + " |"
+            for label, t in (("wall", s), ("CPU (process, all threads)", c))
+        ),
+        "",
+        f"Peak memory (ru_maxrss) {peak / gib:.2f} GiB, predicted (``estimate_resources3d``) "
+        f"{predicted.peak_bytes / gib:.2f} GiB.",
+        "",
+        f"Load average at the end (1, 5, 15 min): {record['load_average']} (2 cores, shared: the wall times "
+        "include waiting for a core).",
+        "",
+        targets_line(record["targets"]),
+    ]
     write_report("elasticity3d", record, lines)
 
 

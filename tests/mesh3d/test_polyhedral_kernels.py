@@ -12,9 +12,16 @@ BOX = {"box": [[0, 0, 0], [1, 2, 1]]}
 PLATE = {"extrude": {"depth": 0.3}, "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["b", "r", "t", "l"]}
 
 
-@pytest.mark.parametrize("family, domain, options", [("hex", BOX, {}), ("tet", BOX, {}), ("voronoi", BOX, {}),
-                                                     ("octree", BOX, {"rule": "random", "seed": 2}),
-                                                     ("voronoi", PLATE, {})])
+@pytest.mark.parametrize(
+    "family, domain, options",
+    [
+        ("hex", BOX, {}),
+        ("tet", BOX, {}),
+        ("voronoi", BOX, {}),
+        ("octree", BOX, {"rule": "random", "seed": 2}),
+        ("voronoi", PLATE, {}),
+    ],
+)
 def test_kernels_equal_the_numpy_twins(family, domain, options):
     mesh = build_mesh3d(family, domain, n=3, **options)
     offsets, ids = mesh.cell_vertex_lists

@@ -35,14 +35,21 @@ def test_voronoi_within_ten_percent(size):
 
 def test_errors():
     with pytest.raises(SceneError, match="give a box domain"):
-        estimate_mesh3d("square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2)
+        estimate_mesh3d(
+            "square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2
+        )
     with pytest.raises(SceneError, match="unknown box family 'square'"):
         estimate_mesh3d("square", BOX, n=2)
 
 
 def test_memory_prediction3d_is_its_formula_and_bounds_the_matrix():
-    from vemkit.config.limits import (BASE_BYTES, BYTES_PER_DOF_3D, BYTES_PER_NONZERO_3D, estimate_resources3d,
-                                      stiffness_entries3d)
+    from vemkit.config.limits import (
+        BASE_BYTES,
+        BYTES_PER_DOF_3D,
+        BYTES_PER_NONZERO_3D,
+        estimate_resources3d,
+        stiffness_entries3d,
+    )
     from vemkit.vem.space import VirtualElementSpace
 
     mesh = build_mesh3d("hex", BOX, n=8)  # 16 x 8 x 8: the boundary's vertices have fewer neighbours

@@ -31,4 +31,6 @@ def test_nearest_seeds_and_centroids_equal_the_kdtree(count, clustered):
     owner = nearest_seeds(points, samples, lower, shape, h, ptr, seeds)
     _, expected = cKDTree(points).query(samples)
     assert np.array_equal(owner, expected)
-    assert np.array_equal(sampled_centroids(points, samples, lower, upper), sampled_centroids_reference(points, samples))
+    assert np.array_equal(
+        sampled_centroids(points, samples, lower, upper), sampled_centroids_reference(points, samples)
+    )

@@ -40,8 +40,11 @@ def nearest_seeds(points, samples, lower, shape, h, ptr, seeds):
                         cell = (k * shape[1] + j) * shape[0] + i
                         for t in range(ptr[cell], ptr[cell + 1]):
                             q = seeds[t]
-                            d = ((points[q, 0] - samples[s, 0]) ** 2 + (points[q, 1] - samples[s, 1]) ** 2
-                                 + (points[q, 2] - samples[s, 2]) ** 2)
+                            d = (
+                                (points[q, 0] - samples[s, 0]) ** 2
+                                + (points[q, 1] - samples[s, 1]) ** 2
+                                + (points[q, 2] - samples[s, 2]) ** 2
+                            )
                             if d < best or (d == best and q < arg):
                                 best, arg = d, q
             reach = np.inf  # the distance from the sample to the outside of the rings searched

@@ -16,8 +16,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vemkit.vem.elements.k1_3d_fields_kernel import body_force_scatter, face_fan_points, face_trace_scatter, \
-    cell_moments, fan_quadrature, projected_fields, projection_table
+from vemkit.vem.elements.k1_3d_fields_kernel import (
+    body_force_scatter,
+    cell_moments,
+    face_fan_points,
+    face_trace_scatter,
+    fan_quadrature,
+    projected_fields,
+    projection_table,
+)
 
 QUADRATURE_CHUNK = 2**22  # points of the body force's fan rule evaluated at a time (~0.2 GiB of work arrays)
 
@@ -42,8 +49,19 @@ def cell_quadrature(mesh, points: int = 3, cells: tuple | None = None):
     ref, ref_w = tetrahedron_rule(points)
     offsets, ids = mesh.cell_vertex_lists
     lo, hi = (0, mesh.n_cells) if cells is None else cells
-    return fan_quadrature(mesh.vertices, mesh.cell_offsets, mesh.cell_faces, mesh.face_offsets, mesh.face_vertices,
-                          offsets, ids, lo, hi, ref, ref_w)
+    return fan_quadrature(
+        mesh.vertices,
+        mesh.cell_offsets,
+        mesh.cell_faces,
+        mesh.face_offsets,
+        mesh.face_vertices,
+        offsets,
+        ids,
+        lo,
+        hi,
+        ref,
+        ref_w,
+    )
 
 
 def cell_projections(mesh, geometry):
@@ -112,8 +130,9 @@ def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK)
         x, w, cells = cell_quadrature(mesh, 3, (lo, hi))
         f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1).astype(float)
         volume, mean_f, centroid = cell_moments(cells - lo, w, x, f, hi - lo)
-        body_force_scatter(vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f, centroid,
-                           out)
+        body_force_scatter(
+            vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f, centroid, out
+        )
     return out
 
 
@@ -172,6 +191,14 @@ def traction_load(mesh, faces, traction, points: int = 4) -> np.ndarray:
     x, w = face_fan_points(mesh.vertices, mesh.face_offsets, mesh.face_vertices, faces, ref, ref_w)
     g = np.stack(np.broadcast_arrays(*traction(x[:, 0], x[:, 1], x[:, 2])), axis=1).astype(float)  # (Q, 3)
     out = np.zeros((mesh.n_vertices, 3))
-    face_trace_scatter(mesh.vertices, mesh.face_offsets, mesh.face_vertices, faces, ref_w.size,
-                       x, np.ascontiguousarray(w[:, None] * g), out)
+    face_trace_scatter(
+        mesh.vertices,
+        mesh.face_offsets,
+        mesh.face_vertices,
+        faces,
+        ref_w.size,
+        x,
+        np.ascontiguousarray(w[:, None] * g),
+        out,
+    )
     return out

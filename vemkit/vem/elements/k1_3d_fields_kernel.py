@@ -31,8 +31,9 @@ def fan_tetrahedra_count(cell_offsets, cell_faces, face_offsets, lo, hi):
 
 
 @numba.njit(cache=True)
-def fan_quadrature(vertices, cell_offsets, cell_faces, face_offsets, face_vertices, v_offsets, v_ids, lo, hi,
-                   ref, ref_w):
+def fan_quadrature(
+    vertices, cell_offsets, cell_faces, face_offsets, face_vertices, v_offsets, v_ids, lo, hi, ref, ref_w
+):
     """(x (T Q, 3), w (T Q,), cell (T Q,)) of cells lo <= c < hi: on each fan tetrahedron (centre, face
     mean, p_i, p_i+1), J its edges from the centre, x = centre + J r, w = det(J) w_r (signed)."""
     q = ref.shape[0]
@@ -62,8 +63,11 @@ def fan_quadrature(vertices, cell_offsets, cell_faces, face_offsets, face_vertic
                     J[r, 0] = mean[r] - centre[r]
                     J[r, 1] = vertices[a, r] - centre[r]
                     J[r, 2] = vertices[b, r] - centre[r]
-                det = (J[0, 0] * (J[1, 1] * J[2, 2] - J[1, 2] * J[2, 1]) - J[0, 1] * (J[1, 0] * J[2, 2] - J[1, 2] * J[2, 0])
-                       + J[0, 2] * (J[1, 0] * J[2, 1] - J[1, 1] * J[2, 0]))
+                det = (
+                    J[0, 0] * (J[1, 1] * J[2, 2] - J[1, 2] * J[2, 1])
+                    - J[0, 1] * (J[1, 0] * J[2, 2] - J[1, 2] * J[2, 0])
+                    + J[0, 2] * (J[1, 0] * J[2, 1] - J[1, 1] * J[2, 0])
+                )
                 for g in range(q):
                     for r in range(3):
                         x[k, r] = centre[r] + J[r, 0] * ref[g, 0] + J[r, 1] * ref[g, 1] + J[r, 2] * ref[g, 2]
@@ -98,8 +102,8 @@ def _cell_projection(vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_l
     for i in range(n):
         p[i] = vertices[v_ids[start + i]]
     volume = boundary_vectors(p[:n], face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], q[:n], w)
-    strain_operator(q[:n], volume, B[:, :3 * n])
-    xb = projection_coefficients(p[:n], B[:, :3 * n], P[:, :3 * n])
+    strain_operator(q[:n], volume, B[:, : 3 * n])
+    xb = projection_coefficients(p[:n], B[:, : 3 * n], P[:, : 3 * n])
     return xb, volume, n
 
 
@@ -120,10 +124,11 @@ def projection_table(vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_l
     xbar, volumes = np.empty((cells, 3)), np.empty(cells)
     table = np.empty((12, 3 * v_offsets[-1]))
     for c in range(cells):
-        xb, volumes[c], n = _cell_projection(vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_local, c, p, q,
-                                             w, B, Pc)
+        xb, volumes[c], n = _cell_projection(
+            vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_local, c, p, q, w, B, Pc
+        )
         xbar[c] = xb
-        table[:, 3 * v_offsets[c]:3 * v_offsets[c + 1]] = Pc[:, :3 * n]
+        table[:, 3 * v_offsets[c] : 3 * v_offsets[c + 1]] = Pc[:, : 3 * n]
     return xbar, table, volumes
 
 
@@ -140,8 +145,9 @@ def gradient_of(P, j, G):
 
 
 @numba.njit(cache=True)
-def body_force_scatter(vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f,
-                       centroid, out):
+def body_force_scatter(
+    vertices, v_offsets, v_ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f, centroid, out
+):
     """out[v] += |K| f_K . (Pi phi_j)(x_K) for the cells lo <= c < lo + len(volume) (row c - lo of
     ``volume``, ``mean_f``, ``centroid``); out (N, 3), dof j = 3 i + a of the cell's vertex i."""
     p, q, w, B, P = _work(v_offsets)
@@ -240,8 +246,9 @@ def face_trace_scatter(vertices, face_offsets, face_vertices, faces, points_per_
             grad[i, 0], grad[i, 1], grad[i, 2] = g0 / (2 * area), g1 / (2 * area), g2 / (2 * area)
         for s in range(m * points_per_face_vertex):
             for i in range(m):
-                phi = 1.0 / m + ((x[k, 0] - xb[0]) * grad[i, 0] + (x[k, 1] - xb[1]) * grad[i, 1]
-                                 + (x[k, 2] - xb[2]) * grad[i, 2])
+                phi = 1.0 / m + (
+                    (x[k, 0] - xb[0]) * grad[i, 0] + (x[k, 1] - xb[1]) * grad[i, 1] + (x[k, 2] - xb[2]) * grad[i, 2]
+                )
                 for r in range(3):
                     out[face_vertices[lo + i], r] += phi * wg[k, r]
             k += 1
