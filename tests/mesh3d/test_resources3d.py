@@ -42,3 +42,25 @@ def test_errors():
         )
     with pytest.raises(SceneError, match="unknown box family 'square'"):
         estimate_mesh3d("square", BOX, n=2)
+
+
+def test_memory_prediction3d_is_its_formula_and_bounds_the_matrix():
+    from vemkit.config.limits import (
+        BASE_BYTES,
+        BYTES_PER_DOF_3D,
+        BYTES_PER_NONZERO_3D,
+        estimate_resources3d,
+        stiffness_entries3d,
+    )
+    from vemkit.vem.space import VirtualElementSpace
+
+    mesh = build_mesh3d("hex", BOX, n=8)  # 16 x 8 x 8: the boundary's vertices have fewer neighbours
+    C, V, F = mesh.n_cells, mesh.n_vertices, mesh.n_faces
+    incidences = 4 * F - 4 * C  # the docstring's model, term by term
+    pairs = incidences**2 / C - (1.5 * incidences) ** 2 / F + 4 * (V + F - C - 1) - V
+    assert stiffness_entries3d(C, V, F) == int(9 * pairs)
+    est = estimate_resources3d(C, V, F)
+    assert (est.cells, est.vertices, est.dofs) == (C, V, 3 * V)
+    assert est.peak_bytes == BASE_BYTES + BYTES_PER_NONZERO_3D * int(9 * pairs) + BYTES_PER_DOF_3D * 3 * V
+    nnz = VirtualElementSpace(mesh, 1).stiffness_matrix(1.0, 1.0, "dofi-2mu").nnz
+    assert nnz <= stiffness_entries3d(C, V, F) <= 1.5 * nnz  # measured 1.36

@@ -23,6 +23,8 @@ from functools import cached_property
 import numba
 import numpy as np
 
+from vemkit.mesh import polyhedral_kernels
+
 
 @dataclass(frozen=True, eq=False)
 class PolyhedralMesh:
@@ -81,50 +83,27 @@ class PolyhedralMesh:
     @cached_property
     def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]:
         """CSR (offsets, vertices): the distinct vertices of every cell, in order of first appearance
-        along its faces."""
-        faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
-        sizes = np.diff(self.face_offsets)[faces]
-        entry = np.repeat(np.arange(faces.size, dtype=np.int64), sizes)
-        local = np.arange(entry.size, dtype=np.int64) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-        ids = self.face_vertices[self.face_offsets[faces][entry] + local]
-        cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))[entry]
-        _, first = np.unique(cells * np.int64(max(self.n_vertices, 1)) + ids, return_index=True)
-        first = np.sort(first)
-        counts = np.bincount(cells[first], minlength=self.n_cells)
-        return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), ids[first]
+        along its faces (a numba kernel; ``polyhedral_reference.cell_vertex_lists_reference`` is its twin)."""
+        return polyhedral_kernels.cell_vertex_lists(
+            self.cell_offsets, self.cell_faces, self.face_offsets, self.face_vertices, self.n_vertices
+        )
 
     # -- geometry -------------------------------------------------------------------------
     @cached_property
-    def _face_corners(self):
-        """(owner face, next corner, corner - vertex mean, cross products about the vertex mean)."""
-        sizes = np.diff(self.face_offsets)
-        owner = np.repeat(np.arange(self.n_faces, dtype=np.int64), sizes)
-        nxt = np.arange(1, self.face_vertices.size + 1, dtype=np.int64)
-        nxt[self.face_offsets[1:][sizes > 0] - 1] = self.face_offsets[:-1][sizes > 0]
-        p = self.vertices[self.face_vertices]
-        mean = _segment_sum(p, self.face_offsets) / np.maximum(sizes, 1)[:, None]
-        q = p - mean[owner]
-        return owner, nxt, mean, q, np.cross(q, q[nxt])
+    def _face_geometry(self):
+        """(|F| n_F, area centroids) of every face (``polyhedral_kernels.face_geometry``)."""
+        return polyhedral_kernels.face_geometry(self.vertices, self.face_offsets, self.face_vertices)
 
     @cached_property
     def face_vector_areas(self) -> np.ndarray:
         """``(F, 3)``: |F| n_F of every face as stored (half the sum of cross products about its vertex mean)."""
-        return 0.5 * _segment_sum(self._face_corners[4], self.face_offsets)
+        return self._face_geometry[0]
 
     @cached_property
     def face_centroids(self) -> np.ndarray:
         """``(F, 3)`` area centroids of the faces (fan triangles from the vertex mean, signed along the
         face normal, so that non-convex planar faces are right too)."""
-        owner, nxt, mean, q, cross = self._face_corners
-        va = self.face_vector_areas
-        unit = va / np.maximum(np.linalg.norm(va, axis=1), np.finfo(float).tiny)[:, None]
-        a = np.einsum("ij,ij->i", cross, unit[owner])
-        total = np.bincount(owner, weights=a, minlength=self.n_faces)
-        moment = _segment_sum((q + q[nxt]) / 3.0 * a[:, None], self.face_offsets)
-        ok = np.abs(total) > 0
-        shift = np.zeros_like(mean)
-        shift[ok] = moment[ok] / total[ok, None]
-        return mean + shift
+        return self._face_geometry[1]
 
     @cached_property
     def cell_volumes(self) -> np.ndarray:
@@ -183,15 +162,6 @@ def diameters_numpy(vertices, offsets, ids) -> np.ndarray:
             d = ((p[:, :, None, :] - p[:, None, :, :]) ** 2).sum(axis=-1)
             out[chunk] = np.sqrt(d.reshape(chunk.size, -1).max(axis=1))
     return out
-
-
-def _segment_sum(values: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """Sums of the rows of ``values`` over the CSR segments ``offsets`` (an empty segment sums to 0)."""
-    m = offsets.size - 1
-    owner = np.repeat(np.arange(m, dtype=np.int64), np.diff(offsets))
-    cols = values.reshape(values.shape[0], -1)
-    out = np.stack([np.bincount(owner, weights=cols[:, j], minlength=m) for j in range(cols.shape[1])], axis=1)
-    return out.reshape((m,) + values.shape[1:])
 
 
 def from_polyhedra(vertices, cells, boundary=None, meta=None) -> PolyhedralMesh:

@@ -5,6 +5,9 @@
   ones included. Each tetrahedron carries a collapsed (Duffy) Gauss-Legendre product rule.
 - Body force: int_K P_0 f . Pi v_h dx, P_0 f the cell average of f; exact for linear Pi v_h.
 - ``projected_solution``: per cell Pi u = c + G (x - xbar), G = E + W (the kernel's coefficients).
+
+The loops over cells and faces are the Numba kernels of ``k1_3d_fields_kernel``; the cell-by-cell
+originals are their twins in ``k1_3d_fields_reference`` (pinned by tests/vem3d/test_k1_3d_fields_kernels.py).
 """
 
 from __future__ import annotations
@@ -13,8 +16,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vemkit.vem.elements.k1_3d_kernel import boundary_vectors, projection_coefficients, strain_operator
+from vemkit.vem.elements.k1_3d_fields_kernel import (
+    body_force_scatter,
+    cell_moments,
+    face_fan_points,
+    face_trace_scatter,
+    fan_quadrature,
+    projected_fields,
+    projection_table,
+)
+
 from vemkit.vem.projection import strain_of
+
+QUADRATURE_CHUNK = 2**22  # points of the body force's fan rule evaluated at a time (~0.2 GiB of work arrays)
 
 
 def tetrahedron_rule(points: int = 3):
@@ -31,41 +45,33 @@ def tetrahedron_rule(points: int = 3):
     return np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1), weight.ravel()
 
 
-def cell_quadrature(mesh, points: int = 3):
-    """(x (Q, 3), weight (Q,), cell (Q,)): a rule on every cell by its signed tetrahedral fan."""
+def cell_quadrature(mesh, points: int = 3, cells: tuple | None = None):
+    """(x (Q, 3), weight (Q,), cell (Q,)): a rule on every cell (or on cells lo <= c < hi, ``cells`` =
+    (lo, hi)) by its signed tetrahedral fan (``k1_3d_fields_kernel.fan_quadrature``)."""
     ref, ref_w = tetrahedron_rule(points)
     offsets, ids = mesh.cell_vertex_lists
-    corners, cells = [], []
-    for c in range(mesh.n_cells):
-        centre = mesh.vertices[ids[offsets[c] : offsets[c + 1]]].mean(axis=0)
-        for s in mesh.cell_face_list(c):
-            face = mesh.face(s) if s >= 0 else mesh.face(-s - 1)[::-1]
-            p = mesh.vertices[face]
-            m = np.broadcast_to(p.mean(axis=0), p.shape)
-            corners.append(np.stack([np.broadcast_to(centre, p.shape), m, p, np.roll(p, -1, axis=0)], axis=1))
-            cells.append(np.full(p.shape[0], c))
-    tets = np.concatenate(corners)  # (T, 4, 3): cell mean, face mean, one edge of the face
-    J = np.transpose(tets[:, 1:] - tets[:, :1], (0, 2, 1))  # columns: the three edges from the cell mean
-    x = tets[:, None, 0] + np.einsum("tij,qj->tqi", J, ref)
-    w = np.linalg.det(J)[:, None] * ref_w[None]
-    cell = np.repeat(np.concatenate(cells), ref_w.size)
-    return x.reshape(-1, 3), w.ravel(), cell
+    lo, hi = (0, mesh.n_cells) if cells is None else cells
+    return fan_quadrature(
+        mesh.vertices,
+        mesh.cell_offsets,
+        mesh.cell_faces,
+        mesh.face_offsets,
+        mesh.face_vertices,
+        offsets,
+        ids,
+        lo,
+        hi,
+        ref,
+        ref_w,
+    )
 
 
 def cell_projections(mesh, geometry):
-    """(xbar (M, 3), P list of (12, 3n), volumes (M,)): the kernel's Pi coefficients per cell."""
+    """(xbar (M, 3), P (12, 3 sum n), volumes (M,)): the kernel's Pi coefficients of every cell, cell c's
+    in the columns 3 offsets[c] ... 3 offsets[c + 1] (offsets of ``mesh.cell_vertex_lists``)."""
     vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
     offsets, ids = mesh.cell_vertex_lists
-    xbars, Ps, vols = np.zeros((mesh.n_cells, 3)), [], np.zeros(mesh.n_cells)
-    for c in range(mesh.n_cells):
-        p = np.ascontiguousarray(vertices[ids[offsets[c] : offsets[c + 1]]])
-        n = p.shape[0]
-        q, w, B, P = np.empty((n, 3)), np.empty(n), np.empty((6, 3 * n)), np.empty((12, 3 * n))
-        vols[c] = boundary_vectors(p, face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], q, w)
-        strain_operator(q, vols[c], B)
-        xbars[c] = projection_coefficients(p, B, P)
-        Ps.append(P)
-    return xbars, Ps, vols
+    return projection_table(vertices, offsets, ids, cell_face_ptr, face_ptr, face_local)
 
 
 def _gradients(P):
@@ -106,32 +112,39 @@ class ProjectedSolution3D:
 
 
 def projected_solution(mesh, geometry, node_values) -> ProjectedSolution3D:
-    u = np.asarray(node_values, float).reshape(-1, 3)
+    """Pi u_h on every cell (``k1_3d_fields_kernel.projected_fields``)."""
+    u = np.ascontiguousarray(np.asarray(node_values, float).reshape(-1, 3))
+    vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
     offsets, ids = mesh.cell_vertex_lists
-    xbar, Ps, _ = cell_projections(mesh, geometry)
-    c, G = np.zeros((mesh.n_cells, 3)), np.zeros((mesh.n_cells, 3, 3))
-    for k, P in enumerate(Ps):
-        v = u[ids[offsets[k] : offsets[k + 1]]].ravel()
-        c[k] = P[:3] @ v
-        G[k] = np.einsum("j,jab->ab", v, _gradients(P))
-    return ProjectedSolution3D(xbar, c, G)
+    return ProjectedSolution3D(*projected_fields(vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, u))
 
 
-def body_force_load(mesh, geometry, field) -> np.ndarray:
-    """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid."""
-    x, w, cells = cell_quadrature(mesh, 3)
-    f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1) * w[:, None]
-    volume = np.bincount(cells, w, mesh.n_cells)
-    mean_f = np.stack([np.bincount(cells, f[:, k], mesh.n_cells) for k in range(3)], axis=1) / volume[:, None]
-    centroid = np.stack([np.bincount(cells, w * x[:, k], mesh.n_cells) for k in range(3)], axis=1) / volume[:, None]
+def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK) -> np.ndarray:
+    """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid: f evaluated on
+    the fan rule of about ``chunk_points`` points at a time (whole cells), bounded memory."""
+    vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
     offsets, ids = mesh.cell_vertex_lists
-    xbar, Ps, _ = cell_projections(mesh, geometry)
     out = np.zeros((mesh.n_vertices, 3))
-    for k, P in enumerate(Ps):
-        value = P[:3].T + _gradients(P) @ (centroid[k] - xbar[k])  # (3n, 3) Pi phi_j (x_K)
-        load = volume[k] * value @ mean_f[k]
-        np.add.at(out, ids[offsets[k] : offsets[k + 1]], load.reshape(-1, 3))
+    faces = np.where(mesh.cell_faces >= 0, mesh.cell_faces, -mesh.cell_faces - 1)
+    tetrahedra = int(np.diff(mesh.face_offsets)[faces].sum())  # 27 points each
+    step = max(1, int(chunk_points * mesh.n_cells // max(27 * tetrahedra, 1)))
+    for lo in range(0, mesh.n_cells, step):
+        hi = min(lo + step, mesh.n_cells)
+        x, w, cells = cell_quadrature(mesh, 3, (lo, hi))
+        f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1).astype(float)
+        volume, mean_f, centroid = cell_moments(cells - lo, w, x, f, hi - lo)
+        body_force_scatter(
+            vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f, centroid, out
+        )
     return out
+
+
+def face_vertex_ids(mesh, faces) -> np.ndarray:
+    """The vertices of ``faces``, face after face (with repeats)."""
+    faces = np.asarray(faces, dtype=np.int64)
+    sizes = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
+    start = np.repeat(mesh.face_offsets[faces] - np.cumsum(sizes) + sizes, sizes)
+    return mesh.face_vertices[start + np.arange(int(sizes.sum()), dtype=np.int64)]
 
 
 def dirichlet_components(mesh, dirichlet):
@@ -141,8 +154,7 @@ def dirichlet_components(mesh, dirichlet):
     values = np.zeros((mesh.n_vertices, 3))
     items = dirichlet.items() if isinstance(dirichlet, dict) else ((side, (0.0, 0.0, 0.0)) for side in dirichlet)
     for side, components in items:
-        faces = mesh.boundary[side]
-        vs = np.unique(np.concatenate([mesh.face(f) for f in faces])) if faces.size else np.zeros(0, np.int64)
+        vs = np.unique(face_vertex_ids(mesh, mesh.boundary[side]))
         x, y, z = mesh.vertices[vs].T
         for k, g in enumerate(components):
             if g is None:
@@ -173,41 +185,39 @@ def face_trace_weights(p, points):
     return 1.0 / m + (points - xb) @ grad.T
 
 
-def face_rule(mesh, f: int, ref, ref_w):
-    """(vertex ids, vertices p (m, 3), points x (Q, 3), weights w (Q,)): the rule of signed fan
-    triangles from the vertex mean of the planar face f (stored orientation), ``ref`` a triangle rule."""
-    ids = mesh.face(f)
-    p = mesh.vertices[ids]
-    xb = p.mean(axis=0)
-    q = np.roll(p, -1, axis=0)
-    x = xb + ref[None, :, :1] * (p - xb)[:, None] + ref[None, :, 1:] * (q - xb)[:, None]  # (m, Q, 3)
-    c = np.cross(p - xb, q - xb)
-    w = (c @ (c.sum(axis=0) / np.linalg.norm(c.sum(axis=0))))[:, None] * ref_w[None]  # 2 |T| (signed) x weights
-    return ids, p, x.reshape(-1, 3), w.ravel()
-
-
 def traction_load(mesh, faces, traction, points: int = 4) -> np.ndarray:
     """(N, 3) int_F g . phi_i ds over the boundary ``faces`` (stored outward): v_h on a face taken as
     Pi^F v_h, as the face integrals of the projection (exact for v_h linear), by signed fan triangles
     from the face's vertex mean (any planar face); traction(x, y, z) -> (g1, g2, g3)."""
     ref, ref_w = triangle_rule(points)
+    faces = np.ascontiguousarray(np.asarray(faces, dtype=np.int64).ravel())
+    x, w = face_fan_points(mesh.vertices, mesh.face_offsets, mesh.face_vertices, faces, ref, ref_w)
+    g = np.stack(np.broadcast_arrays(*traction(x[:, 0], x[:, 1], x[:, 2])), axis=1).astype(float)  # (Q, 3)
     out = np.zeros((mesh.n_vertices, 3))
-    for f in np.asarray(faces, dtype=np.int64).ravel():
-        ids, p, x, w = face_rule(mesh, f, ref, ref_w)
-        g = np.stack(np.broadcast_arrays(*traction(x[:, 0], x[:, 1], x[:, 2])), axis=1)  # (Q, 3)
-        np.add.at(out, ids, face_trace_weights(p, x).T @ (w[:, None] * g))
+    face_trace_scatter(
+        mesh.vertices,
+        mesh.face_offsets,
+        mesh.face_vertices,
+        faces,
+        ref_w.size,
+        x,
+        np.ascontiguousarray(w[:, None] * g),
+        out,
+    )
     return out
 
 
 def pressure_load(mesh, faces, pressure, points: int = 4) -> np.ndarray:
     """(N, 3) the load of a normal pressure p(x, y, z) (or a number) on the boundary ``faces``: the
     traction -p nu_F of each planar face F, nu_F its outward unit normal (as ``traction_load``)."""
-    ref, ref_w = triangle_rule(points)
-    out = np.zeros((mesh.n_vertices, 3))
-    faces = np.asarray(faces, dtype=np.int64).ravel()
+    faces = np.ascontiguousarray(np.asarray(faces, dtype=np.int64).ravel())
     areas = mesh.face_vector_areas[faces]
-    for f, nu in zip(faces, areas / np.linalg.norm(areas, axis=1, keepdims=True)):
-        ids, p, x, w = face_rule(mesh, f, ref, ref_w)
-        value = pressure(x[:, 0], x[:, 1], x[:, 2]) if callable(pressure) else float(pressure)
-        np.add.at(out, ids, np.outer(face_trace_weights(p, x).T @ (w * value), -nu))
-    return out
+    normals = areas / np.linalg.norm(areas, axis=1, keepdims=True)
+    per_face = np.diff(mesh.face_offsets)[faces] * triangle_rule(points)[1].size  # fan points of each face
+    normal_at = np.repeat(normals, per_face, axis=0)
+
+    def traction(x, y, z):
+        p = np.broadcast_to(pressure(x, y, z) if callable(pressure) else float(pressure), np.shape(x))
+        return tuple(-p * normal_at[:, k] for k in range(3))
+
+    return traction_load(mesh, faces, traction, points)

@@ -51,43 +51,48 @@ def cross(a0, a1, a2, b0, b1, b2):
 @numba.njit(cache=True)
 def face_frame(p, ids, lo, hi):
     """(|F|, n_F, x_F - xbar_F, xbar_F) of the planar face with vertices p[ids[lo:hi]] (in order):
-    the vector area and the centroid by the fan of signed triangles from the vertex mean."""
+    the vector area and the centroid by the fan of signed triangles from the vertex mean (scalar
+    arithmetic: no temporary arrays in the loops)."""
     m = hi - lo
-    xb = np.zeros(3)
+    x0 = x1 = x2 = 0.0
     for t in range(lo, hi):
-        xb += p[ids[t]]
-    xb /= m
-    a = np.zeros(3)
+        x0 += p[ids[t], 0]
+        x1 += p[ids[t], 1]
+        x2 += p[ids[t], 2]
+    x0, x1, x2 = x0 / m, x1 / m, x2 / m
+    a0 = a1 = a2 = 0.0
     for t in range(lo, hi):
-        q = p[ids[t]] - xb
-        r = p[ids[lo + (t - lo + 1) % m]] - xb
-        c0, c1, c2 = cross(q[0], q[1], q[2], r[0], r[1], r[2])
-        a[0] += 0.5 * c0
-        a[1] += 0.5 * c1
-        a[2] += 0.5 * c2
-    area = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-    n = a / area
+        i, j = ids[t], ids[lo + (t - lo + 1) % m]
+        c0, c1, c2 = cross(p[i, 0] - x0, p[i, 1] - x1, p[i, 2] - x2, p[j, 0] - x0, p[j, 1] - x1, p[j, 2] - x2)
+        a0 += 0.5 * c0
+        a1 += 0.5 * c1
+        a2 += 0.5 * c2
+    area = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+    n0, n1, n2 = a0 / area, a1 / area, a2 / area
     # fan triangle t: signed area s_t = (q x r) . n / 2, centroid offset (q + r) / 3
-    shift = np.zeros(3)
+    s0 = s1 = s2 = 0.0
     for t in range(lo, hi):
-        q = p[ids[t]] - xb
-        r = p[ids[lo + (t - lo + 1) % m]] - xb
-        c0, c1, c2 = cross(q[0], q[1], q[2], r[0], r[1], r[2])
-        s = 0.5 * (c0 * n[0] + c1 * n[1] + c2 * n[2])
-        shift += s * (q + r) / 3.0
-    return area, n, shift / area, xb
+        i, j = ids[t], ids[lo + (t - lo + 1) % m]
+        q0, q1, q2 = p[i, 0] - x0, p[i, 1] - x1, p[i, 2] - x2
+        r0, r1, r2 = p[j, 0] - x0, p[j, 1] - x1, p[j, 2] - x2
+        c0, c1, c2 = cross(q0, q1, q2, r0, r1, r2)
+        s = 0.5 * (c0 * n0 + c1 * n1 + c2 * n2)
+        s0 += s * (q0 + r0) / 3.0
+        s1 += s * (q1 + r1) / 3.0
+        s2 += s * (q2 + r2) / 3.0
+    return area, (n0, n1, n2), (s0 / area, s1 / area, s2 / area), (x0, x1, x2)
 
 
 @numba.njit(cache=True)
 def face_weights(p, ids, lo, hi, w):
     """w[0:m] the weights of int_F v ds = sum_i w_i v(p_i) of the enhanced k = 1 face space (module
-    doc); returns the unit normal n_F (orientation of the vertex order)."""
+    doc); returns the unit normal n_F (orientation of the vertex order), a tuple."""
     m = hi - lo
     area, n, shift, xb = face_frame(p, ids, lo, hi)
     for t in range(m):
-        nxt = p[ids[lo + (t + 1) % m]]
-        prv = p[ids[lo + (t - 1 + m) % m]]
-        e0, e1, e2 = cross(nxt[0] - prv[0], nxt[1] - prv[1], nxt[2] - prv[2], n[0], n[1], n[2])
+        nxt = ids[lo + (t + 1) % m]
+        prv = ids[lo + (t - 1 + m) % m]
+        e0, e1, e2 = cross(p[nxt, 0] - p[prv, 0], p[nxt, 1] - p[prv, 1], p[nxt, 2] - p[prv, 2], n[0], n[1], n[2])
         w[t] = area / m + 0.5 * (e0 * shift[0] + e1 * shift[1] + e2 * shift[2])
     return n
 
@@ -98,10 +103,12 @@ def boundary_vectors(p, face_ptr, face_local, f_lo, f_hi, q, w):
     (about the vertex mean: x - xbar is linear, so the face weights integrate it exactly)."""
     n_v = p.shape[0]
     q[:n_v] = 0.0
-    xb = np.zeros(3)
+    x0 = x1 = x2 = 0.0
     for i in range(n_v):
-        xb += p[i]
-    xb /= n_v
+        x0 += p[i, 0]
+        x1 += p[i, 1]
+        x2 += p[i, 2]
+    xb = (x0 / n_v, x1 / n_v, x2 / n_v)
     volume = 0.0
     for f in range(f_lo, f_hi):
         lo = face_ptr[f]
@@ -177,6 +184,9 @@ def projection_coefficients(p, B, P):
     n = p.shape[0]
     xb, S, Minv = vertex_moments(p)
     E = np.empty((3, 3))
+    T = np.empty((3, 3))
+    d = np.empty(3)
+    e = np.zeros(3)
     g = np.empty(3)
     for j in range(3 * n):
         i, comp = j // 3, j % 3
@@ -188,10 +198,11 @@ def projection_coefficients(p, B, P):
         E[0, 1] = E[1, 0] = P[9, j]
         E[0, 2] = E[2, 0] = P[10, j]
         E[1, 2] = E[2, 1] = P[11, j]
-        T = E @ S  # mean(d x E d)_a = eps_abc (E S)_cb
-        d = p[i] - xb
-        e = np.zeros(3)
-        e[comp] = 1.0 / n
+        for a in range(3):  # T = E S: mean(d x E d)_a = eps_abc (E S)_cb
+            for b in range(3):
+                T[a, b] = E[a, 0] * S[0, b] + E[a, 1] * S[1, b] + E[a, 2] * S[2, b]
+            d[a] = p[i, a] - xb[a]
+            e[a] = 1.0 / n if a == comp else 0.0
         v0, v1, v2 = cross(d[0], d[1], d[2], e[0], e[1], e[2])  # mean(d x phi_j)
         g[0] = v0 - (T[2, 1] - T[1, 2])
         g[1] = v1 - (T[0, 2] - T[2, 0])
