@@ -39,7 +39,7 @@ def cell_quadrature_reference(mesh, points: int = 3):
 
 def cell_projections_reference(mesh, geometry):
     """(xbar (M, 3), P list of (12, 3n), volumes (M,)): the kernel's Pi coefficients per cell."""
-    vertices, cell_face_ptr, face_ptr, face_local = geometry
+    vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
     offsets, ids = mesh.cell_vertex_lists
     xbars, Ps, vols = np.zeros((mesh.n_cells, 3)), [], np.zeros(mesh.n_cells)
     for c in range(mesh.n_cells):
