@@ -67,7 +67,7 @@ def projected_solution_reference(mesh, geometry, node_values) -> ProjectedSoluti
 
 def body_force_load_reference(mesh, geometry, field) -> np.ndarray:
     """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid."""
-    x, w, cells = cell_quadrature_reference(mesh, 3)
+    x, w, cells = cell_quadrature_reference(mesh, 2)  # k1_3d_fields.BODY_FORCE_POINTS
     f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1) * w[:, None]
     volume = np.bincount(cells, w, mesh.n_cells)
     mean_f = np.stack([np.bincount(cells, f[:, k], mesh.n_cells) for k in range(3)], axis=1) / volume[:, None]
