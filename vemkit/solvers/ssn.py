@@ -66,6 +66,7 @@ import numpy as np
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import linear_solver
 from vemkit.contact.boundary import rank_one_blocks
+from vemkit.solvers.sparse_ops import abs_matvec, add_in_pattern
 from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis
 from vemkit.solvers.solution import (
     ContactSolution,
@@ -106,7 +107,6 @@ class _Newton:
     b_ref: float = 1.0  # reference friction bound
     gamma: np.ndarray | None = None  # the complementarity parameter per contact vertex
     energy_merit: bool = False  # the reduced law: line search on the convex energy
-    K_abs: object = None  # |K| for the rounding floor
     records: list = field(default_factory=list)  # history, one dict per iteration
     previous_state: np.ndarray | None = None  # contact/stick/slip codes of the last step
     short_steps: int = 0
@@ -220,7 +220,6 @@ def _prepare(newton, t):
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     newton.gamma = GAMMA_FACTOR * newton.kd_tau / (np.sum(cb.weight) * newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
-    newton.K_abs = abs(K)
 
 
 def _evaluate(newton, u, lam) -> _Point:
@@ -253,7 +252,7 @@ def _converged(newton, point) -> bool:
     problem = newton.problem
     cb, law = problem.contact, problem.law
     stiff = cb.weight * np.minimum(law.normal_stiffness(point.t), newton.stiffness_cap) * np.abs(point.t + cb.gap)
-    size = newton.K_abs @ np.abs(point.u) + np.abs(problem.load) + cb.scatter(stiff, newton.zero, problem.n_dofs)
+    size = abs_matvec(problem.stiffness, np.abs(point.u)) + np.abs(problem.load) + cb.scatter(stiff, newton.zero, problem.n_dofs)
     point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
     return residual <= point.floor
 
@@ -332,12 +331,12 @@ def _newton_direction(newton, point, k):
         return rank_one_blocks(cb, np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0), cb.tangent, n)
 
     # the Newton system: K + J (+ the friction-bound derivative w p_tau' lambda tau nu^T, m_tau > 0)
-    A = K + cb.normal_jacobian(point.u, law, newton.stiffness_cap)
+    J = cb.normal_jacobian(point.u, law, newton.stiffness_cap)
     if not law.reduced:
         lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
-        A = A + rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    A = A.tocsr()
+        J = J + rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
+    A = add_in_pattern(K, J)  # K's index arrays, a copy of its values: no pattern merge of K + J
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction

@@ -14,6 +14,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import LinearSolveError
 from vemkit.solvers.linear import linear_solver
+from vemkit.solvers.sparse_ops import reduced_operator
 
 REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
 MIN_REBUILD_ITERATIONS = 20
@@ -61,9 +62,9 @@ class ReducedSolver:
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True):
         """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs)."""
         b = rhs if Z is None else Z.T @ rhs
-        A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
         lift = (lambda y: y) if Z is None else (lambda y: Z @ y)
         if self.method == "direct":
+            A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
             if symmetric:
                 return lift(linear_solver(A_red, "direct").solve(b)), 1
             y = spla.splu(A_red.tocsc()).solve(b)
@@ -75,6 +76,7 @@ class ReducedSolver:
         if np.linalg.norm(b) == 0.0:
             return np.zeros(A.shape[0]), 0
         krylov = spla.cg if symmetric else _gmres
+        A_red = A if Z is None else reduced_operator(A, Z)  # Z^T A Z never formed (a matrix the size of K)
         y, its = self._krylov(krylov, A_red, Z, b, eta)
         decades = max(np.log10(1.0 / eta), 1.0)
         if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
