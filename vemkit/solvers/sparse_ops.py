@@ -8,7 +8,9 @@ At 2.1 M DOFs (the paper scene at h = 2^-10) K holds 38 M entries, 450 MB: ``abs
 - :func:`add_in_pattern` is K + J as K's index arrays with a copy of its values, J added in place
   (J's entries lie on K's pattern: the contact blocks couple dofs of one node, or of the two ends
   of a Gamma_C edge, which share a cell); K + J by scipy when one does not;
-- :func:`reduced_operator` is y -> Z^T A Z y, three sparse products, for the Krylov solves.
+- :func:`reduced_operator` is y -> Z^T A Z y, three sparse products, for the Krylov solves;
+- :class:`SumOperator` is K + J as K x + J x, a matrix only when a direct solve or a rebuilt
+  hierarchy asks for one (:func:`as_matrix`): the Krylov steps never copy K's 38 M values.
 """
 
 from __future__ import annotations
@@ -67,3 +69,27 @@ def reduced_operator(A, Z):
     """y -> Z^T A Z y as a LinearOperator (Z^T A Z never formed)."""
     ZT = Z.T.tocsr()
     return spla.LinearOperator((Z.shape[1], Z.shape[1]), matvec=lambda y: ZT @ (A @ (Z @ np.ravel(y))), dtype=float)
+
+
+class SumOperator(spla.LinearOperator):
+    """K + J (square, CSR) applied as K x + J x; ``matrix()`` forms it (:func:`add_in_pattern`)."""
+
+    def __init__(self, K, J):
+        super().__init__(dtype=float, shape=K.shape)
+        self.K, self.J = K, J.tocsr()
+
+    def _matvec(self, x):
+        x = np.ravel(x)
+        return self.K @ x + self.J @ x
+
+    def _rmatvec(self, x):
+        x = np.ravel(x)
+        return self.K.T @ x + self.J.T @ x
+
+    def matrix(self):
+        return add_in_pattern(self.K, self.J)
+
+
+def as_matrix(A):
+    """A sparse matrix of A (a :class:`SumOperator` formed, anything else as it is)."""
+    return A.matrix() if isinstance(A, SumOperator) else A

@@ -66,7 +66,7 @@ import numpy as np
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import linear_solver
 from vemkit.contact.boundary import rank_one_blocks
-from vemkit.solvers.sparse_ops import abs_matvec, add_in_pattern
+from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
 from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis
 from vemkit.solvers.solution import (
     ContactSolution,
@@ -332,11 +332,16 @@ def _newton_direction(newton, point, k):
 
     # the Newton system: K + J (+ the friction-bound derivative w p_tau' lambda tau nu^T, m_tau > 0)
     J = cb.normal_jacobian(point.u, law, newton.stiffness_cap)
+    slope_blocks = None
     if not law.reduced:
         lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
-        J = J + rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    A = add_in_pattern(K, J)  # K's index arrays, a copy of its values: no pattern merge of K + J
+        slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
+    if newton.reduced.method == "direct":  # formed as it always was: the same numbers to the last bit
+        A = K + J if slope_blocks is None else K + J + slope_blocks
+        A = A.tocsr()
+    else:  # K x + J x: no copy of K's values (formed, on K's index arrays, only for a rebuilt hierarchy)
+        A = SumOperator(K, J if slope_blocks is None else J + slope_blocks)
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction
