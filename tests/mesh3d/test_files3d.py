@@ -21,8 +21,10 @@ def same_mesh(a, b):
         assert np.array_equal(a.boundary[name], b.boundary[name])
 
 
-@pytest.mark.parametrize("make", [lambda: octree(3, rule="random", seed=1), lambda: voronoi(3),
-                                  lambda: extrude(build_mesh("hanging", 3), 2, 0.5)])
+@pytest.mark.parametrize(
+    "make",
+    [lambda: octree(3, rule="random", seed=1), lambda: voronoi(3), lambda: extrude(build_mesh("hanging", 3), 2, 0.5)],
+)
 def test_netcdf_round_trip(tmp_path, make):
     mesh = make()
     write_ugrid3d(mesh, tmp_path / "m.nc")
@@ -79,10 +81,11 @@ def vtu_arrays(path):
 
     kinds = {"Float64": np.float64, "Int64": np.int64, "UInt8": np.uint8}
     out = {}
-    for kind, name, text in re.findall(r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>',
-                                       path.read_text()):
+    for kind, name, text in re.findall(
+        r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>', path.read_text()
+    ):
         raw = base64.b64decode(text)
-        out[name] = np.frombuffer(raw[8:8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
+        out[name] = np.frombuffer(raw[8 : 8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
     return out
 
 
@@ -91,7 +94,7 @@ def stream_cycles(faces, faceoffsets):
     for end in faceoffsets:
         count, at, cycles = faces[start], start + 1, []
         for _ in range(count):
-            cycles.append(canonical(faces[at + 1:at + 1 + faces[at]]))
+            cycles.append(canonical(faces[at + 1 : at + 1 + faces[at]]))
             at += 1 + faces[at]
         assert at == end
         cells.append(sorted(cycles))
@@ -109,7 +112,9 @@ def test_vtu_polyhedra_read_back(tmp_path):
     assert cycles == [outward_cycles(mesh, c) for c in range(mesh.n_cells)]  # outward, in mesh order
     offsets, ids = mesh.cell_vertex_lists
     assert np.array_equal(arrays["offsets"], offsets[1:]) and np.array_equal(arrays["connectivity"], ids)
-    assert np.array_equal(arrays["vol"], mesh.cell_volumes) and np.array_equal(arrays["u"].reshape(-1, 3), mesh.vertices)
+    assert np.array_equal(arrays["vol"], mesh.cell_volumes) and np.array_equal(
+        arrays["u"].reshape(-1, 3), mesh.vertices
+    )
 
 
 def test_meshio_reads_the_vtu_polyhedra(tmp_path):
@@ -188,8 +193,9 @@ def grid_cells(kind):
         return mesh, lattice((2, 2, 1), ((0, 0, 0), (1, 1, 1)))[1]
     if kind == "tetra":
         mesh = tet(shape=(1, 2, 1))
-        ids = lattice((1, 2, 1), ((0, 0, 0), (1, 1, 1)))[1][:, [[0, 1, 2, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 7, 6],
-                                                                [0, 4, 5, 6], [0, 1, 5, 6]]].reshape(-1, 4)
+        ids = lattice((1, 2, 1), ((0, 0, 0), (1, 1, 1)))[1][
+            :, [[0, 1, 2, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 7, 6], [0, 4, 5, 6], [0, 1, 5, 6]]
+        ].reshape(-1, 4)
         return mesh, ids  # half of them mirrored: the reader turns them outward
     base = build_mesh("triangle", 2, kind="structured")
     mesh = extrude(base, 2, 1.0)
@@ -224,9 +230,11 @@ def test_gmsh_3d_errors(tmp_path):
     sides = boundary_cycles(mesh)
     untagged = read_mesh3d(gmsh_file(tmp_path, mesh.vertices, "hexahedron", cells, {"left": sides["left"]}, "gmsh22"))
     assert len(untagged.boundary["untagged"]) == mesh.boundary_faces.size - len(sides["left"])
-    inner = mesh.face_vertices[mesh.face_offsets[0]:mesh.face_offsets[1]]
-    interior = [csr_rows(mesh.face_offsets, mesh.face_vertices)[f].tolist()
-                for f in np.flatnonzero((mesh.face_cells >= 0).all(axis=1))[:1]]
+    inner = mesh.face_vertices[mesh.face_offsets[0] : mesh.face_offsets[1]]
+    interior = [
+        csr_rows(mesh.face_offsets, mesh.face_vertices)[f].tolist()
+        for f in np.flatnonzero((mesh.face_cells >= 0).all(axis=1))[:1]
+    ]
     assert inner.size == 4
     with pytest.raises(MeshError, match="is not a boundary face of the mesh; tag boundary surfaces only"):
         read_mesh3d(gmsh_file(tmp_path, mesh.vertices, "hexahedron", cells, {"bad": interior}, "gmsh22"))

@@ -35,6 +35,8 @@ def test_voronoi_within_ten_percent(size):
 
 def test_errors():
     with pytest.raises(SceneError, match="give a box domain"):
-        estimate_mesh3d("square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2)
+        estimate_mesh3d(
+            "square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2
+        )
     with pytest.raises(SceneError, match="unknown box family 'square'"):
         estimate_mesh3d("square", BOX, n=2)

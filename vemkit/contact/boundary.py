@@ -49,8 +49,10 @@ MAX_GAUSS_POINTS = 10
 def gauss_rule(points: int):
     """Gauss-Legendre points and weights on [0, 1] (weights sum to 1), exact for degree 2 points - 1."""
     if not (isinstance(points, (int, np.integer)) and 1 <= points <= MAX_GAUSS_POINTS):
-        raise SceneError(f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to "
-                         f"{MAX_GAUSS_POINTS}", key="discretization.contact_gauss_points")
+        raise SceneError(
+            f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to {MAX_GAUSS_POINTS}",
+            key="discretization.contact_gauss_points",
+        )
     x, w = np.polynomial.legendre.leggauss(int(points))
     return 0.5 * (x + 1.0), 0.5 * w
 
@@ -88,13 +90,18 @@ class ContactBoundary:
 
     def __post_init__(self):
         if self.quadrature not in QUADRATURES:
-            raise SceneError(f"discretization.contact_quadrature = {self.quadrature!r}: use nodal or gauss",
-                             key="discretization.contact_quadrature")
+            raise SceneError(
+                f"discretization.contact_quadrature = {self.quadrature!r}: use nodal or gauss",
+                key="discretization.contact_quadrature",
+            )
         if self.quadrature == "gauss":
             free = self.edge_vertex >= 0
             if not np.array_equal(self.edge_gap[free], self.gap[self.edge_vertex[free]]):
-                raise InputError("the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
-                                 "quadrature: use ContactBoundary.with_gap", key="contact.gap")
+                raise InputError(
+                    "the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
+                    "quadrature: use ContactBoundary.with_gap",
+                    key="contact.gap",
+                )
 
     @property
     def size(self) -> int:
@@ -192,7 +199,6 @@ class ContactBoundary:
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
 
-
 class FoundationLine:
     """The foundation as a line (SPEC §7 ``contact.foundation``): the gap of a boundary point x with
     outward normal nu is the distance from x along nu to the line, d / cos with d = (x - point) . n
@@ -220,11 +226,14 @@ def _gap_values(gap, coords, normals, check=True):
         bad = int(np.flatnonzero(~np.isfinite(g) | (g < 0))[0])
         where = f"{g[bad]:.6g} at x={coords[bad, 0]:.6g}, y={coords[bad, 1]:.6g}"
         if isinstance(gap, FoundationLine):
-            raise SceneError(f"contact.foundation: the contact side is beyond the foundation line (gap {where}: the body "
-                             "starts out penetrating it); move contact.foundation.point or flip its normal",
-                             key="contact.foundation")
-        raise SceneError(f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}",
-                         key="contact.gap")
+            raise SceneError(
+                f"contact.foundation: the contact side is beyond the foundation line (gap {where}: the body "
+                "starts out penetrating it); move contact.foundation.point or flip its normal",
+                key="contact.foundation",
+            )
+        raise SceneError(
+            f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}", key="contact.gap"
+        )
     return g
 
 
@@ -258,9 +267,12 @@ def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
 def check_quadrature(space, quadrature: str) -> None:
     """SceneError unless the quadrature suits the element: ``gauss`` needs linear traces (k = 1)."""
     if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
-        raise SceneError(f"discretization.contact_quadrature = {quadrature!r} is not available with "
-                         f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
-                         "midpoints is used); set contact_quadrature: nodal", key="discretization.contact_quadrature")
+        raise SceneError(
+            f"discretization.contact_quadrature = {quadrature!r} is not available with "
+            f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
+            "midpoints is used); set contact_quadrature: nodal",
+            key="discretization.contact_quadrature",
+        )
 
 
 def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float):
@@ -301,10 +313,28 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     free = dofs.free_index[verts]
     g = _gap_values(gap, coords, normal)
     if w_mid is not None:  # the Gauss option needs linear traces: no edge data
-        return ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2), weight, normal,
-                               tangent, g, coords, quadrature)
-    return _with_edges(ContactBoundary(verts, np.stack([2 * free, 2 * free + 1], axis=1), weight, normal, tangent, g,
-                                       coords, quadrature), mesh, edges, dofs, gap, length, weighted_normal, gauss_points)
+        return ContactBoundary(
+            verts,
+            np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2),
+            weight,
+            normal,
+            tangent,
+            g,
+            coords,
+            quadrature,
+        )
+    return _with_edges(
+        ContactBoundary(
+            verts, np.stack([2 * free, 2 * free + 1], axis=1), weight, normal, tangent, g, coords, quadrature
+        ),
+        mesh,
+        edges,
+        dofs,
+        gap,
+        length,
+        weighted_normal,
+        gauss_points,
+    )
 
 
 def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):
@@ -317,6 +347,14 @@ def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weigh
     edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, cb.gap, edge_normal)
     prescribed = np.einsum("eai,ei->ea", dofs.prescribed_displacement()[edges], edge_normal)
     s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
-    return replace(cb, edge_vertex=edge_vertex, edge_normal=edge_normal, edge_length=length, edge_gap=edge_gap,
-                   edge_coords=edge_coords, gauss_points=s, gauss_weights=w,
-                   edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed))
+    return replace(
+        cb,
+        edge_vertex=edge_vertex,
+        edge_normal=edge_normal,
+        edge_length=length,
+        edge_gap=edge_gap,
+        edge_coords=edge_coords,
+        gauss_points=s,
+        gauss_weights=w,
+        edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed),
+    )

@@ -107,8 +107,19 @@ def smoothed_prolongator(A, aggregates, tvalues, n_aggregates: int, omega: float
     index_type = np.int32 if max(nnz, k * n_aggregates) < np.iinfo(np.int32).max else np.int64
     p_indices = np.empty(nnz, dtype=index_type)
     p_data = np.empty(nnz)
-    _fill(A.indptr, A.indices, A.data, agg, np.ascontiguousarray(tvalues, dtype=float), float(omega), widest, k,
-          p_ptr, p_indices, p_data)
+    _fill(
+        A.indptr,
+        A.indices,
+        A.data,
+        agg,
+        np.ascontiguousarray(tvalues, dtype=float),
+        float(omega),
+        widest,
+        k,
+        p_ptr,
+        p_indices,
+        p_data,
+    )
     P = sp.csr_matrix((p_data, p_indices, p_ptr.astype(index_type)), shape=(A.shape[0], k * n_aggregates))
     P.has_sorted_indices = True
     return P

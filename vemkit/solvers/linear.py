@@ -51,8 +51,9 @@ def v_cycle_preconditioner(hierarchy):
         here.R = here.R if here.R.format == "csc" else here.R.tocsr()  # csc: P^T as a view of P
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
-    return spla.LinearOperator(levels[0].A.shape, dtype=float,
-                               matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b)))
+    return spla.LinearOperator(
+        levels[0].A.shape, dtype=float, matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
+    )
 
 
 #: pyamg's options, measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR
@@ -91,14 +92,17 @@ def smoothed_aggregation(A, near_nullspace=None):
 
     options = dict(AMG_OPTIONS)
     if A.shape[0] <= max(FINEST_OWN, options["max_coarse"]) or near_nullspace is None:
-        return pyamg.smoothed_aggregation_solver(A, B=near_nullspace, **dict(options, strength=[None, options["strength"]]))
+        return pyamg.smoothed_aggregation_solver(
+            A, B=near_nullspace, **dict(options, strength=[None, options["strength"]])
+        )
     from vemkit.solvers.amg_setup import finest_level
 
     P, R, A_coarse, B_coarse = finest_level(A, near_nullspace, omega=options["smooth"][1]["omega"])
     presmoother, postsmoother = options.pop("presmoother"), options.pop("postsmoother")
     coarse_solver = options.pop("coarse_solver")
-    coarse = pyamg.smoothed_aggregation_solver(A_coarse, B=B_coarse, presmoother=presmoother,
-                                               postsmoother=postsmoother, coarse_solver=coarse_solver, **options)
+    coarse = pyamg.smoothed_aggregation_solver(
+        A_coarse, B=B_coarse, presmoother=presmoother, postsmoother=postsmoother, coarse_solver=coarse_solver, **options
+    )
     finest = MultilevelSolver.Level()
     finest.A, finest.B, finest.P, finest.R = A, np.asarray(near_nullspace, dtype=float), P, R
     A.symmetry = "hermitian"
@@ -133,14 +137,17 @@ class AMGSolver:
         def callback(xk):
             count[0] += 1
 
-        x, info = spla.cg(A, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback)
+        x, info = spla.cg(
+            A, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback
+        )
         self.iterations = count[0]
         self.residual = float(np.linalg.norm(b - A @ x) / bnorm)
         if info != 0 or not np.all(np.isfinite(x)):
             raise LinearSolveError(
                 f"AMG-CG stopped after {count[0]} iterations at relative residual {self.residual:.2e} "
                 f"(asked {tol:.1e}); try solver.linear=direct",
-                solver="amg", iterations=count[0],
+                solver="amg",
+                iterations=count[0],
             )
         return x
 
@@ -165,7 +172,8 @@ class DirectSolver:
         except RuntimeError as exc:  # exactly singular
             raise LinearSolveError(
                 f"the stiffness matrix is singular ({exc}); is the body held (Dirichlet part)?",
-                solver="direct", iterations=0,
+                solver="direct",
+                iterations=0,
             ) from None
 
     def solve(self, b, x0=None, tol=None, A=None):
@@ -178,7 +186,8 @@ class DirectSolver:
         if not np.all(np.isfinite(x)):
             raise LinearSolveError(
                 "the direct solve produced non-finite values; the matrix is singular or badly scaled",
-                solver="direct", iterations=1,
+                solver="direct",
+                iterations=1,
             )
         return x
 

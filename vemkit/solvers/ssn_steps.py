@@ -104,7 +104,8 @@ class ReducedSolver:
             raise LinearSolveError(
                 f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
                 f"try solver.linear=direct",
-                solver="amg", iterations=count[0],
+                solver="amg",
+                iterations=count[0],
             )
         return y, count[0]
 

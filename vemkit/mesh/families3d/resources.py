@@ -50,8 +50,9 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
     """The counts of ``family`` on a box domain (module doc); SceneError for another body or family."""
     body = domain3d_from_spec(domain)
     if not isinstance(body, Box):
-        raise SceneError("estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh)",
-                         key="domain")
+        raise SceneError(
+            "estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh)", key="domain"
+        )
     box = (body.lower, body.upper)
     if family == "voronoi":
         count = seed_count(cells_per_length3d(body, n, h, None) if cells is None else None, box, cells)
@@ -60,8 +61,10 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
         faces = max(4, int(VORONOI_FACES_PER_CELL * count - deficit))
         return Mesh3dEstimate(count, vertices, faces, 3 * vertices, False)
     if family not in ("hex", "tet", "octree"):
-        raise SceneError(f"estimate_mesh3d: unknown box family {family!r}; valid: hex, tet, octree, voronoi",
-                         key="discretization.mesh.family")
+        raise SceneError(
+            f"estimate_mesh3d: unknown box family {family!r}; valid: hex, tet, octree, voronoi",
+            key="discretization.mesh.family",
+        )
     nx, ny, nz = grid_shape(box_cells_per_length(family, body, n, h, cells, options), box)
     c, v, f = _grid_counts(nx, ny, nz)
     if family == "hex":
