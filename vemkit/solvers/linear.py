@@ -10,7 +10,6 @@ its hierarchy as a preconditioner for it, the direct solver refactorizes.
 from __future__ import annotations
 
 import numpy as np
-import pyamg
 import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import InputError, LinearSolveError, SceneError
@@ -40,16 +39,92 @@ def v_cycle_preconditioner(hierarchy):
     CG iteration at 10^6 DOFs. The coarse levels (pyamg makes them 3 x 3 block BSR for the three
     rigid modes) are smoothed in scalar CSR: pyamg's block Gauss-Seidel costs 3-4 times as much
     per nonzero, for the same CG iteration counts (measured: Cook at 10^6 DOFs, squares and
-    triangles; the paper scene, ssn and uzawa, n = 128 ... 512). Both: CG time -32 %.
+    triangles; the paper scene, ssn and uzawa, n = 128 ... 512). Both: CG time -32 %. The
+    transfers P, R are CSR as well: a V-cycle at 2.1 M DOFs (paper scene, 1024^2) 0.246 -> 0.191 s
+    CPU, the same vector to the last bit.
     """
     levels = hierarchy.levels
     for here in levels[1:-1]:
         here.A = here.A.tocsr()
+    for here in levels[:-1]:  # the transfers too: BSR (1 x 3, 3 x 3) products cost 1.5 x CSR's, same sums
+        here.P = here.P.tocsr()
+        here.R = here.R if here.R.format == "csc" else here.R.tocsr()  # csc: P^T as a view of P
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
     return spla.LinearOperator(
         levels[0].A.shape, dtype=float, matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
     )
+
+
+#: pyamg's options, measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR
+#: aggregation with the rigid-body modes converges in as few CG iterations as 2 x 2 BSR blocks and
+#: its Gauss-Seidel sweeps are cheaper; improving the candidates doubles the setup for nothing.
+AMG_OPTIONS = dict(
+    symmetry="hermitian",
+    # the coarse levels are 3 x 3 blocks, amalgamated by "symmetric" with theta = 0: every entry is strong
+    strength=("symmetric", {"theta": 0.0}),
+    # "local" weighting bounds rho(D^-1 A) by row sums: the default Lanczos estimate
+    # was 70 % of the set-up at 512^2 squares, for 4 fewer CG iterations
+    smooth=("jacobi", {"omega": 4.0 / 3.0, "degree": 1, "weighting": "local"}),
+    presmoother=("gauss_seidel", {"sweep": "forward"}),
+    postsmoother=("gauss_seidel", {"sweep": "backward"}),
+    improve_candidates=None,
+    max_coarse=2000,
+    coarse_solver="splu",  # pinv (the default) costs seconds when coarsening stalls above max_coarse
+    keep=False,
+)
+FINEST_OWN = 2000  # above this many unknowns the finest level is vemkit.solvers.amg_setup's
+
+
+def smoothed_aggregation(A, near_nullspace=None):
+    """The smoothed aggregation hierarchy of A (CSR) with the rigid-body modes as near-nullspace.
+
+    The finest level: theta = 0 makes every entry strong, so its strength matrix is A's own
+    pattern (strength None: the same aggregates; 0.5 s less set-up and 0.2 GiB less peak memory at
+    10^6 DOFs, benchmarks/cook.py). Its smoothed prolongator is built by
+    ``vemkit.solvers.amg_setup`` (the same P as pyamg's "local" Jacobi smoother without its three
+    copies of A: at 2.1 M DOFs the set-up 8.8 -> 4.5 s CPU); the coarser levels are pyamg's
+    with the same options.
+    """
+    import pyamg
+    from pyamg.multilevel import MultilevelSolver
+    from pyamg.relaxation.smoothing import change_smoothers
+
+    options = dict(AMG_OPTIONS)
+    if near_nullspace is not None and np.shape(near_nullspace)[1] == 6 and A.shape[0] % 3 == 0:
+        return _block_hierarchy(A, near_nullspace, options)
+    if A.shape[0] <= max(FINEST_OWN, options["max_coarse"]) or near_nullspace is None:
+        return pyamg.smoothed_aggregation_solver(
+            A, B=near_nullspace, **dict(options, strength=[None, options["strength"]])
+        )
+    from vemkit.solvers.amg_setup import finest_level
+
+    P, R, A_coarse, B_coarse = finest_level(A, near_nullspace, omega=options["smooth"][1]["omega"])
+    presmoother, postsmoother = options.pop("presmoother"), options.pop("postsmoother")
+    coarse_solver = options.pop("coarse_solver")
+    coarse = pyamg.smoothed_aggregation_solver(
+        A_coarse, B=B_coarse, presmoother=presmoother, postsmoother=postsmoother, coarse_solver=coarse_solver, **options
+    )
+    finest = MultilevelSolver.Level()
+    finest.A, finest.B, finest.P, finest.R = A, np.asarray(near_nullspace, dtype=float), P, R
+    A.symmetry = "hermitian"
+    hierarchy = MultilevelSolver([finest] + coarse.levels, coarse_solver=coarse_solver)
+    change_smoothers(hierarchy, presmoother, postsmoother)
+    return hierarchy
+
+
+def _block_hierarchy(A, near_nullspace, options):
+    """3D (six rigid modes, three dofs per node): the set-up on the 3 x 3 block form of A, so that every
+    level's strength is by "symmetric" on blocks: the same aggregates and CG iterations as scalar CSR,
+    set-up 2.2 times faster (hexahedra at 2e5 DOFs: 1.41 s instead of 3.08 s CPU, 24 iterations either
+    way; theta = 0.02: 22 iterations, the same CG time; max_coarse 500 or 2000 the same levels, 8000
+    stops at a 16 464-unknown LU: 18 iterations, 3.7 x the CG time). The cycle smooths the finest
+    level in scalar CSR (``v_cycle_preconditioner``)."""
+    import pyamg
+
+    hierarchy = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(3, 3)), B=near_nullspace, **options)
+    hierarchy.levels[0].A = A
+    return hierarchy
 
 
 class AMGSolver:
@@ -61,37 +136,7 @@ class AMGSolver:
         self.A = A.tocsr()
         self.tol = tol
         self.maxiter = maxiter
-        # Settings measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR aggregation with
-        # the rigid-body modes converges in as few CG iterations as 2 x 2 BSR blocks and its
-        # Gauss-Seidel sweeps are cheaper; improving the candidates doubles the setup for nothing.
-        # the six rigid motions of 3D, three dofs per node
-        three_d = near_nullspace is not None and np.shape(near_nullspace)[1] == 6 and self.A.shape[0] % 3 == 0
-        self.hierarchy = pyamg.smoothed_aggregation_solver(
-            self.A.tobsr(blocksize=(3, 3)) if three_d else self.A,
-            B=near_nullspace,
-            symmetry="hermitian",
-            # theta = 0: every entry is strong. On the scalar finest level the strength matrix is then
-            # A's own pattern (None: the same aggregates; 0.5 s less set-up and 0.2 GiB less peak
-            # memory at 10^6 DOFs, benchmarks/cook.py); the
-            # coarse levels are 3 x 3 blocks, amalgamated by "symmetric".
-            # 3D (six modes): the finest level in 3 x 3 blocks too (one node's three dofs), so every
-            # level's strength is by "symmetric" on blocks: the same aggregates and CG iterations as
-            # scalar CSR, set-up 2.2 times faster (hexahedra at 2e5 DOFs: 1.41 s instead of 3.08 s CPU, 24
-            # iterations either way; theta = 0.02: 22 iterations, the same CG time; max_coarse 500 or
-            # 2000 the same levels, 8000 stops at a 16 464-unknown LU: 18 iterations, 3.7 x the CG time)
-            strength=("symmetric", {"theta": 0.0}) if three_d else [None, ("symmetric", {"theta": 0.0})],
-            # "local" weighting bounds rho(D^-1 A) by row sums: the default Lanczos estimate
-            # was 70 % of the set-up at 512^2 squares, for 4 fewer CG iterations
-            smooth=("jacobi", {"omega": 4.0 / 3.0, "degree": 1, "weighting": "local"}),
-            presmoother=("gauss_seidel", {"sweep": "forward"}),
-            postsmoother=("gauss_seidel", {"sweep": "backward"}),
-            improve_candidates=None,
-            max_coarse=2000,
-            coarse_solver="splu",  # pinv (the default) costs seconds when coarsening stalls above max_coarse
-            keep=False,
-        )
-        if three_d:  # the cycle smooths the finest level in scalar CSR (``v_cycle_preconditioner``)
-            self.hierarchy.levels[0].A = self.A
+        self.hierarchy = smoothed_aggregation(self.A, near_nullspace)
         self.preconditioner = v_cycle_preconditioner(self.hierarchy)
         self.iterations = 0
         self.residual = 0.0

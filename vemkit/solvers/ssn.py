@@ -73,6 +73,7 @@ from vemkit.solvers.solution import (
     residual_scale,
     young_modulus,
 )
+from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
 from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
@@ -106,7 +107,6 @@ class _Newton:
     b_ref: float = 1.0  # reference friction bound
     gamma: np.ndarray | None = None  # the complementarity parameter per contact vertex
     energy_merit: bool = False  # the reduced law: line search on the convex energy
-    K_abs: object = None  # |K| for the rounding floor
     records: list = field(default_factory=list)  # history, one dict per iteration
     previous_state: np.ndarray | None = None  # contact/stick/slip codes of the last step
     short_steps: int = 0
@@ -243,7 +243,6 @@ def _prepare(newton, t):
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     newton.gamma = GAMMA_FACTOR * newton.kd_tau / (np.sum(cb.weight) * newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
-    newton.K_abs = abs(K)
 
 
 def _evaluate(newton, u, lam) -> _Point:
@@ -276,7 +275,11 @@ def _converged(newton, point) -> bool:
     problem = newton.problem
     cb, law = problem.contact, problem.law
     stiff = cb.weight * np.minimum(law.normal_stiffness(point.t), newton.stiffness_cap) * np.abs(point.t + cb.gap)
-    size = newton.K_abs @ np.abs(point.u) + np.abs(problem.load) + cb.scatter(stiff, newton.zero, problem.n_dofs)
+    size = (
+        abs_matvec(problem.stiffness, np.abs(point.u))
+        + np.abs(problem.load)
+        + cb.scatter(stiff, newton.zero, problem.n_dofs)
+    )
     point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
     return residual <= point.floor
 
@@ -361,12 +364,17 @@ def _newton_direction(newton, point, k):
         return rank_one_blocks(cb, np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0), cb.tangent, n)
 
     # the Newton system: K + J (+ the friction-bound derivative w p_tau' lambda tau nu^T, m_tau > 0)
-    A = K + cb.normal_jacobian(point.u, law, newton.stiffness_cap)
+    J = cb.normal_jacobian(point.u, law, newton.stiffness_cap)
+    slope_blocks = None
     if not law.reduced:
         lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
-        A = A + rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    A = A.tocsr()
+        slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
+    if newton.reduced.method == "direct":  # formed as it always was: the same numbers to the last bit
+        A = K + J if slope_blocks is None else K + J + slope_blocks
+        A = A.tocsr()
+    else:  # K x + J x: no copy of K's values (formed, on K's index arrays, only for a rebuilt hierarchy)
+        A = SumOperator(K, J if slope_blocks is None else J + slope_blocks)
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction

@@ -14,6 +14,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import LinearSolveError
 from vemkit.solvers.linear import linear_solver
+from vemkit.solvers.sparse_ops import as_matrix, reduced_operator
 
 REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
 MIN_REBUILD_ITERATIONS = 20
@@ -59,11 +60,14 @@ class ReducedSolver:
         self.baseline = baseline  # CG iterations per decade of residual reduction with K
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True):
-        """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs)."""
+        """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs). A: a
+        sparse matrix or a ``vemkit.solvers.sparse_ops.SumOperator`` (K + J, formed only here for
+        a direct solve or a rebuilt hierarchy)."""
         b = rhs if Z is None else Z.T @ rhs
-        A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
         lift = (lambda y: y) if Z is None else (lambda y: Z @ y)
         if self.method == "direct":
+            A = as_matrix(A)
+            A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
             if symmetric:
                 return lift(linear_solver(A_red, "direct").solve(b)), 1
             y = spla.splu(A_red.tocsc()).solve(b)
@@ -75,10 +79,11 @@ class ReducedSolver:
         if np.linalg.norm(b) == 0.0:
             return np.zeros(A.shape[0]), 0
         krylov = spla.cg if symmetric else _gmres
+        A_red = A if Z is None else reduced_operator(A, Z)  # Z^T A Z never formed (a matrix the size of K)
         y, its = self._krylov(krylov, A_red, Z, b, eta)
         decades = max(np.log10(1.0 / eta), 1.0)
         if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
-            hierarchy = linear_solver(A + penalty(), "amg", near_nullspace=self.problem.near_nullspace)
+            hierarchy = linear_solver(as_matrix(A) + penalty(), "amg", near_nullspace=self.problem.near_nullspace)
             self.preconditioner = hierarchy.preconditioner
             self.rebuilds += 1
             y, more = self._krylov(krylov, A_red, Z, b, eta, x0=y)

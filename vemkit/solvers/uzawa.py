@@ -75,6 +75,7 @@ from vemkit.solvers.solution import (
     history_arrays,
     residual_scale,
 )
+from vemkit.solvers.sparse_ops import abs_matvec
 from vemkit.solvers.uzawa_failures import boundary_compliance, fail, refuse
 
 RHO_FACTOR = 1.5  # rho = RHO_FACTOR / (k_tau b mu_tau); stable below 2
@@ -95,8 +96,8 @@ def acceptable_residual(problem, u, forces, tol, K_abs=None) -> float:
     f = problem.load
     scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(forces)))
     solve_level = tol * max(float(np.linalg.norm(f - forces)), scale) / scale
-    K_abs = abs(problem.stiffness) if K_abs is None else K_abs
-    size = float(np.linalg.norm(K_abs @ np.abs(u) + np.abs(f) + np.abs(forces)))
+    Ku = abs_matvec(problem.stiffness, np.abs(u)) if K_abs is None else K_abs @ np.abs(u)
+    size = float(np.linalg.norm(Ku + np.abs(f) + np.abs(forces)))
     return max(RESIDUAL_FACTOR * solve_level, ROUNDING_FLOOR * np.finfo(float).eps * size / scale)
 
 
@@ -379,8 +380,6 @@ def _stop_check(state, stopped_by):
     if problem.law.frictionless:  # lambda carries no force: the one consistent with the slip
         lam = np.sign(problem.contact.tangential_displacement(state.u))
     check = contact_residual(problem, state.u, lam)
-    if state.K_abs is None:
-        state.K_abs = abs(problem.stiffness)
     level = acceptable_residual(problem, state.u, state.forces, state.options["tol"], state.K_abs)
     if check["worst"] <= level:
         state.lam = lam
