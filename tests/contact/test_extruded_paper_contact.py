@@ -1,0 +1,74 @@
+"""The extruded paper body with u3 = 0 on both end faces against the 2D plane-strain contact solve
+(SPEC §10, issue 21 item 5): equal u1, u2 at every vertex to 1e-10, both solvers, friction on.
+
+The end faces' contact vertices have u3 prescribed (a symmetry roller meeting Gamma_C): they stay
+contact points with u1, u2 in the law (vemkit.contact.boundary). Prisms over triangles: there the 3D
+element on each prism and the 2D element on its base give the same plane-strain stiffness (its
+elasticity-only comparison is exact). On prisms over squares or Voronoi polygons the elasticity alone
+already differs (the 3D stabilization is not the 2D one times the layer: measured without contact,
+gap 10 and friction 0, square n = 4, one layer: 12 % of max|u|; trace stabilization 3 %, dofi 1.5 %), so
+there the contact solves cannot agree either; those cases are xfail, strict, until the elements do.
+"""
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from vemkit.config.scene import scene_from_dict
+from vemkit.contact.problem import scene_problem
+from vemkit.solvers.dispatch import solve
+from vemkit.solvers.solution import SEPARATED, SLIP, STICK, contact_state
+
+PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
+BASE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
+OPTIONS = {"uzawa": {"method": "uzawa", "tol": 1e-12, "linear": "direct", "stop": "both", "eps_u": 1e-13,
+                     "eps_lambda": 1e-13, "max_iterations": 20000},
+           "ssn": {"method": "ssn", "tol": 1e-12, "linear": "direct"}}
+
+
+def scenes(family: str, n: int, layers: int, friction: float):
+    """The paper scene on the square as a polygon (plane strain) and extruded by 0.25 (3D)."""
+    flat = yaml.safe_load(PAPER.read_text())
+    flat.update(model="plane_strain", domain=BASE)
+    flat["contact"]["friction"]["k"] = friction
+    flat["discretization"]["mesh"] = {"family": family, "n": n}
+    body = copy.deepcopy(flat)
+    body.update(model="3d", domain=dict(BASE, extrude={"depth": 0.25}), body_force=[0, 0, 0])
+    body["discretization"]["mesh"] = {"family": family, "n": n, "layers": layers}
+    body["boundary"]["dirichlet"] = {"right": [0, 0, 0], "front": [None, None, 0], "back": [None, None, 0]}
+    body["boundary"]["neumann"] = {"left": {"traction": ["200*(5-y)", -200, 0]}, "top": {"traction": [0, 0, 0]}}
+    return scene_from_dict(flat), scene_from_dict(body)
+
+
+def compare(family, n, layers, friction, method):
+    flat, body = (scene_problem(s) for s in scenes(family, n, layers, friction))
+    s2, s3 = solve(flat, OPTIONS[method]), solve(body, OPTIONS[method])
+    u2, u3 = flat.vertex_displacement(s2.u), body.vertex_displacement(s3.u)
+    base = {tuple(np.round(x, 12)): i for i, x in enumerate(flat.mesh.vertices)}
+    below = np.array([base[tuple(np.round(x[:2], 12))] for x in body.mesh.vertices])
+    difference = np.max(np.abs(u3[:, :2] - u2[below])) / np.max(np.abs(u2))
+    return difference, np.max(np.abs(u3[:, 2])), body, s3
+
+
+@pytest.mark.parametrize("method", ["ssn", "uzawa"])
+@pytest.mark.parametrize("friction, layers", [(450.0, 2), (700.0, 2), (700.0, 1)])
+def test_the_extruded_paper_body_is_the_plane_strain_solve(method, friction, layers):
+    difference, u3, body, solution = compare("triangle", 6, layers, friction, method)
+    assert difference < 1e-10 and u3 < 1e-14, (difference, u3)
+    cb = body.contact
+    assert cb.fixed is not None and cb.fixed[:, 2].sum() == 2 * cb.size // (layers + 1)  # both end faces
+    states = contact_state(body, solution.u, solution.multiplier).state
+    assert np.sum(states == SLIP) > 0 and np.sum(states == SEPARATED) > 0
+    if friction == 700.0:
+        assert np.sum(states == STICK) > 0
+
+
+@pytest.mark.xfail(strict=True, reason="the 3D stabilization on polygonal prisms is not the 2D one: the "
+                                       "elasticity alone differs (module docstring)")
+@pytest.mark.parametrize("family", ["square", "voronoi"])
+def test_on_polygonal_prisms_the_elasticity_differs_already(family):
+    difference, _, _, _ = compare(family, 4, 1, 450.0, "ssn")
+    assert difference < 1e-10
