@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.contact.gaps import FoundationLine, _edge_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
 from vemkit.contact.trace_nodes import contact_edges, midpoint_edges, rule_weights
 from vemkit.exceptions import InputError, SceneError
 from vemkit.mesh.mesh import Mesh, edge_indices
@@ -262,55 +263,6 @@ class ContactBoundary:
         dofs = self._edge_dofs(n_dofs)
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
-
-
-class FoundationLine:
-    """The foundation as a line (SPEC §7 ``contact.foundation``), or a plane in 3D (SPEC §10, a point and
-    a normal of three components): the gap of a boundary point x with
-    outward normal nu is the distance from x along nu to the line, d / cos with d = (x - point) . n
-    (n the unit normal of the line towards the body) and cos = -nu . n; a surface turned away from
-    the line (cos below MIN_FACING) gets d / MIN_FACING, far enough never to touch."""
-
-    MIN_FACING = 1e-2
-
-    def __init__(self, point, normal):
-        self.point = np.asarray(point, dtype=float)
-        normal = np.asarray(normal, dtype=float)
-        self.normal = normal / (np.hypot(*normal) if normal.size == 2 else np.linalg.norm(normal))
-
-    def along(self, coords: np.ndarray, normals: np.ndarray) -> np.ndarray:
-        distance = (coords - self.point) @ self.normal
-        facing = np.maximum(-(normals @ self.normal), self.MIN_FACING)
-        return distance / facing
-
-
-def _gap_values(gap, coords, normals, check=True):
-    if isinstance(gap, FoundationLine):
-        g = gap.along(coords, normals)
-    else:
-        g = np.broadcast_to(np.asarray(gap(*coords.T), dtype=float), (coords.shape[0],)).copy()
-    if not np.all(np.isfinite(g)) or (check and np.any(g < 0)):
-        bad = int(np.flatnonzero(~np.isfinite(g) | (g < 0))[0])
-        where = f"{g[bad]:.6g} at " + ", ".join(f"{a}={c:.6g}" for a, c in zip("xyz", coords[bad]))
-        if isinstance(gap, FoundationLine):
-            raise SceneError(f"contact.foundation: the contact side is beyond the foundation line (gap {where}: the body "
-                             "starts out penetrating it); move contact.foundation.point or flip its normal",
-                             key="contact.foundation")
-        raise SceneError(f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}",
-                         key="contact.gap")
-    return g
-
-
-def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap, edge_normal):
-    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at dropped ends (with
-    the edge's normal)."""
-    ends = np.zeros(edge_vertex.shape)
-    free = edge_vertex >= 0
-    ends[free] = vertex_gap[edge_vertex[free]]
-    if np.any(~free):
-        normals = np.broadcast_to(edge_normal[:, None, :], edge_coords.shape)
-        ends[~free] = _gap_values(gap, edge_coords[~free], normals[~free], check=False)
-    return ends
 
 
 def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):

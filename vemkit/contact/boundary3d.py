@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.contact.boundary import ContactBoundary, _gap_values, contact_nodes, fixed_components
+from vemkit.contact.boundary import ContactBoundary, contact_nodes, fixed_components
+from vemkit.contact.gaps import _gap_values
 from vemkit.exceptions import SceneError
 
 
