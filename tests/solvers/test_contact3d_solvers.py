@@ -1,14 +1,13 @@
 """Coulomb friction on a 3D body (SPEC §10, issue 21 items 3-4): uzawa (Steps 1-3 with the multiplier
 projected on the unit disk) and ssn (the semismooth Newton step of vemkit.solvers.ssn_disk) agree to
 1e-10 at tol 1e-12 with stick and slip vertices, the slip direction is not an axis (turning along Gamma_C: a box
-instead of the disk would fail), and the independent check sees a multiplier turned off the slip direction and |lambda| > 1."""
+instead of the disk would fail), for the reduced law m_tau = 0 and for m_tau = 1, and the independent check sees a multiplier turned off the slip direction and |lambda| > 1."""
 
 import numpy as np
 import pytest
 
 from vemkit.config.scene import scene_from_dict
 from vemkit.contact.problem import scene_problem
-from vemkit.exceptions import InputError
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import SLIP, STICK, contact_state
 from vemkit.solvers.verification import verify_solution
@@ -59,9 +58,15 @@ def test_the_check_sees_a_wrong_slip_direction_and_a_multiplier_outside_the_disk
     assert verify_solution(problem, b.u, 1.01 * b.multiplier)["multiplier_bound"] > 5e-3
 
 
-def test_ssn_refuses_the_full_law_in_3d_and_uzawa_solves_it():
-    problem = sheared_box("hex", 3, 2e4, m=1.0)
-    with pytest.raises(InputError, match="reduced friction law"):
-        solve(problem, SSN)
-    a = solve(problem, UZAWA)
-    assert verify_solution(problem, a.u, a.multiplier, tol=1e-10)["passed"]
+@pytest.mark.parametrize("family, n, friction", [("hex", 4, 330.0), ("voronoi", 3, 500.0)])
+def test_the_full_law_m_tau_1_uzawa_and_ssn_agree(family, n, friction):
+    """m_tau = 1: the friction bound k_tau t follows the penetration (the unsymmetric Newton step)."""
+    problem = sheared_box(family, n, friction, m=1.0)
+    a, b = solve(problem, UZAWA), solve(problem, SSN)
+    assert np.max(np.abs(a.u - b.u)) / np.max(np.abs(b.u)) < 1e-10
+    assert np.max(np.abs(a.multiplier - b.multiplier)) < 1e-10
+    assert b.iterations <= 20
+    state = contact_state(problem, b.u, b.multiplier).state
+    assert np.sum(state == SLIP) > 0 and np.sum(state == STICK) > 0
+    for s in (a, b):
+        assert verify_solution(problem, s.u, s.multiplier, tol=1e-10)["passed"]

@@ -6,7 +6,7 @@ Unknowns u (free dofs) and the friction multiplier lambda (one per contact verte
     C(u, lambda) = lambda - P(lambda + gamma u_tau) = 0,   P: projection onto [-1, 1].
 
 On a 3D body (SPEC §10) lambda and u_tau have two components in the vertex basis (t1, t2), P is the
-projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk (reduced law only).
+projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk.
 
 C = 0 is |lambda| <= 1, lambda u_tau = |u_tau| for any gamma > 0. The choice only steers the active
 sets: gamma_c = GAMMA_FACTOR kd_c / (|Gamma_C| b_ref), kd_c the stiffness diagonal in the tangential
@@ -66,7 +66,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vemkit.exceptions import ConvergenceError, InputError, LinearSolveError
+from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import linear_solver
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.solvers.ssn_steps import (ReducedSolver, direction_diagonal, disk_slip_step, line_search, stick_basis,
@@ -155,9 +155,6 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
     t = cb.normal_displacement(u) - cb.gap
     if cb.size == 0 or (not np.any(law.normal_pressure(t)) and not np.any(law.friction_bound(t))):
         return _plain_solution(newton, u)
-    if cb.dimension == 3 and not law.reduced:
-        raise InputError("solver.method = 'ssn' on a 3D body takes the reduced friction law (contact.friction.m = 0, "
-                         "or k = 0) so far; use solver.method=uzawa for m > 0", key="solver.method")
     _prepare(newton, t)
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
     if cb.dimension == 2:

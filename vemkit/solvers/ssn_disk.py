@@ -3,7 +3,9 @@
 The complementarity function is that of 2D, C = lambda - P(q), q = lambda + gamma u_tau, with P the
 projection onto the unit disk of the tangent plane (lambda, u_tau: two components in the vertex
 basis (t1, t2), ``vemkit.contact.boundary3d``); the contact problem (5.2)-(5.3) with the reduced law
-(m_tau = 0 or k_tau = 0, the friction bound b = p_tau independent of u). Generalized Newton on
+(m_tau = 0 or k_tau = 0, the friction bound b = p_tau independent of u; for m_tau > 0 the Jacobian
+also holds w p_tau'(t) (t1, t2) lambda_hat nu^T, lambda_hat the new multiplier's part that does not
+depend on du, and is unsymmetric, as in 2D). Generalized Newton on
 C = 0 with the derivative P'(q) = 0 (stick, |q| <= 1) or (I - n n^T)/|q| (slip, n = q/|q|):
 
 - stick A = {|q| <= 1}: u_tau,new = 0 (both tangents; eliminated by Z, v_c = a nu_c), the stick
@@ -51,6 +53,10 @@ def disk_direction(newton, point, k, sets, solve):
         return rank_one_blocks(cb, weight, cb.tangent, n) + rank_one_blocks(cb, weight, cb.tangent2, n)
 
     A = (K + cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n))
+    if not law.reduced:  # the friction bound's derivative w p_tau'(t) (t1, t2) lambda_hat nu^T (unsymmetric)
+        lam_hat = np.where(slip[:, None], slip_base, np.where(stick[:, None], lam, 0.0))
+        along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
+        A = A + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
     A = A.tocsr()
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = solve(newton, point, k, A, Z, rhs, penalty)
