@@ -92,3 +92,29 @@ def test_on_polygonal_prisms_the_contact_solve_is_a_plane_strain_state(family):
     assert np.max(np.abs(u[0][:, 2])) < 1e-14
     states = contact_state(problem, solutions[0].u, solutions[0].multiplier).state
     assert np.sum(states == SLIP) > 0 and np.sum(states == STICK) + np.sum(states == SEPARATED) > 0
+
+
+def test_a_curved_contact_side_on_a_foundation_plane_is_the_plane_strain_solve():
+    """The Hertz half disk (config/scenes/hertz.yaml: curved Gamma_C, rollers, foundation line)
+    extruded by 0.1 on the foundation plane y = -1: vertex normals averaged over the curved faces and
+    the gap along them give the 2D plane-strain solve and its total force per depth, to 1e-12."""
+    flat = yaml.safe_load((PAPER.parent / "hertz.yaml").read_text())
+    flat.update(model="plane_strain")
+    flat["discretization"]["mesh"] = {"family": "triangle", "h": 0.04}
+    body = copy.deepcopy(flat)
+    body.update(model="3d", body_force=[0, 0, 0])
+    body["domain"]["extrude"] = {"depth": 0.1}
+    body["discretization"]["mesh"]["layers"] = 1
+    body["boundary"]["dirichlet"] = {"top": [None, -0.01, None], "pin": [0.0, -0.01, None],
+                                     "front": [None, None, 0], "back": [None, None, 0]}
+    body["contact"]["foundation"] = {"point": [0, -1, 0], "normal": [0, 1, 0]}
+    p2, p3 = scene_problem(scene_from_dict(flat)), scene_problem(scene_from_dict(body))
+    s2, s3 = solve(p2, OPTIONS["ssn"]), solve(p3, OPTIONS["ssn"])
+    u2, u3 = p2.vertex_displacement(s2.u), p3.vertex_displacement(s3.u)
+    base = {tuple(np.round(x, 10)): i for i, x in enumerate(p2.mesh.vertices)}
+    below = np.array([base[tuple(np.round(x[:2], 10))] for x in p3.mesh.vertices])
+    assert np.max(np.abs(u3[:, :2] - u2[below])) / np.max(np.abs(u2)) < 1e-12
+    forces = [np.sum(p.contact.weight * p.law.normal_pressure(p.contact.normal_displacement(s.u) - p.contact.gap))
+              for p, s in ((p2, s2), (p3, s3))]
+    assert forces[0] > 0 and abs(forces[1] / 0.1 / forces[0] - 1) < 1e-12
+    assert np.allclose(p3.contact.normal[:, 2], 0.0) and not np.allclose(p3.contact.normal[:, 0], 0.0)
