@@ -69,7 +69,7 @@ import numpy as np
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import linear_solver
 from vemkit.contact.boundary import rank_one_blocks
-from vemkit.solvers.ssn_steps import (ReducedSolver, direction_diagonal, disk_slip_step, line_search, stick_basis,
+from vemkit.solvers.ssn_steps import (ReducedSolver, direction_diagonal, line_search, stick_basis,
                                       tangential_diagonal)
 from vemkit.solvers.solution import (
     ContactSolution,
