@@ -16,6 +16,11 @@ C = 0 with the derivative P'(q) = 0 (stick, |q| <= 1) or (I - n n^T)/|q| (slip, 
   SPD (CG with AMG, or direct). This is the semismooth Newton method of the primal-dual active set
   family for 3D Coulomb (Hueber, Stadler, Wohlmuth, SIAM J. Sci. Comput. 30, 2008), here on the
   projection form of the complementarity function; in 2D, I - n n^T = 0 and it is the 2D step.
+
+A stick vertex with a prescribed component (a symmetry roller meeting Gamma_C) keeps it exactly when
+that component is orthogonal to nu (a symmetry plane crosses Gamma_C at right angles: the extruded
+body's end faces, a quarter model's planes), since the column nu_c of Z has no entry there; otherwise
+the step moves it and only the converged residual (which holds its row) restores it.
 """
 
 from __future__ import annotations
