@@ -49,7 +49,8 @@ def test_a_3d_contact_solve_writes_the_contact_node_variables(tmp_path):
     assert "contact_tangent1" in ds.attrs["contact_tangent_basis"]
     assert np.isclose(ds["contact_weight"].sum(), 1.0) and np.allclose(ds["contact_z"], 0.0)
     vertex = ds["contact_vertex"].values
-    assert np.allclose(mesh.vertices[vertex, 0], ds["contact_x"]) and np.allclose(mesh.vertices[vertex, 1], ds["contact_y"])
+    for k, axis in enumerate("xyz"):
+        assert np.allclose(mesh.vertices[vertex, k], ds[f"contact_{axis}"])
     basis = np.stack([np.stack([ds[f"contact_{v}_{a}"].values for a in "xyz"], axis=1)
                       for v in ("tangent1", "tangent2", "normal")], axis=1)
     assert np.allclose(basis @ basis.transpose(0, 2, 1), np.eye(3))
@@ -90,4 +91,15 @@ def test_a_bad_3d_gap_expression_is_refused_in_one_line(tmp_path, gap, message):
     (tmp_path / "s.yaml").write_text(text)
     run = vemkit("solve", tmp_path / "s.yaml", "-o", tmp_path / "s.nc")
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1 and message in run.stderr, run.stderr
+    assert not (tmp_path / "s.nc").exists()
+
+
+def test_a_2d_scene_refuses_a_3d_foundation_in_one_line(tmp_path):
+    text = ("domain: unit_square\nmaterial: {E: 1000.0, nu: 0.3}\nboundary: {dirichlet: [top], contact: [bottom]}\n"
+            "contact:\n  foundation: {point: [0, 0, 0], normal: [0, 0, 1]}\n  normal: {k: 1.0, m: 1.0}\n"
+            "  friction: {k: 0.0, m: 0.0}\ndiscretization: {mesh: {family: square, n: 2}}\n")
+    (tmp_path / "s.yaml").write_text(text)
+    run = vemkit("solve", tmp_path / "s.yaml", "-o", tmp_path / "s.nc")
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1, run.stderr
+    assert "a 2D scene's foundation is a line: give 2" in run.stderr
     assert not (tmp_path / "s.nc").exists()

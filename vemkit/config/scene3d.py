@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.config.boundary_conditions import (MAX_NORMAL_K_OVER_E, PROBES, PlaneProbes, _dirichlet, boundary_expressions,
-                                               check_mesh_size, check_sides, compile_checked, evaluate_checked,
-                                               rigid_motion_error)
+from vemkit.config.boundary_conditions import (MAX_NORMAL_K_OVER_E, PROBES, PlaneProbes, _dirichlet,
+                                               boundary_expressions, check_mesh_size, check_sides, compile_checked,
+                                               evaluate_checked, rigid_motion_error)
 from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError

@@ -12,8 +12,12 @@ displacement is given. A point with only some components prescribed (a symmetry 
 Gamma_C) stays (nodal rule): its prescribed components are fixed dofs (``vemkit.vem.dofs``: decoupled
 rows K_ii u_i = K_ii g_i, so u_i = g_i is what the law reads), no contact force or Jacobian entry goes
 into their rows (the constraint's reaction takes it), and the free components carry the law. With
-the ``gauss`` rule such a point is still dropped (its edge end keeps its prescribed displacement). ``ContactBoundary.vertices`` holds node numbers of the
-space: a mesh vertex v, or n_vertices + e for the midpoint of edge e (k = 2).
+the ``gauss`` rule such a point is still dropped (its edge end keeps its prescribed displacement).
+``ContactBoundary.vertices`` holds node numbers of the space: a mesh vertex v, or n_vertices + e for the
+midpoint of edge e (k = 2). One class for d = 2 and 3: dofs, normals and coordinates are (n_c, d);
+tangential quantities are (n_c,) in 2D and (n_c, 2) in 3D (components along ``tangent`` = t1 and
+``tangent2`` = t2, ``vemkit.contact.boundary3d``), the friction multiplier a scalar in [-1, 1] or a
+vector in the unit disk (``project``, ``direction``, ``magnitude``).
 
 ``gauss`` quadrature (``contact_gauss_points`` N per edge; for an element with linear traces, k = 1):
 the normal-compliance term of (3.16),
