@@ -32,8 +32,17 @@ from _common import MACHINE, quick_parser, targets_line, write_report
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "adaptivity.yaml"
-DEFAULTS = {"error": "true_error", "overrides": [], "theta": 0.5, "target": 1e-3, "max_dofs": 200000, "max_steps": 60, "max_hanging": None,
-            "uniform_steps": 5, "reference": None}
+DEFAULTS = {
+    "error": "true_error",
+    "overrides": [],
+    "theta": 0.5,
+    "target": 1e-3,
+    "max_dofs": 200000,
+    "max_steps": 60,
+    "max_hanging": None,
+    "uniform_steps": 5,
+    "reference": None,
+}
 QUICK = {"max_dofs": 20000, "uniform_steps": 4}
 
 
@@ -88,16 +97,30 @@ def run_scene(label: str, quick: bool) -> dict:
         runs[mode] = history(adaptive_dataset(scene, run))
         print(f"{label} {mode}: {len(run.history)} steps, {run.history[-1]['n_dofs']} dofs ({run.reason})", flush=True)
     result = compare(runs["adaptive"], runs["uniform"], case["error"], (0.01,))
-    result.update({"scene": case["scene"], "overrides": case["overrides"], "reference": case["reference"],
-                   "reference_time": reference_time, "reference_reused": reused,
-                   "steps": {mode: {k: [float(v) for v in h[k]] for k in ("n_dofs", "estimate", "true_error", "true_error_h1", "wall_time")}
-                             for mode, h in runs.items()}})
+    result.update(
+        {
+            "scene": case["scene"],
+            "overrides": case["overrides"],
+            "reference": case["reference"],
+            "reference_time": reference_time,
+            "reference_reused": reused,
+            "steps": {
+                mode: {
+                    k: [float(v) for v in h[k]]
+                    for k in ("n_dofs", "estimate", "true_error", "true_error_h1", "wall_time")
+                }
+                for mode, h in runs.items()
+            },
+        }
+    )
     return result
 
 
-WARM_CASES = (("paper", ["discretization.mesh.n=8", "solver.method=ssn"], 60000),
-              ("paper", ["discretization.mesh.n=8", "solver.method=uzawa"], 60000),
-              ("lbracket", ["discretization.mesh.h=2.5", "solver.method=ssn"], 40000))
+WARM_CASES = (
+    ("paper", ["discretization.mesh.n=8", "solver.method=ssn"], 60000),
+    ("paper", ["discretization.mesh.n=8", "solver.method=uzawa"], 60000),
+    ("lbracket", ["discretization.mesh.h=2.5", "solver.method=ssn"], 40000),
+)
 
 
 def warm_start(quick: bool) -> list:
@@ -114,32 +137,55 @@ def warm_start(quick: bool) -> list:
         for warm in (False, True):
             run = adapt(scene, settings, warm_start=warm)
             later = run.history[1:]  # the first step has nothing to start from
-            rows.append({"scene": label, "solver": scene.solver_options["method"], "warm_start": warm,
-                         "steps": len(run.history), "final_dofs": run.history[-1]["n_dofs"],
-                         "iterations": sum(r["iterations"] for r in later),
-                         "linear_iterations": sum(r["linear_iterations"] for r in later),
-                         "warm_chosen": sum(r["warm_start"] for r in later),
-                         "solve_time": sum(r["solve_time"] for r in later), "loop_time": sum(r["wall_time"] for r in run.history)})
+            rows.append(
+                {
+                    "scene": label,
+                    "solver": scene.solver_options["method"],
+                    "warm_start": warm,
+                    "steps": len(run.history),
+                    "final_dofs": run.history[-1]["n_dofs"],
+                    "iterations": sum(r["iterations"] for r in later),
+                    "linear_iterations": sum(r["linear_iterations"] for r in later),
+                    "warm_chosen": sum(r["warm_start"] for r in later),
+                    "solve_time": sum(r["solve_time"] for r in later),
+                    "loop_time": sum(r["wall_time"] for r in run.history),
+                }
+            )
     return rows
 
 
 def _lines(results: dict, warm: list, targets: dict, quick: bool) -> list:
     from vemkit.studies.adaptivity_compare import summary_markdown
 
-    lines = [f"# Adaptive refinement benchmark ({MACHINE}){' (--quick: not the targets)' if quick else ''}", "",
-             summary_markdown(results).split("\n", 2)[2]]
+    lines = [
+        f"# Adaptive refinement benchmark ({MACHINE}){' (--quick: not the targets)' if quick else ''}",
+        "",
+        summary_markdown(results).split("\n", 2)[2],
+    ]
     lines += ["## Effectivity estimate / true error over the adaptive runs", ""]
-    lines += [f"- {k}: {v['effectivity_adaptive'][0]:.2f} – {v['effectivity_adaptive'][1]:.2f} "
-              f"(uniform: {v['effectivity_uniform'][0]:.2f} – {v['effectivity_uniform'][1]:.2f})"
-              for k, v in results.items() if "effectivity_adaptive" in v]
-    lines += ["", "## Warm start (adaptive loops; sums over the steps after the first)", "",
-              "warm used: steps whose solve started from the prolongated solution (ssn keeps its cold start "
-              "when that has the smaller residual).", "",
-              "| scene | solver | warm start | steps | final DOFs | iterations | linear iterations | warm used | "
-              "solve time [s] | loop time [s] |", "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
-    lines += [f"| {r['scene']} | {r['solver']} | {'yes' if r['warm_start'] else 'no'} | {r['steps']} | {r['final_dofs']} | "
-              f"{r['iterations']} | {r['linear_iterations']} | {r['warm_chosen']} | {r['solve_time']:.2f} | "
-              f"{r['loop_time']:.2f} |" for r in warm]
+    lines += [
+        f"- {k}: {v['effectivity_adaptive'][0]:.2f} – {v['effectivity_adaptive'][1]:.2f} "
+        f"(uniform: {v['effectivity_uniform'][0]:.2f} – {v['effectivity_uniform'][1]:.2f})"
+        for k, v in results.items()
+        if "effectivity_adaptive" in v
+    ]
+    lines += [
+        "",
+        "## Warm start (adaptive loops; sums over the steps after the first)",
+        "",
+        "warm used: steps whose solve started from the prolongated solution (ssn keeps its cold start "
+        "when that has the smaller residual).",
+        "",
+        "| scene | solver | warm start | steps | final DOFs | iterations | linear iterations | warm used | "
+        "solve time [s] | loop time [s] |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    lines += [
+        f"| {r['scene']} | {r['solver']} | {'yes' if r['warm_start'] else 'no'} | {r['steps']} | {r['final_dofs']} | "
+        f"{r['iterations']} | {r['linear_iterations']} | {r['warm_chosen']} | {r['solve_time']:.2f} | "
+        f"{r['loop_time']:.2f} |"
+        for r in warm
+    ]
     lines += ["", targets_line(targets)]
     return lines
 
@@ -155,19 +201,26 @@ def _targets(results: dict) -> dict:
     if "paper" in results:
         out["paper 1 % with >= 2x fewer DOFs"] = (results["paper"]["targets"][0]["dofs_ratio"] or 0) >= 2
     if "kirsch" in results:
-        out["kirsch >= 2x fewer DOFs at equal exact error"] = (results["kirsch"]["finest_uniform"]["dofs_ratio"] or 0) >= 2
+        out["kirsch >= 2x fewer DOFs at equal exact error"] = (
+            results["kirsch"]["finest_uniform"]["dofs_ratio"] or 0
+        ) >= 2
     return out
 
 
 def main() -> None:
     parser = quick_parser(__doc__, "small runs and references")
-    parser.add_argument("--scenes", default="lbracket,paper,kirsch,cook", help="comma-separated labels of config/adaptivity.yaml")
+    parser.add_argument(
+        "--scenes", default="lbracket,paper,kirsch,cook", help="comma-separated labels of config/adaptivity.yaml"
+    )
     args = parser.parse_args()
     results = {label: run_scene(label, args.quick) for label in args.scenes.split(",") if label}
     warm = warm_start(args.quick)
     targets = _targets(results)
-    write_report("adaptivity", {"machine": MACHINE, "quick": args.quick, "results": results, "warm_start": warm,
-                                "targets": targets}, _lines(results, warm, targets, args.quick))
+    write_report(
+        "adaptivity",
+        {"machine": MACHINE, "quick": args.quick, "results": results, "warm_start": warm, "targets": targets},
+        _lines(results, warm, targets, args.quick),
+    )
 
 
 if __name__ == "__main__":

@@ -29,14 +29,20 @@ CASES = [("k1", 1, None), ("k2-p0", 2, "p0"), ("k2-p1", 2, "p1")]
 
 def smooth_scene(n: int):
     from manufactured import elasticity_solution
+
     from vemkit.config.scene import scene_from_dict
 
     E, nu = 1000.0, 0.3
-    return scene_from_dict({
-        "name": "smooth", "material": {"E": E, "nu": nu},
-        "body_force": elasticity_solution(*FIELD, E, nu)["body_force"],
-        "boundary": {"dirichlet": {side: FIELD for side in ("left", "bottom", "right", "top")}},
-        "discretization": {"mesh": {"family": "square", "n": n}}, "exact": {"displacement": FIELD}})
+    return scene_from_dict(
+        {
+            "name": "smooth",
+            "material": {"E": E, "nu": nu},
+            "body_force": elasticity_solution(*FIELD, E, nu)["body_force"],
+            "boundary": {"dirichlet": {side: FIELD for side in ("left", "bottom", "right", "top")}},
+            "discretization": {"mesh": {"family": "square", "n": n}},
+            "exact": {"displacement": FIELD},
+        }
+    )
 
 
 def scene_of(name: str, n: int, order: int, projection):
@@ -66,24 +72,40 @@ def measure(name: str, sizes) -> list[dict]:
         for n in sizes:
             scene = scene_of(name, n, order, projection)
             problem, _, ds = solve_scene(scene, verify=True)
-            rows.append({"scene": name, "case": label, "n": n, "n_dofs": int(ds.attrs["n_dofs"]),
-                         "h1": float(ds.attrs["error_h1"]), "l2": float(ds.attrs["error_l2"]),
-                         "vertex": vertex_error(scene, problem, ds)})
+            rows.append(
+                {
+                    "scene": name,
+                    "case": label,
+                    "n": n,
+                    "n_dofs": int(ds.attrs["n_dofs"]),
+                    "h1": float(ds.attrs["error_h1"]),
+                    "l2": float(ds.attrs["error_l2"]),
+                    "vertex": vertex_error(scene, problem, ds),
+                }
+            )
             print(json.dumps(rows[-1]), flush=True)
     return rows
 
 
 def table(rows) -> str:
-    lines = ["| scene | n | k = 1 H1 / L2 / vertex | k = 2 p0 H1 / L2 / vertex | k = 2 p1 H1 / L2 / vertex "
-             "| vertex k1/p0 | vertex k1/p1 |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| scene | n | k = 1 H1 / L2 / vertex | k = 2 p0 H1 / L2 / vertex | k = 2 p1 H1 / L2 / vertex "
+        "| vertex k1/p0 | vertex k1/p1 |",
+        "|---|---|---|---|---|---|---|",
+    ]
     by = {(r["scene"], r["case"], r["n"]): r for r in rows}
     for scene, _, n in sorted({(r["scene"], 0, r["n"]) for r in rows}, key=lambda t: (t[0], t[2])):
         cells = [by[(scene, case, n)] for case, _, _ in CASES]
         text = [" / ".join(f"{c[key]:.2e}" for key in ("h1", "l2", "vertex")) for c in cells]
         ratio = [f"{cells[0]['vertex'] / c['vertex']:.0f}" for c in cells[1:]]
         lines.append(f"| {scene} | {n} | " + " | ".join(text + ratio) + " |")
-    lines += ["", "Observed orders in h (finest step), H1 / L2 / vertex:", "",
-              "| scene | k = 1 | k = 2 p0 | k = 2 p1 |", "|---|---|---|---|"]
+    lines += [
+        "",
+        "Observed orders in h (finest step), H1 / L2 / vertex:",
+        "",
+        "| scene | k = 1 | k = 2 p0 | k = 2 p1 |",
+        "|---|---|---|---|",
+    ]
     for scene in dict.fromkeys(r["scene"] for r in rows):
         orders = []
         for case, _, _ in CASES:

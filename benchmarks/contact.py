@@ -18,17 +18,17 @@ import sys
 import time
 from pathlib import Path
 
-
 from _common import MACHINE, OUT
+
 PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
 
 
 def run_case(method: str, level: int) -> dict:
+    from vemkit.config.scene import load_scene
     from vemkit.contact.problem import scene_problem
     from vemkit.solvers.dispatch import solve as solve_problem
-    from vemkit.config.scene import load_scene
 
-    scene = load_scene(PAPER_SCENE, [f"discretization.mesh.n={2 ** level}", f"solver.method={method}"])
+    scene = load_scene(PAPER_SCENE, [f"discretization.mesh.n={2**level}", f"solver.method={method}"])
     warm = load_scene(PAPER_SCENE, ["discretization.mesh.n=4", f"solver.method={method}"])
     solve_problem(scene_problem(warm), warm.solver_options)  # JIT warm-up
     t0 = time.perf_counter()
@@ -37,9 +37,14 @@ def run_case(method: str, level: int) -> dict:
     solution = solve_problem(problem, scene.solver_options)
     t2 = time.perf_counter()
     return {
-        "method": method, "h": f"2^-{level}", "n": 2**level, "dofs": problem.n_dofs,
-        "iterations": int(solution.iterations), "linear_iterations": int(solution.linear_iterations),
-        "assembly_s": t1 - t0, "solve_s": t2 - t1,
+        "method": method,
+        "h": f"2^-{level}",
+        "n": 2**level,
+        "dofs": problem.n_dofs,
+        "iterations": int(solution.iterations),
+        "linear_iterations": int(solution.linear_iterations),
+        "assembly_s": t1 - t0,
+        "solve_s": t2 - t1,
         "peak_memory_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20,
     }
 
@@ -60,7 +65,9 @@ def main():
         for method in ("ssn", "uzawa"):
             if method == "uzawa" and level > args.uzawa_max_level:
                 continue
-            out = subprocess.run([sys.executable, __file__, "--case", method, str(level)], capture_output=True, text=True)
+            out = subprocess.run(
+                [sys.executable, __file__, "--case", method, str(level)], capture_output=True, text=True
+            )
             if out.returncode != 0:
                 rows.append({"method": method, "h": f"2^-{level}", "error": out.stderr.strip().splitlines()[-1]})
             else:
@@ -84,18 +91,27 @@ def main():
     record = {
         "command": "python benchmarks/contact.py" + (" --quick" if args.quick else ""),
         "machine": MACHINE,
-        "rows": rows, "targets": targets,
+        "rows": rows,
+        "targets": targets,
     }
     OUT.mkdir(exist_ok=True)
     (OUT / "contact.json").write_text(json.dumps(record, indent=2))
-    lines = ["# Contact solvers on the paper scene", "", f"`{record['command']}` on {record['machine']}", "",
-             "| h | dofs | method | iterations | linear its | assembly s | solve s | peak GiB |", "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# Contact solvers on the paper scene",
+        "",
+        f"`{record['command']}` on {record['machine']}",
+        "",
+        "| h | dofs | method | iterations | linear its | assembly s | solve s | peak GiB |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         if "error" in r:
             lines.append(f"| {r['h']} | | {r['method']} | failed: {r['error']} | | | | |")
         else:
-            lines.append(f"| {r['h']} | {r['dofs']} | {r['method']} | {r['iterations']} | {r['linear_iterations']} | "
-                         f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {r['peak_memory_gib']:.2f} |")
+            lines.append(
+                f"| {r['h']} | {r['dofs']} | {r['method']} | {r['iterations']} | {r['linear_iterations']} | "
+                f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {r['peak_memory_gib']:.2f} |"
+            )
     if targets:
         lines += ["", "Targets: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in targets.items())]
     (OUT / "contact.md").write_text("\n".join(lines) + "\n")

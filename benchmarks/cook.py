@@ -80,12 +80,27 @@ def run_case(family: str, n: int) -> dict:
     tol = check_tolerance(scene.solver_options)
     checks, check_s, check_cpu = _timed(lambda: verify_solution(problem, solution.u, solution.multiplier, tol))
     return {
-        "family": family, "n": n, "cells": mesh.n_cells, "vertices": mesh.n_vertices, "dofs": problem.n_dofs,
-        "nnz": int(problem.stiffness.nnz), "method": solution.method, "linear": solution.info.get("linear"),
-        "tol": scene.solver_options["tol"], "linear_iterations": int(solution.linear_iterations),  # 1 if direct
-        "mesh_s": mesh_s, "mesh_cpu_s": mesh_cpu, "assembly_s": assembly_s, "assembly_cpu_s": assembly_cpu,
-        "solve_s": solve_s, "solve_cpu_s": solve_cpu, "check_s": check_s, "check_cpu_s": check_cpu,
-        "check_worst": checks["worst"], "check_tolerance": tol, "check_passed": checks["passed"],
+        "family": family,
+        "n": n,
+        "cells": mesh.n_cells,
+        "vertices": mesh.n_vertices,
+        "dofs": problem.n_dofs,
+        "nnz": int(problem.stiffness.nnz),
+        "method": solution.method,
+        "linear": solution.info.get("linear"),
+        "tol": scene.solver_options["tol"],
+        "linear_iterations": int(solution.linear_iterations),  # 1 if direct
+        "mesh_s": mesh_s,
+        "mesh_cpu_s": mesh_cpu,
+        "assembly_s": assembly_s,
+        "assembly_cpu_s": assembly_cpu,
+        "solve_s": solve_s,
+        "solve_cpu_s": solve_cpu,
+        "check_s": check_s,
+        "check_cpu_s": check_cpu,
+        "check_worst": checks["worst"],
+        "check_tolerance": tol,
+        "check_passed": checks["passed"],
         "tip_v": edge_value(problem, solution.u, "load", TIP),
         "peak_memory_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20,
     }
@@ -99,7 +114,9 @@ def run_in_subprocess(family: str, n: int) -> dict:
     if out.returncode != 0:
         return {"family": family, "n": n, "error": (out.stderr.strip().splitlines() or ["?"])[-1]}
     row = json.loads(out.stdout.strip().splitlines()[-1])
-    row["process_cpu_s"] = (after.children_user - before.children_user) + (after.children_system - before.children_system)
+    row["process_cpu_s"] = (after.children_user - before.children_user) + (
+        after.children_system - before.children_system
+    )
     row["process_wall_s"] = after.elapsed - before.elapsed
     row["load_average_after"] = [round(x, 2) for x in os.getloadavg()]
     return row
@@ -111,18 +128,22 @@ def targets_of(rows: list, families: list) -> dict:
     for family in families:
         large = [r for r in rows if r["family"] == family and r.get("dofs", 0) >= TARGET_DOFS]
         failed = [r for r in rows if r["family"] == family and "error" in r]
-        targets[f"{family}: ssn <= 30 s at >= {TARGET_DOFS} DOFs"] = bool(large) and not failed and all(
-            r["solve_s"] <= 30.0 for r in large)
+        targets[f"{family}: ssn <= 30 s at >= {TARGET_DOFS} DOFs"] = (
+            bool(large) and not failed and all(r["solve_s"] <= 30.0 for r in large)
+        )
         targets[f"{family}: peak <= 4 GiB"] = bool(large) and all(r["peak_memory_gib"] <= 4.0 for r in large)
         targets[f"{family}: independent check passed at every size"] = not failed and all(
-            r["check_passed"] for r in rows if r["family"] == family)
+            r["check_passed"] for r in rows if r["family"] == family
+        )
     return targets
 
 
 def table(rows: list) -> list:
-    lines = ["| family | n | cells | DOFs | mesh s (CPU) | assembly s (CPU) | ssn solve s (CPU) | linear solver (its) | "
-             "check s (CPU) | check worst | v(48, 52) | peak GiB | process s (CPU) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| family | n | cells | DOFs | mesh s (CPU) | assembly s (CPU) | ssn solve s (CPU) | linear solver (its) | "
+        "check s (CPU) | check worst | v(48, 52) | peak GiB | process s (CPU) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         if "error" in r:
             lines.append(f"| {r['family']} | {r['n']} | failed: {r['error']} |" + " |" * 10)
@@ -131,15 +152,17 @@ def table(rows: list) -> list:
             f"| {r['family']} | {r['n']} | {r['cells']} | {r['dofs']} | {r['mesh_s']:.2f} ({r['mesh_cpu_s']:.2f}) | "
             f"{r['assembly_s']:.2f} ({r['assembly_cpu_s']:.2f}) | {r['solve_s']:.2f} ({r['solve_cpu_s']:.2f}) | "
             f"{r['linear']} ({r['linear_iterations']}) | {r['check_s']:.2f} ({r['check_cpu_s']:.2f}) | {r['check_worst']:.1e} | "
-            f"{r['tip_v']:.4f} | {r['peak_memory_gib']:.2f} | {r['process_wall_s']:.1f} ({r['process_cpu_s']:.1f}) |")
+            f"{r['tip_v']:.4f} | {r['peak_memory_gib']:.2f} | {r['process_wall_s']:.1f} ({r['process_cpu_s']:.1f}) |"
+        )
     return lines
 
 
 def main():
     parser = quick_parser(__doc__, "n = 2, 4 only (at most 47 000 DOFs)")
     parser.add_argument("--families", nargs="+", default=list(FAMILIES))
-    parser.add_argument("--n", type=int, nargs="+", default=list(SIZES),
-                        help="cells per unit length (19: about 1.05e6 DOFs)")
+    parser.add_argument(
+        "--n", type=int, nargs="+", default=list(SIZES), help="cells per unit length (19: about 1.05e6 DOFs)"
+    )
     parser.add_argument("--case", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.case:
@@ -152,22 +175,40 @@ def main():
         for n in sizes:
             rows.append(run_in_subprocess(family, n))
             print(rows[-1], flush=True)
-    command = "python benchmarks/cook.py" + (" --quick" if args.quick else "") + \
-        ("" if args.n == list(SIZES) or args.quick else " --n " + " ".join(map(str, args.n))) + \
-        ("" if args.families == list(FAMILIES) else " --families " + " ".join(args.families))
+    command = (
+        "python benchmarks/cook.py"
+        + (" --quick" if args.quick else "")
+        + ("" if args.n == list(SIZES) or args.quick else " --n " + " ".join(map(str, args.n)))
+        + ("" if args.families == list(FAMILIES) else " --families " + " ".join(args.families))
+    )
     targets = targets_of(rows, args.families)
-    record = {"command": command, "machine": MACHINE, "cpu_count": os.cpu_count(), "scene": str(COOK_SCENE.name),
-              "published_tip_v": PUBLISHED_TIP, "load_average_before": load_before,
-              "load_average_after": [round(x, 2) for x in os.getloadavg()], "rows": rows, "targets": targets}
-    lines = ["# Cook's membrane: one ssn solve at about 10^6 DOFs", "",
-             f"`{command}` on {MACHINE}, {os.cpu_count()} cores", "", *table(rows), "",
-             "Seconds are wall time, CPU time (all threads of the process) in brackets; each case runs in its own "
-             "process after a warm-up at n = 1 (process s: the whole subprocess, imports and warm-up included). "
-             f"`check`: the independent verification (`verify_solution`) at the scene's check tolerance. "
-             f"v(48, 52): mid loaded edge, published {PUBLISHED_TIP}.",
-             f"Load average (1, 5, 15 min) before: {load_before}, after: {record['load_average_after']} "
-             "(shared machine: wall time includes waiting for a core).", "",
-             targets_line(targets, "Targets")]
+    record = {
+        "command": command,
+        "machine": MACHINE,
+        "cpu_count": os.cpu_count(),
+        "scene": str(COOK_SCENE.name),
+        "published_tip_v": PUBLISHED_TIP,
+        "load_average_before": load_before,
+        "load_average_after": [round(x, 2) for x in os.getloadavg()],
+        "rows": rows,
+        "targets": targets,
+    }
+    lines = [
+        "# Cook's membrane: one ssn solve at about 10^6 DOFs",
+        "",
+        f"`{command}` on {MACHINE}, {os.cpu_count()} cores",
+        "",
+        *table(rows),
+        "",
+        "Seconds are wall time, CPU time (all threads of the process) in brackets; each case runs in its own "
+        "process after a warm-up at n = 1 (process s: the whole subprocess, imports and warm-up included). "
+        f"`check`: the independent verification (`verify_solution`) at the scene's check tolerance. "
+        f"v(48, 52): mid loaded edge, published {PUBLISHED_TIP}.",
+        f"Load average (1, 5, 15 min) before: {load_before}, after: {record['load_average_after']} "
+        "(shared machine: wall time includes waiting for a core).",
+        "",
+        targets_line(targets, "Targets"),
+    ]
     write_report("cook", record, lines)
 
 

@@ -17,12 +17,15 @@ import time
 import numpy as np
 
 from _common import MACHINE, quick_parser, targets_line, write_report
+
 PLATE = {
     "polygon": [[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]],
     "sides": ["bottom", "right", "top", "left"],
-    "holes": [{"circle": [0.8, 1.0, 0.35], "side": "hole_a"},
-              {"circle": [2.0, 0.9, 0.5], "side": "hole_b"},
-              {"circle": [3.2, 1.1, 0.3], "side": "hole_c"}],
+    "holes": [
+        {"circle": [0.8, 1.0, 0.35], "side": "hole_a"},
+        {"circle": [2.0, 0.9, 0.5], "side": "hole_b"},
+        {"circle": [3.2, 1.1, 0.3], "side": "hole_c"},
+    ],
 }
 FAMILIES = [("square", {}), ("triangle", {}), ("voronoi", {}), ("hanging", {"levels": 1})]
 
@@ -51,9 +54,17 @@ def case(family: str, options: dict, cells: int, repeat: int) -> dict:
     t = time.perf_counter()
     validate_mesh(mesh)
     check = time.perf_counter() - t
-    record = {"family": family, "options": options, "cells_asked": cells, "cells": mesh.n_cells,
-              "vertices": mesh.n_vertices, "seconds": min(times), "cpu_seconds": min(cpu), "validate_seconds": check,
-              "sides": sorted(mesh.boundary)}
+    record = {
+        "family": family,
+        "options": options,
+        "cells_asked": cells,
+        "cells": mesh.n_cells,
+        "vertices": mesh.n_vertices,
+        "seconds": min(times),
+        "cpu_seconds": min(cpu),
+        "validate_seconds": check,
+        "sides": sorted(mesh.boundary),
+    }
     if family in ("square", "hanging"):
         record["worst_area_ratio_to_largest_neighbour"] = worst_neighbour_ratio(mesh)
     return record
@@ -66,19 +77,32 @@ def main():
     record = {
         "command": "python benchmarks/meshing.py" + (" --quick" if args.quick else ""),
         "machine": MACHINE,
-        "domain": PLATE, "results": results, "load_average": [round(x, 2) for x in os.getloadavg()],
+        "domain": PLATE,
+        "results": results,
+        "load_average": [round(x, 2) for x in os.getloadavg()],
         "targets": {f"{r['family']} <= 10 s": (not args.quick) and r["seconds"] <= 10.0 for r in results},
     }
-    lines = ["# Meshing benchmark: a plate with three circular holes", "", f"`{record['command']}` on {record['machine']}",
-             "", "| family | options | cells | vertices | seconds | CPU seconds | validate_mesh s | worst area ratio |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# Meshing benchmark: a plate with three circular holes",
+        "",
+        f"`{record['command']}` on {record['machine']}",
+        "",
+        "| family | options | cells | vertices | seconds | CPU seconds | validate_mesh s | worst area ratio |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in results:
         ratio = r.get("worst_area_ratio_to_largest_neighbour")
-        lines.append(f"| {r['family']} | {r['options'] or ''} | {r['cells']} | {r['vertices']} | {r['seconds']:.2f} | "
-                     f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {'' if ratio is None else f'{ratio:.3f}'} |")
-    lines += ["", f"Load average while running (1, 5, 15 min): {record['load_average']}. On a shared machine "
-              "the wall time includes waiting for a core; the CPU time is the process's own.",
-              "", targets_line(record["targets"], "Targets (wall time)")]
+        lines.append(
+            f"| {r['family']} | {r['options'] or ''} | {r['cells']} | {r['vertices']} | {r['seconds']:.2f} | "
+            f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {'' if ratio is None else f'{ratio:.3f}'} |"
+        )
+    lines += [
+        "",
+        f"Load average while running (1, 5, 15 min): {record['load_average']}. On a shared machine "
+        "the wall time includes waiting for a core; the CPU time is the process's own.",
+        "",
+        targets_line(record["targets"], "Targets (wall time)"),
+    ]
     write_report("meshing", record, lines)
 
 

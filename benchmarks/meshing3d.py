@@ -17,10 +17,19 @@ import time
 from _common import MACHINE, quick_parser, targets_line, write_report
 
 CUBE = {"box": [[0, 0, 0], [1, 1, 1]]}
-PLATE = {"extrude": {"depth": 0.2}, "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-         "holes": [{"circle": [1.0, 0.5, 0.25], "side": "bore"}]}
-CASES = [("voronoi", CUBE, {}), ("hex", CUBE, {}), ("tet", CUBE, {}), ("octree", CUBE, {"rule": "random", "seed": 1}),
-         ("voronoi", PLATE, {})]
+PLATE = {
+    "extrude": {"depth": 0.2},
+    "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+    "sides": ["bottom", "right", "top", "left"],
+    "holes": [{"circle": [1.0, 0.5, 0.25], "side": "bore"}],
+}
+CASES = [
+    ("voronoi", CUBE, {}),
+    ("hex", CUBE, {}),
+    ("tet", CUBE, {}),
+    ("octree", CUBE, {"rule": "random", "seed": 1}),
+    ("voronoi", PLATE, {}),
+]
 
 
 def case(family: str, domain: dict, options: dict, cells: int, repeat: int) -> dict:
@@ -38,10 +47,19 @@ def case(family: str, domain: dict, options: dict, cells: int, repeat: int) -> d
     t = time.perf_counter()
     validate_mesh3d(mesh)
     check = time.perf_counter() - t
-    record = {"family": family, "domain": "box" if "box" in domain else "extrude", "options": options,
-              "cells_asked": cells, "cells": mesh.n_cells, "vertices": mesh.n_vertices, "faces": mesh.n_faces,
-              "seconds": min(times), "cpu_seconds": min(cpu), "validate_seconds": check,
-              "volume": float(mesh.cell_volumes.sum())}
+    record = {
+        "family": family,
+        "domain": "box" if "box" in domain else "extrude",
+        "options": options,
+        "cells_asked": cells,
+        "cells": mesh.n_cells,
+        "vertices": mesh.n_vertices,
+        "faces": mesh.n_faces,
+        "seconds": min(times),
+        "cpu_seconds": min(cpu),
+        "validate_seconds": check,
+        "volume": float(mesh.cell_volumes.sum()),
+    }
     if "box" in domain:
         record["estimate"] = estimate_mesh3d(family, domain, cells=cells, **options)._asdict()
     return record
@@ -52,20 +70,35 @@ def main():
     cells = 10_000 if args.quick else 100_000
     results = [case(family, domain, options, cells, args.repeat) for family, domain, options in CASES]
     voronoi = results[0]
-    record = {"command": "python benchmarks/meshing3d.py" + (" --quick" if args.quick else ""), "machine": MACHINE,
-              "results": results, "load_average": [round(x, 2) for x in os.getloadavg()],
-              "targets": {"voronoi 1e5 cells <= 30 s": (not args.quick) and voronoi["seconds"] <= 30.0}}
-    lines = ["# 3D meshing benchmark", "", f"`{record['command']}` on {record['machine']}", "",
-             "| family | domain | cells | vertices | faces | seconds | CPU seconds | validate_mesh3d s | predicted cells / vertices / faces |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    record = {
+        "command": "python benchmarks/meshing3d.py" + (" --quick" if args.quick else ""),
+        "machine": MACHINE,
+        "results": results,
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+        "targets": {"voronoi 1e5 cells <= 30 s": (not args.quick) and voronoi["seconds"] <= 30.0},
+    }
+    lines = [
+        "# 3D meshing benchmark",
+        "",
+        f"`{record['command']}` on {record['machine']}",
+        "",
+        "| family | domain | cells | vertices | faces | seconds | CPU seconds | validate_mesh3d s | predicted cells / vertices / faces |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in results:
         est = r.get("estimate")
         guess = f"{est['cells']} / {est['vertices']} / {est['faces']}" if est else ""
-        lines.append(f"| {r['family']} | {r['domain']} | {r['cells']} | {r['vertices']} | {r['faces']} | {r['seconds']:.2f} | "
-                     f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {guess} |")
-    lines += ["", f"Load average at the end (1, 5, 15 min): {record['load_average']}. On a shared machine the wall time "
-              "includes waiting for a core; the CPU time is the process's own.", "",
-              targets_line(record["targets"], "Targets (wall time)")]
+        lines.append(
+            f"| {r['family']} | {r['domain']} | {r['cells']} | {r['vertices']} | {r['faces']} | {r['seconds']:.2f} | "
+            f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {guess} |"
+        )
+    lines += [
+        "",
+        f"Load average at the end (1, 5, 15 min): {record['load_average']}. On a shared machine the wall time "
+        "includes waiting for a core; the CPU time is the process's own.",
+        "",
+        targets_line(record["targets"], "Targets (wall time)"),
+    ]
     write_report("meshing3d", record, lines)
 
 

@@ -49,12 +49,22 @@ def run_case(order: int, n: int, repeat: int) -> dict:
         run = (time.perf_counter() - w, time.process_time() - c, solution)
         best = run if best is None or run[0] < best[0] else best
     wall, cpu, solution = best
-    return {"order": order, "n": n, "space_dofs": int(getattr(problem, "n_space_dofs", problem.n_dofs)),
-            "unknowns": int(problem.n_dofs), "assembly_wall_s": assembly[0], "assembly_cpu_s": assembly[1],
-            "solve_wall_s": wall, "solve_cpu_s": cpu, "iterations": int(solution.iterations),
-            "linear_iterations": int(solution.linear_iterations), "linear": solution.info.get("linear", ""),
-            "load_before": load_before, "load_after": os.getloadavg(),
-            "peak_memory_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
+    return {
+        "order": order,
+        "n": n,
+        "space_dofs": int(getattr(problem, "n_space_dofs", problem.n_dofs)),
+        "unknowns": int(problem.n_dofs),
+        "assembly_wall_s": assembly[0],
+        "assembly_cpu_s": assembly[1],
+        "solve_wall_s": wall,
+        "solve_cpu_s": cpu,
+        "iterations": int(solution.iterations),
+        "linear_iterations": int(solution.linear_iterations),
+        "linear": solution.info.get("linear", ""),
+        "load_before": load_before,
+        "load_after": os.getloadavg(),
+        "peak_memory_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20,
+    }
 
 
 def main():
@@ -66,27 +76,46 @@ def main():
         return
     rows = []
     for order, n in QUICK_CASES if args.quick else CASES:
-        out = subprocess.run([sys.executable, __file__, "--case", str(order), str(n), "--repeat", str(args.repeat)],
-                             capture_output=True, text=True)
+        out = subprocess.run(
+            [sys.executable, __file__, "--case", str(order), str(n), "--repeat", str(args.repeat)],
+            capture_output=True,
+            text=True,
+        )
         if out.returncode != 0:
             raise SystemExit(f"case k = {order}, n = {n} failed:\n{out.stderr}")
         rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
         print(rows[-1], flush=True)
-    lines = ["# ssn with k = 2 on the paper scene (issue 14, item 6)", "",
-             f"`python benchmarks/order2.py{' --quick' if args.quick else ''} --repeat {args.repeat}` on {MACHINE}, "
-             "2 cores shared with other processes (load average: 1, 5, 15 min)", "",
-             "| k | mesh | DOFs (space) | unknowns | assembly wall / CPU s | ssn wall / CPU s | ssn its | CG its "
-             "| load before | load after | peak GiB |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# ssn with k = 2 on the paper scene (issue 14, item 6)",
+        "",
+        f"`python benchmarks/order2.py{' --quick' if args.quick else ''} --repeat {args.repeat}` on {MACHINE}, "
+        "2 cores shared with other processes (load average: 1, 5, 15 min)",
+        "",
+        "| k | mesh | DOFs (space) | unknowns | assembly wall / CPU s | ssn wall / CPU s | ssn its | CG its "
+        "| load before | load after | peak GiB |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        lines.append(f"| {r['order']} | {r['n']}^2 squares | {r['space_dofs']} | {r['unknowns']} | "
-                     f"{r['assembly_wall_s']:.2f} / {r['assembly_cpu_s']:.2f} | {r['solve_wall_s']:.2f} / "
-                     f"{r['solve_cpu_s']:.2f} | {r['iterations']} | {r['linear_iterations']} | "
-                     + " ".join(f"{x:.2f}" for x in r["load_before"]) + " | "
-                     + " ".join(f"{x:.2f}" for x in r["load_after"]) + f" | {r['peak_memory_gib']:.2f} |")
+        lines.append(
+            f"| {r['order']} | {r['n']}^2 squares | {r['space_dofs']} | {r['unknowns']} | "
+            f"{r['assembly_wall_s']:.2f} / {r['assembly_cpu_s']:.2f} | {r['solve_wall_s']:.2f} / "
+            f"{r['solve_cpu_s']:.2f} | {r['iterations']} | {r['linear_iterations']} | "
+            + " ".join(f"{x:.2f}" for x in r["load_before"])
+            + " | "
+            + " ".join(f"{x:.2f}" for x in r["load_after"])
+            + f" | {r['peak_memory_gib']:.2f} |"
+        )
     target = next((r for r in rows if r["order"] == 2 and r["n"] == 256), None)
-    targets = {} if target is None else {
-        f"k = 2, {target['space_dofs']} DOFs: ssn solve <= {TARGET_SECONDS:g} s wall": target["solve_wall_s"] <= TARGET_SECONDS,
-        f"k = 2, {target['space_dofs']} DOFs: ssn solve <= {TARGET_SECONDS:g} s CPU": target["solve_cpu_s"] <= TARGET_SECONDS}
+    targets = (
+        {}
+        if target is None
+        else {
+            f"k = 2, {target['space_dofs']} DOFs: ssn solve <= {TARGET_SECONDS:g} s wall": target["solve_wall_s"]
+            <= TARGET_SECONDS,
+            f"k = 2, {target['space_dofs']} DOFs: ssn solve <= {TARGET_SECONDS:g} s CPU": target["solve_cpu_s"]
+            <= TARGET_SECONDS,
+        }
+    )
     lines += ["", targets_line(targets) if targets else "(quick run: no target)"]
     write_report("order2", {"machine": MACHINE, "rows": rows, "targets": targets}, lines)
 

@@ -40,11 +40,11 @@ PEERS = Path(__file__).resolve().parent / "peers"
 VEMKIT = Path(sys.executable).with_name("vemkit")
 SYSTEM_PYTHON = "/usr/bin/python3"
 E, NU = 2000.0, 0.4
-LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))   # the paper's plane-stress C (SPEC §1)
-TRACTION_LEFT = [[1000.0, 0.0, -200.0], [-200.0, 0.0, 0.0]]   # (200 (5 - y), -200) as a + b x + c y
+LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C (SPEC §1)
+TRACTION_LEFT = [[1000.0, 0.0, -200.0], [-200.0, 0.0, 0.0]]  # (200 (5 - y), -200) as a + b x + c y
 PROBLEMS = ("elasticity", "compliance", "friction")
-FRICTION_K = 450.0   # the paper's k_tau (m_tau = 0): every Gamma_C vertex slides
-SKFEM_DIRECT_MAX_DOFS = 200_000   # spsolve up to here, pyamg SA + CG above (scikit-fem's docs)
+FRICTION_K = 450.0  # the paper's k_tau (m_tau = 0): every Gamma_C vertex slides
+SKFEM_DIRECT_MAX_DOFS = 200_000  # spsolve up to here, pyamg SA + CG above (scikit-fem's docs)
 
 
 def measured(command: list[str]) -> dict:
@@ -80,8 +80,10 @@ def write_mesh(kind: str, n: int, path: Path) -> None:
 def mesh_case(mesh_path: Path) -> dict:
     """Vertices, triangles and the four sides' edges of a vemkit mesh file (UGRID, SPEC §8)."""
     with xr.open_dataset(mesh_path) as ds:
-        case = {"vertices": np.stack([ds.mesh2d_node_x.values, ds.mesh2d_node_y.values], axis=1),
-                "triangles": ds.mesh2d_face_nodes.values.astype(np.int64)}
+        case = {
+            "vertices": np.stack([ds.mesh2d_node_x.values, ds.mesh2d_node_y.values], axis=1),
+            "triangles": ds.mesh2d_face_nodes.values.astype(np.int64),
+        }
         for side in ("bottom", "right", "top", "left"):
             case[f"side_{side}"] = ds[f"boundary_{side}"].values.astype(np.int64)
     assert case["triangles"].shape[1] == 3 and case["triangles"].min() >= 0
@@ -90,19 +92,33 @@ def mesh_case(mesh_path: Path) -> dict:
 
 def peer_params(problem: str, n_dofs: int, friction_k: float = FRICTION_K) -> dict:
     """The discrete problem as the peers state it (see the module docstring)."""
-    return {"problem": problem, "lam": LAM, "mu": MU, "traction_affine": TRACTION_LEFT,
-            "neumann": "left", "dirichlet": ["right"], "contact": "bottom", "gap": 0.1,
-            "kn": 10.0, "kt": friction_k, "r_friction": 100.0,
-            "quadrature": "nodal" if problem == "friction" else "gauss", "gauss_points": 3,
-            "max_res": 1e-9, "lsolver": "auto",
-            "solver": "direct" if n_dofs <= SKFEM_DIRECT_MAX_DOFS else "amg", "cg_rtol": 1e-12}
+    return {
+        "problem": problem,
+        "lam": LAM,
+        "mu": MU,
+        "traction_affine": TRACTION_LEFT,
+        "neumann": "left",
+        "dirichlet": ["right"],
+        "contact": "bottom",
+        "gap": 0.1,
+        "kn": 10.0,
+        "kt": friction_k,
+        "r_friction": 100.0,
+        "quadrature": "nodal" if problem == "friction" else "gauss",
+        "gauss_points": 3,
+        "max_res": 1e-9,
+        "lsolver": "auto",
+        "solver": "direct" if n_dofs <= SKFEM_DIRECT_MAX_DOFS else "amg",
+        "cg_rtol": 1e-12,
+    }
 
 
 def case_from_mesh(mesh) -> dict:
     """The same arrays from a vemkit Mesh in memory (a triangle mesh of the unit square)."""
     case = {"vertices": mesh.vertices, "triangles": mesh.cell_vertices.reshape(-1, 3).astype(np.int64)}
-    return case | {f"side_{side}": np.asarray(mesh.boundary[side], dtype=np.int64)
-                   for side in ("bottom", "right", "top", "left")}
+    return case | {
+        f"side_{side}": np.asarray(mesh.boundary[side], dtype=np.int64) for side in ("bottom", "right", "top", "left")
+    }
 
 
 def vemkit_scene(problem: str, mesh_entry: dict, friction_k: float = FRICTION_K) -> dict:
@@ -125,8 +141,12 @@ def run_vemkit(problem: str, mesh_path: Path, work: Path) -> tuple[np.ndarray, d
     record = measured([str(VEMKIT), "solve", str(scene_path), "-o", str(out)])
     with xr.open_dataset(out) as ds:
         u = np.stack([ds.u1.values, ds.u2.values], axis=1)
-        record.update(assembly_s=float(ds.attrs["assembly_time"]), solve_s=float(ds.attrs["wall_time"]),
-                      iterations=int(ds.attrs["iterations"]), solver="ssn, linear solver auto")
+        record.update(
+            assembly_s=float(ds.attrs["assembly_time"]),
+            solve_s=float(ds.attrs["wall_time"]),
+            iterations=int(ds.attrs["iterations"]),
+            solver="ssn, linear solver auto",
+        )
         xy = np.stack([ds.mesh2d_node_x.values, ds.mesh2d_node_y.values], axis=1)
     return u, record | {"node_xy": xy}
 
@@ -141,8 +161,12 @@ def run_peer(peer: str, problem: str, case: dict, work: Path, params: dict | Non
     with np.load(out) as result:
         info = json.loads(str(result["info"]))
         u = result["u"]
-    record.update(assembly_s=info["setup_s"], solve_s=info["solve_s"],
-                  solver=info.get("lsolver") or info.get("solver"), iterations=info.get("iterations"))
+    record.update(
+        assembly_s=info["setup_s"],
+        solve_s=info["solve_s"],
+        solver=info.get("lsolver") or info.get("solver"),
+        iterations=info.get("iterations"),
+    )
     return u, record
 
 
@@ -182,19 +206,25 @@ def warm_up(work: Path, problems) -> None:
 
 
 def table_lines(rows: list[dict], header: list[str]) -> list[str]:
-    lines = ["| mesh | n | DOFs | problem | code | solver | rel. diff. to vemkit | wall s | max RSS MiB "
-             "| assembly s | solve s | vemkit/peer wall |", "|" + "---|" * 12]
+    lines = [
+        "| mesh | n | DOFs | problem | code | solver | rel. diff. to vemkit | wall s | max RSS MiB "
+        "| assembly s | solve s | vemkit/peer wall |",
+        "|" + "---|" * 12,
+    ]
     for r in rows:
         diff = f"{r['rel_diff_to_vemkit']:.1e}" if "rel_diff_to_vemkit" in r else "–"
         ratio = f"{r['vemkit_over_peer_wall']:.2f}" if "vemkit_over_peer_wall" in r else "–"
-        lines.append(f"| {r['mesh']} | {r['n']} | {r['dofs']:,} | {r['problem']} | {r['code']} | "
-                     f"{r['solver']} | {diff} | {r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | "
-                     f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {ratio} |")
+        lines.append(
+            f"| {r['mesh']} | {r['n']} | {r['dofs']:,} | {r['problem']} | {r['code']} | "
+            f"{r['solver']} | {diff} | {r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | "
+            f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {ratio} |"
+        )
     return header + lines
 
 
 def figure(rows: list[dict], path: Path) -> None:
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.ticker
@@ -202,13 +232,20 @@ def figure(rows: list[dict], path: Path) -> None:
     fig, axes = plt.subplots(1, len(PROBLEMS), figsize=(13, 4.2), sharey=True)
     for ax, problem in zip(axes, PROBLEMS):
         for code, color in (("vemkit", "C0"), ("skfem", "C1"), ("getfem", "C2")):
-            own = sorted((r for r in rows if r["problem"] == problem and r["code"] == code
-                          and r["mesh"] == "structured"), key=lambda r: r["dofs"])
+            own = sorted(
+                (r for r in rows if r["problem"] == problem and r["code"] == code and r["mesh"] == "structured"),
+                key=lambda r: r["dofs"],
+            )
             if own:
                 dofs = [r["dofs"] for r in own]
                 ax.loglog(dofs, [r["wall_s"] for r in own], "o-", color=color, label=f"{code}: process")
-                ax.loglog(dofs, [r["assembly_s"] + r["solve_s"] for r in own], "s--", color=color,
-                          label=f"{code}: assembly + solve")
+                ax.loglog(
+                    dofs,
+                    [r["assembly_s"] + r["solve_s"] for r in own],
+                    "s--",
+                    color=color,
+                    label=f"{code}: assembly + solve",
+                )
         ax.set_title(f"{problem} (structured triangles)")
         ax.set_xlabel("DOFs")
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
@@ -226,8 +263,12 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[32, 128, 512, 708])
     parser.add_argument("--delaunay-sizes", type=int, nargs="*", default=[32, 128])
     parser.add_argument("--problems", nargs="+", default=list(PROBLEMS), choices=PROBLEMS)
-    parser.add_argument("--getfem-contact-max-dofs", type=int, default=10**9,
-                        help="no GetFEM contact solves above this (its Newton refactorizes every step)")
+    parser.add_argument(
+        "--getfem-contact-max-dofs",
+        type=int,
+        default=10**9,
+        help="no GetFEM contact solves above this (its Newton refactorizes every step)",
+    )
     parser.add_argument("--keep", type=Path, help="keep the meshes and solutions in this folder")
     parser.add_argument("--resume", action="store_true", help="keep the cases of benchmarks/out/peers.json")
     args = parser.parse_args()
@@ -244,7 +285,7 @@ def main() -> None:
                 dofs = 2 * (n + 1) ** 2
                 chosen = peers_for(problem, dofs, getfem_reason, args.getfem_contact_max_dofs)
                 rows += compare_case(kind, n, problem, chosen, work)
-                report(rows, getfem_reason, quiet=True)   # after every case: a stopped run keeps its rows
+                report(rows, getfem_reason, quiet=True)  # after every case: a stopped run keeps its rows
     if not args.keep:
         shutil.rmtree(work)
     report(rows, getfem_reason)
@@ -252,14 +293,19 @@ def main() -> None:
 
 def report(rows: list[dict], getfem_reason: str | None, quiet: bool = False) -> None:
     load = os.getloadavg()
-    header = ["# vemkit k = 1 against scikit-fem and GetFEM P1 (benchmarks/peers.py)", "",
-              f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {load[0]:.1f} at the end "
-              "(timings taken under this load).",
-              "GetFEM: " + (getfem_reason or "python3-getfem under /usr/bin/python3."), "",
-              "Relative difference: max nodal |u_peer - u_vemkit| / max nodal |u_vemkit|. Wall time and "
-              "max RSS: the whole process (wait4). vemkit: assembly_time and the solver's wall_time "
-              "attributes; GetFEM: solve s is model.solve (its assembly included), assembly s the mesh "
-              "and model set-up.", ""]
+    header = [
+        "# vemkit k = 1 against scikit-fem and GetFEM P1 (benchmarks/peers.py)",
+        "",
+        f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {load[0]:.1f} at the end "
+        "(timings taken under this load).",
+        "GetFEM: " + (getfem_reason or "python3-getfem under /usr/bin/python3."),
+        "",
+        "Relative difference: max nodal |u_peer - u_vemkit| / max nodal |u_vemkit|. Wall time and "
+        "max RSS: the whole process (wait4). vemkit: assembly_time and the solver's wall_time "
+        "attributes; GetFEM: solve s is model.solve (its assembly included), assembly s the mesh "
+        "and model set-up.",
+        "",
+    ]
     OUT.mkdir(parents=True, exist_ok=True)
     record = {"machine": MACHINE, "load_average": load, "getfem": getfem_reason or "installed", "rows": rows}
     lines = table_lines(rows, header)

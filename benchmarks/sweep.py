@@ -23,7 +23,6 @@ import tempfile
 import time
 from pathlib import Path
 
-
 ROOT = Path(__file__).resolve().parents[1]
 OUT = Path(__file__).resolve().parent / "out"
 LIMIT = 180.0  # seconds
@@ -35,7 +34,9 @@ def sweep_config(name: str) -> dict:
     data = yaml.safe_load((ROOT / os.environ.get("VEMKIT_SWEEPS_CONFIG", "config/sweeps.yaml")).read_text())
     spec = dict(data["sweeps"][name])
     solver = {**data.get("sweep_defaults", {}).get("solver", {"method": "ssn", "tol": 1e-10}), **spec.get("solver", {})}
-    spec["all_overrides"] = data.get("overrides", []) + spec.get("overrides", []) + [f"solver.{k}={v}" for k, v in solver.items()]
+    spec["all_overrides"] = (
+        data.get("overrides", []) + spec.get("overrides", []) + [f"solver.{k}={v}" for k, v in solver.items()]
+    )
     spec["scene"] = data.get("scene", "config/scenes/paper.yaml")
     return spec
 
@@ -49,16 +50,24 @@ def in_process(name: str) -> dict:
 
     spec = sweep_config(name)
     scene = load_scene(ROOT / spec["scene"], spec["all_overrides"])
-    out = {"sweep": name, "n": scene.mesh_options["n"], "solver": scene.solver_options["method"],
-           "linear_solver_reuse_supported": prebuilt_linear_supported()}
+    out = {
+        "sweep": name,
+        "n": scene.mesh_options["n"],
+        "solver": scene.solver_options["method"],
+        "linear_solver_reuse_supported": prebuilt_linear_supported(),
+    }
     for reuse in (True, False):
         t0 = time.perf_counter()
         ds = run_sweep(scene, spec["grid"], reuse=reuse)
         seconds = time.perf_counter() - t0
         out["reused" if reuse else "fresh"] = {
-            "seconds": seconds, "points": int(ds.attrs["points"]), "converged": int(ds.attrs["converged_points"]),
-            "solve_seconds": float(ds["wall_time"].sum()), "setup_seconds": float(ds["setup_time"].sum()),
-            "mean_solve_seconds": float(ds["wall_time"].mean()), "n_dofs": int(np.max(ds["n_dofs"].values)),
+            "seconds": seconds,
+            "points": int(ds.attrs["points"]),
+            "converged": int(ds.attrs["converged_points"]),
+            "solve_seconds": float(ds["wall_time"].sum()),
+            "setup_seconds": float(ds["setup_time"].sum()),
+            "mean_solve_seconds": float(ds["wall_time"].mean()),
+            "n_dofs": int(np.max(ds["n_dofs"].values)),
         }
     return out
 
@@ -72,8 +81,19 @@ def snakemake_run(name: str) -> dict:
         scratch.write(f'include: "{ROOT / "workflow/rules/sweeps.smk"}"\n')
         scratch.close()
         snakefile = Path(scratch.name)
-    command = [str(Path(sys.executable).with_name("snakemake")), "-s", str(snakefile), "-d", str(ROOT), "-j2",
-               "--forceall", "--quiet", "rules", "--", target]
+    command = [
+        str(Path(sys.executable).with_name("snakemake")),
+        "-s",
+        str(snakefile),
+        "-d",
+        str(ROOT),
+        "-j2",
+        "--forceall",
+        "--quiet",
+        "rules",
+        "--",
+        target,
+    ]
     t0 = time.perf_counter()
     run = subprocess.run(command, cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - t0
@@ -90,30 +110,51 @@ def snakemake_run(name: str) -> dict:
 
     with xr.open_dataset(ROOT / target) as ds:
         points, converged = int(ds.attrs["points"]), int(ds.attrs["converged_points"])
-    shown = ["snakemake", "-j2", "--forceall", target] if scratch is None else \
-        ["snakemake", "-s", "<scratch Snakefile including workflow/rules/sweeps.smk>", "-j2", "--forceall", target]
-    return {"command": " ".join(shown), "seconds": seconds, "points": points, "converged": converged,
-            "jobs": benchmarks, "within_limit": seconds <= LIMIT, "limit_seconds": LIMIT}
+    shown = (
+        ["snakemake", "-j2", "--forceall", target]
+        if scratch is None
+        else ["snakemake", "-s", "<scratch Snakefile including workflow/rules/sweeps.smk>", "-j2", "--forceall", target]
+    )
+    return {
+        "command": " ".join(shown),
+        "seconds": seconds,
+        "points": points,
+        "converged": converged,
+        "jobs": benchmarks,
+        "within_limit": seconds <= LIMIT,
+        "limit_seconds": LIMIT,
+    }
 
 
 def markdown(result: dict) -> str:
     lines = ["# Sweep benchmark", "", f"{result['machine']}", ""]
     proc = result.get("in_process")
     if proc:
-        lines += [f"Sweep `{proc['sweep']}`: h = 1/{proc['n']}, {proc['reused']['n_dofs']} unknowns, solver "
-                  f"{proc['solver']}; linear solver reuse supported by the contact solver: "
-                  f"{proc['linear_solver_reuse_supported']}.", "",
-                  "| in one process | points | converged | total [s] | set-up [s] | solves [s] | mean solve [s] |",
-                  "|---|---:|---:|---:|---:|---:|---:|"]
+        lines += [
+            f"Sweep `{proc['sweep']}`: h = 1/{proc['n']}, {proc['reused']['n_dofs']} unknowns, solver "
+            f"{proc['solver']}; linear solver reuse supported by the contact solver: "
+            f"{proc['linear_solver_reuse_supported']}.",
+            "",
+            "| in one process | points | converged | total [s] | set-up [s] | solves [s] | mean solve [s] |",
+            "|---|---:|---:|---:|---:|---:|---:|",
+        ]
         for key, label in (("reused", "problem reused"), ("fresh", "built per point")):
             r = proc[key]
-            lines.append(f"| {label} | {r['points']} | {r['converged']} | {r['seconds']:.2f} | {r['setup_seconds']:.2f} | "
-                         f"{r['solve_seconds']:.2f} | {r['mean_solve_seconds']:.3f} |")
+            lines.append(
+                f"| {label} | {r['points']} | {r['converged']} | {r['seconds']:.2f} | {r['setup_seconds']:.2f} | "
+                f"{r['solve_seconds']:.2f} | {r['mean_solve_seconds']:.3f} |"
+            )
     snake = result.get("snakemake")
     if snake:
-        lines += ["", f"Workflow: `{snake['command']}`: **{snake['seconds']:.1f} s** for {snake['points']} solves "
-                  f"({snake['converged']} converged); limit {snake['limit_seconds']:.0f} s: "
-                  f"{'met' if snake['within_limit'] else 'NOT met'}.", "", "| job | seconds | max RSS [MB] |", "|---|---:|---:|"]
+        lines += [
+            "",
+            f"Workflow: `{snake['command']}`: **{snake['seconds']:.1f} s** for {snake['points']} solves "
+            f"({snake['converged']} converged); limit {snake['limit_seconds']:.0f} s: "
+            f"{'met' if snake['within_limit'] else 'NOT met'}.",
+            "",
+            "| job | seconds | max RSS [MB] |",
+            "|---|---:|---:|",
+        ]
         lines += [f"| {job} | {b['seconds']:.2f} | {b['max_rss_mb']:.0f} |" for job, b in snake["jobs"].items()]
     return "\n".join(lines) + "\n"
 

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from vemkit.contact.laws import ContactLaw
-from vemkit.mesh.families import build_mesh
 from vemkit.contact.problem import discrete_problem
+from vemkit.mesh.families import build_mesh
 from vemkit.mesh.mesh import from_polygons, tag_box_boundary
 
 PAPER = dict(E=2000.0, nu=0.4, gap=0.1, law=ContactLaw(10.0, 1.0, 450.0, 0.0))

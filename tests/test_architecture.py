@@ -36,7 +36,9 @@ def _imported(path: Path, module: str):
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
-                base = ".".join(package.split(".")[: len(package.split(".")) - node.level + 1] + ([base] if base else []))
+                base = ".".join(
+                    package.split(".")[: len(package.split(".")) - node.level + 1] + ([base] if base else [])
+                )
             if base == "vemkit":
                 yield from (f"vemkit.{a.name}" for a in node.names if a.name in LAYERS)
             elif base.startswith("vemkit."):
@@ -51,8 +53,9 @@ def test_no_module_imports_from_a_layer_above_it(module, path):
 
 def test_every_subpackage_says_what_it_owns_and_may_import():
     for layer in LAYERS[1:-1]:
-        doc = " ".join((ast.get_docstring(ast.parse((PACKAGE / layer / "__init__.py").read_text(encoding="utf-8")))
-                        or "").split())
+        doc = " ".join(
+            (ast.get_docstring(ast.parse((PACKAGE / layer / "__init__.py").read_text(encoding="utf-8"))) or "").split()
+        )
         assert doc and f"Layer {LAYERS.index(layer)}" in doc and "Imports from vemkit" in doc, layer
 
 
@@ -73,22 +76,27 @@ def _python(code: str) -> subprocess.CompletedProcess:
 def test_the_core_imports_and_solves_without_snakemake_or_matplotlib(tmp_path):
     core = [m for m, _ in _modules() if _layer(m) <= LAYERS.index("studies")]
     scene = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
-    code = _BLOCK.format(blocked=["snakemake", "matplotlib"]) + f"""
+    code = (
+        _BLOCK.format(blocked=["snakemake", "matplotlib"])
+        + f"""
 import importlib
 for name in {core!r}:
     importlib.import_module(name)
 from vemkit.cli import main
-assert main(["solve", {str(scene)!r}, "-o", {str(tmp_path / 'out.nc')!r}, "--set", "discretization.mesh.n=4", "-q"]) == 0
+assert main(["solve", {str(scene)!r}, "-o", {str(tmp_path / "out.nc")!r}, "--set", "discretization.mesh.n=4", "-q"]) == 0
 """
+    )
     run = _python(code)
     assert run.returncode == 0, run.stderr[-2000:]
     assert (tmp_path / "out.nc").is_file()
 
 
 def test_importing_vemkit_has_no_side_effects():
-    run = _python("import json, os, sys; before = dict(os.environ); import vemkit; "
-                  "print(json.dumps([dict(os.environ) == before, sorted(m for m in sys.modules "
-                  "if m.split('.')[0] in ('numpy', 'matplotlib', 'numba'))]))")
+    run = _python(
+        "import json, os, sys; before = dict(os.environ); import vemkit; "
+        "print(json.dumps([dict(os.environ) == before, sorted(m for m in sys.modules "
+        "if m.split('.')[0] in ('numpy', 'matplotlib', 'numba'))]))"
+    )
     unchanged, heavy = json.loads(run.stdout)
     assert unchanged and heavy == []
 

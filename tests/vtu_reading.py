@@ -29,10 +29,11 @@ def vtu_arrays(path):
 
     kinds = {"Float64": np.float64, "Int64": np.int64, "UInt8": np.uint8}
     out = {}
-    for kind, name, text in re.findall(r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>',
-                                       path.read_text()):
+    for kind, name, text in re.findall(
+        r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>', path.read_text()
+    ):
         raw = base64.b64decode(text)
-        out[name] = np.frombuffer(raw[8:8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
+        out[name] = np.frombuffer(raw[8 : 8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
     return out
 
 
@@ -41,7 +42,7 @@ def stream_cycles(faces, faceoffsets):
     for end in faceoffsets:
         count, at, cycles = faces[start], start + 1, []
         for _ in range(count):
-            cycles.append(canonical(faces[at + 1:at + 1 + faces[at]]))
+            cycles.append(canonical(faces[at + 1 : at + 1 + faces[at]]))
             at += 1 + faces[at]
         assert at == end
         cells.append(sorted(cycles))

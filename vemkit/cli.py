@@ -60,8 +60,10 @@ def _outputs(args, inputs):
     output = output_target(args.output, "-o", inputs)
     vtu = None if args.vtu is None else output_target(args.vtu, "--vtu", inputs)
     if vtu is not None and same_file(output, vtu):
-        raise OutputError(f"-o {shown(args.output)} and --vtu {shown(args.vtu)} name the same file; give two "
-                          "different paths", key="--vtu")
+        raise OutputError(
+            f"-o {shown(args.output)} and --vtu {shown(args.vtu)} name the same file; give two different paths",
+            key="--vtu",
+        )
     return output, vtu
 
 
@@ -75,10 +77,15 @@ def _writing(args):
         from vemkit.io.output_files import WRITTEN, shown
 
         names = " and ".join(shown(p) for p in (args.output, args.vtu) if p)
-        reason = error.strerror if isinstance(error, OSError) and error.strerror else shown(" ".join(str(error).split()), 200)
+        reason = (
+            error.strerror
+            if isinstance(error, OSError) and error.strerror
+            else shown(" ".join(str(error).split()), 200)
+        )
         done = f"only {', '.join(map(shown, WRITTEN))} was written" if WRITTEN else "nothing was written"
-        raise OutputError(f"cannot write {names} ({reason}); {done}: check the disk space and permissions",
-                          key="-o") from None
+        raise OutputError(
+            f"cannot write {names} ({reason}); {done}: check the disk space and permissions", key="-o"
+        ) from None
 
 
 def _name(path) -> str:
@@ -113,8 +120,10 @@ def cmd_solve(args) -> int:
         if vtu_part is not None:
             _write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:
-        print(f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
-              f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})")
+        print(
+            f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
+            f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})"
+        )
     return 0
 
 
@@ -131,8 +140,10 @@ def _check_resources(scene, max_dofs):
 
 
 #: the cell fields of a solution's VTU file (2D, 3D)
-VTU_CELL_FIELDS = {2: ("stress_11", "stress_22", "stress_12", "shear_energy_density"),
-                   3: ("stress_11", "stress_22", "stress_33", "stress_12", "stress_13", "stress_23", "von_mises")}
+VTU_CELL_FIELDS = {
+    2: ("stress_11", "stress_22", "stress_12", "shear_energy_density"),
+    3: ("stress_11", "stress_22", "stress_33", "stress_12", "stress_13", "stress_23", "von_mises"),
+}
 
 
 def _write_solution_vtu(problem, solution, ds, path) -> None:
@@ -149,27 +160,34 @@ def _write_solution_vtu(problem, solution, ds, path) -> None:
 def _adapt_inputs(args):
     """The scene, the adaptivity settings, the true-error measure and the output targets of ``adapt``."""
     from vemkit.config.limits import check_scene_resources
-    from vemkit.vem.elements import element_for
     from vemkit.config.scene import load_scene
     from vemkit.studies.adaptivity import AdaptivitySettings
     from vemkit.studies.adaptivity_errors import reference_path, scene_true_error
+    from vemkit.vem.elements import element_for
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
     if scene.dimension == 3:
-        raise InputError(f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
-                         "(SPEC §9); solve it with vemkit solve", key="model")
+        raise InputError(
+            f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
+            "(SPEC §9); solve it with vemkit solve",
+            key="model",
+        )
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
     targets = _outputs(args, inputs)
-    check_scene_resources(scene, args.max_dofs, element_for(scene.order).layout)  # the first mesh; the loop keeps below max_dofs
+    check_scene_resources(
+        scene, args.max_dofs, element_for(scene.order).layout
+    )  # the first mesh; the loop keeps below max_dofs
     return scene, AdaptivitySettings.from_scene(scene, args.max_dofs), scene_true_error(scene), targets
 
 
 def _step_line(step: int, record: dict) -> str:
     true = f", true error {record['true_error']:.3e}" if "true_error" in record else ""
-    return (f"vemkit adapt: step {step + 1}: {record['n_dofs']} dofs, {record['n_cells']} cells, estimate "
-            f"{record['estimate']:.3e}{true}, {record['iterations']} iterations, {record['wall_time']:.2f} s")
+    return (
+        f"vemkit adapt: step {step + 1}: {record['n_dofs']} dofs, {record['n_cells']} cells, estimate "
+        f"{record['estimate']:.3e}{true}, {record['iterations']} iterations, {record['wall_time']:.2f} s"
+    )
 
 
 def cmd_adapt(args) -> int:
@@ -189,17 +207,26 @@ def cmd_adapt(args) -> int:
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
         if vtu_part is not None:
-            write_vtu(run.problem.mesh, vtu_part, point_data={"displacement": run.problem.dofs.expand(run.solution.u)},
-                      cell_data={"error_indicator": ds["error_indicator"].values})
+            write_vtu(
+                run.problem.mesh,
+                vtu_part,
+                point_data={"displacement": run.problem.dofs.expand(run.solution.u)},
+                cell_data={"error_indicator": ds["error_indicator"].values},
+            )
     last = run.history[-1]
     if run.reason != "target":
-        print(f"vemkit: note: adaptivity.target = {settings.target:g} not reached: {STOP_REASONS[run.reason]} "
-              f"(estimate {last['estimate']:.3e} after {len(run.history)} steps, {last['n_dofs']} dofs); "
-              f"{_name(args.output)} holds the last solution", file=sys.stderr)
+        print(
+            f"vemkit: note: adaptivity.target = {settings.target:g} not reached: {STOP_REASONS[run.reason]} "
+            f"(estimate {last['estimate']:.3e} after {len(run.history)} steps, {last['n_dofs']} dofs); "
+            f"{_name(args.output)} holds the last solution",
+            file=sys.stderr,
+        )
     if not args.quiet:
-        print(f"{_name(args.output)}: {len(run.history)} adaptive steps ({run.reason}), {last['n_dofs']} dofs, "
-              f"{last['n_cells']} cells, estimate {last['estimate']:.3e}, {ds.attrs['adapt_wall_time']:.2f} s "
-              f"(check {ds.attrs['check_worst']:.1e})")
+        print(
+            f"{_name(args.output)}: {len(run.history)} adaptive steps ({run.reason}), {last['n_dofs']} dofs, "
+            f"{last['n_cells']} cells, estimate {last['estimate']:.3e}, {ds.attrs['adapt_wall_time']:.2f} s "
+            f"(check {ds.attrs['check_worst']:.1e})"
+        )
     return 0
 
 
@@ -209,8 +236,9 @@ def _family_mesh(args):
     from vemkit.config.mesh_options import mesh_request
 
     if args.family is None or args.n is None or args.set:
-        raise InputError("vemkit mesh: give FAMILY N (the unit square) or --scene SCENE.yaml [--set ...], "
-                         "not both", key="arguments")
+        raise InputError(
+            "vemkit mesh: give FAMILY N (the unit square) or --scene SCENE.yaml [--set ...], not both", key="arguments"
+        )
     options = mesh_request(args.family, args.n, args.option or ())
     estimate = estimate_resources(*estimate_mesh(options))  # before anything is built
     family, n = options.pop("family"), options.pop("n")
@@ -225,8 +253,11 @@ def _scene_mesh(args):
     from vemkit.config.scene import load_scene
 
     if args.family is not None or args.n is not None or args.option:
-        raise InputError("vemkit mesh --scene takes the mesh from the scene: drop FAMILY N and --option "
-                         "(use --set discretization.mesh.KEY=VALUE)", key="arguments")
+        raise InputError(
+            "vemkit mesh --scene takes the mesh from the scene: drop FAMILY N and --option "
+            "(use --set discretization.mesh.KEY=VALUE)",
+            key="arguments",
+        )
     scene = load_scene(args.scene, args.set or ())
     if scene.mesh_file is not None:  # never write over the mesh file the scene reads
         _outputs(args, [args.scene, scene.mesh_file])
@@ -243,7 +274,8 @@ def cmd_mesh(args) -> int:
     from vemkit.io.output_files import atomic_outputs
 
     if getattr(mesh, "dimension", 2) == 3:
-        from vemkit.mesh.files3d import write_ugrid3d as write_ugrid, write_vtu3d as write_vtu
+        from vemkit.mesh.files3d import write_ugrid3d as write_ugrid
+        from vemkit.mesh.files3d import write_vtu3d as write_vtu
     else:
         from vemkit.mesh.files import write_ugrid, write_vtu
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
@@ -278,35 +310,52 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    limit = dict(type=_positive_int, default=DEFAULT_MAX_DOFS, metavar="DOFS",
-                 help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})")
+    limit = dict(
+        type=_positive_int,
+        default=DEFAULT_MAX_DOFS,
+        metavar="DOFS",
+        help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})",
+    )
     solve = sub.add_parser("solve", help="solve a scene and write the solution as netCDF")
     solve.add_argument("scene", help="scene YAML file (see config/scenes/paper.yaml)")
     solve.add_argument("-o", "--output", required=True, help="solution file (netCDF4, UGRID)")
-    solve.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. solver.method=uzawa")
+    solve.add_argument(
+        "--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. solver.method=uzawa"
+    )
     solve.add_argument("--vtu", help="also write a VTU file for ParaView")
     solve.add_argument("--max-dofs", **limit)
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress display and no summary line")
     solve.set_defaults(func=cmd_solve)
-    mesh = sub.add_parser("mesh", help="build a mesh (of a family on the unit square, or of a scene's body) "
-                                       "and write it as UGRID netCDF")
+    mesh = sub.add_parser(
+        "mesh", help="build a mesh (of a family on the unit square, or of a scene's body) and write it as UGRID netCDF"
+    )
     mesh.add_argument("family", nargs="?", help="square, triangle, voronoi or hanging")
     mesh.add_argument("n", nargs="?", type=int, help="cells per side (h = 1/n)")
     mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead (SPEC §8)")
     mesh.add_argument("--set", action="append", metavar="KEY=VALUE", help="with --scene: override a scene value")
     mesh.add_argument("-o", "--output", required=True, help="mesh file (netCDF4, UGRID)")
-    mesh.add_argument("--option", action="append", metavar="KEY=VALUE", help="family option, e.g. seed=3, kind=delaunay")
+    mesh.add_argument(
+        "--option", action="append", metavar="KEY=VALUE", help="family option, e.g. seed=3, kind=delaunay"
+    )
     mesh.add_argument("--vtu", help="also write a VTU file")
     mesh.add_argument("--max-dofs", **limit)
     mesh.add_argument("-q", "--quiet", action="store_true")
     mesh.set_defaults(func=cmd_mesh)
-    adapt = sub.add_parser("adapt", help="solve, estimate, mark and refine until the scene's adaptivity target "
-                                         "(SPEC §9); write the final solution with the indicator and the history")
+    adapt = sub.add_parser(
+        "adapt",
+        help="solve, estimate, mark and refine until the scene's adaptivity target "
+        "(SPEC §9); write the final solution with the indicator and the history",
+    )
     adapt.add_argument("scene", help="scene YAML file; its adaptivity: block sets the loop (defaults filled in)")
-    adapt.add_argument("-o", "--output", required=True, help="final solution file (netCDF4, UGRID) with "
-                                                            "error_indicator and the adapt_* history")
-    adapt.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. "
-                                                                          "adaptivity.target=0.05")
+    adapt.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="final solution file (netCDF4, UGRID) with error_indicator and the adapt_* history",
+    )
+    adapt.add_argument(
+        "--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. adaptivity.target=0.05"
+    )
     adapt.add_argument("--vtu", help="also write the final mesh with the displacement and the indicator (VTU)")
     adapt.add_argument("--max-dofs", **limit)
     adapt.add_argument("-q", "--quiet", action="store_true", help="no progress lines and no summary line")
@@ -321,7 +370,7 @@ def _fail(message, status: int = EXIT_FAILURE) -> int:
     text = " ".join(str(message).split())
     text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
     if len(text) > MAX_MESSAGE:  # cut the middle: the fix is at the end of the line
-        text = text[:MAX_MESSAGE // 3] + " ... " + text[-(2 * MAX_MESSAGE // 3 - 5):]
+        text = text[: MAX_MESSAGE // 3] + " ... " + text[-(2 * MAX_MESSAGE // 3 - 5) :]
     print(f"vemkit: error: {text}", file=sys.stderr)
     return status
 
@@ -341,16 +390,14 @@ def _run(argv) -> int:
     except (InputError, SolveError, VemkitError) as error:
         return _fail(error)
     except MemoryError:
-        return _fail("out of memory although the estimate fitted (please report); use a coarser "
-                     "discretization.mesh")
+        return _fail("out of memory although the estimate fitted (please report); use a coarser discretization.mesh")
     except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
         from vemkit.io.output_files import shown
 
         where = f"{shown(error.filename)}: " if error.filename else ""
         return _fail(f"{where}{error.strerror or error}; nothing was written")
     except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
-        return _fail(f"internal error ({type(error).__name__}: {error}); please report",
-                     EXIT_INTERNAL)
+        return _fail(f"internal error ({type(error).__name__}: {error}); please report", EXIT_INTERNAL)
 
 
 def main(argv=None) -> int:

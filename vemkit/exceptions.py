@@ -75,8 +75,16 @@ class ResourceLimitError(InputError):
 
 
 #: why a solve failed (``SolveError.reason``); the robustness study classifies by these
-SOLVE_FAILURE_REASONS = ("diverged", "stagnated", "max_iterations", "inaccurate_stop", "other",
-                         "time_budget", "linear_solver_failed", "check_failed")
+SOLVE_FAILURE_REASONS = (
+    "diverged",
+    "stagnated",
+    "max_iterations",
+    "inaccurate_stop",
+    "other",
+    "time_budget",
+    "linear_solver_failed",
+    "check_failed",
+)
 
 
 class SolveError(VemkitError, RuntimeError):

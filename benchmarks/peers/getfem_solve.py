@@ -17,15 +17,20 @@ import json
 import sys
 import time
 
-import numpy as np
 import getfem as gf
+import numpy as np
 from scipy.spatial import cKDTree
 
 # IM_TRIANGLE(k) restricted to an edge is a Gauss-Legendre rule: 2 points for k = 2, 3, 3 points
 # for k = 4, 5, 4 points for k = 6, 7, 5 points for k = 9 (checked by its face_pts); IM_NC(2, 1)
 # restricted to an edge is the trapezoid rule (vemkit's `nodal` contact quadrature).
-GAUSS_EDGE_RULE = {1: "IM_TRIANGLE(1)", 2: "IM_TRIANGLE(3)", 3: "IM_TRIANGLE(5)",
-                   4: "IM_TRIANGLE(7)", 5: "IM_TRIANGLE(9)"}
+GAUSS_EDGE_RULE = {
+    1: "IM_TRIANGLE(1)",
+    2: "IM_TRIANGLE(3)",
+    3: "IM_TRIANGLE(5)",
+    4: "IM_TRIANGLE(7)",
+    5: "IM_TRIANGLE(9)",
+}
 
 
 def build_mesh(case):
@@ -89,7 +94,7 @@ def add_tresca_friction(model, mesh, mim_c, region, p):
     model.add_fem_variable("lam_t", multiplier_fem(mesh, region, p))
     model.add_initialized_data("kt", [p["kt"]])
     model.add_initialized_data("r_t", [p["r_friction"]])
-    tangent = "[-Normal(2), Normal(1)]"   # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
+    tangent = "[-Normal(2), Normal(1)]"  # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
     model.add_nonlinear_term(mim_c, f"kt*lam_t*(Test_u.{tangent})", region)
     z = f"(lam_t + r_t*(u.{tangent}))"
     projected = f"({z} - pos_part({z} - 1) + pos_part(-{z} - 1))"
@@ -103,7 +108,7 @@ def linear_solver(requested):
     try:
         gf.linsolve_mumps(gf.Spmat("identity", 2), np.ones(2))
         return "mumps"
-    except Exception:   # GetFEM raises its own error type when MUMPS is not compiled in
+    except Exception:  # GetFEM raises its own error type when MUMPS is not compiled in
         return "superlu"
 
 
@@ -122,7 +127,7 @@ def multiplier_fem(mesh, region, p):
     for side_region in p["dirichlet_regions"]:
         dofs -= set(full.basic_dof_on_region(side_region))
     partial = gf.MeshFem("partial", full, np.array(sorted(dofs), dtype=np.int32))
-    _KEEP_ALIVE.append(full)   # the partial MeshFem refers to it: freeing it would crash GetFEM
+    _KEEP_ALIVE.append(full)  # the partial MeshFem refers to it: freeing it would crash GetFEM
     return partial
 
 
@@ -149,8 +154,14 @@ def main(case_path, out_path):
     setup_s = time.perf_counter() - start
     solve_s, iterations = solve(model, p, lsolver)
     u = nodal_displacement(model, mf, mesh, to_gf)
-    info = {"setup_s": setup_s, "solve_s": solve_s, "lsolver": lsolver,
-            "iterations": _as_int(iterations), "n_dofs": int(mf.nbdof()), "getfem": getattr(gf, "__version__", str(getattr(gf, "__revision__", "?")))}
+    info = {
+        "setup_s": setup_s,
+        "solve_s": solve_s,
+        "lsolver": lsolver,
+        "iterations": _as_int(iterations),
+        "n_dofs": int(mf.nbdof()),
+        "getfem": getattr(gf, "__version__", str(getattr(gf, "__revision__", "?"))),
+    }
     np.savez(out_path, u=u, info=json.dumps(info))
 
 

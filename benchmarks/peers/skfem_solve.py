@@ -31,8 +31,7 @@ def assemble(case, p):
     basis = skfem.Basis(mesh, element, intorder=2)
     stiffness = skfem.asm(linear_elasticity(p["lam"], p["mu"]), basis)
     coefficients = np.array(p["traction_affine"], dtype=float)
-    neumann = skfem.FacetBasis(mesh, element, facets=facets_of(mesh, case[f"side_{p['neumann']}"]),
-                               intorder=4)
+    neumann = skfem.FacetBasis(mesh, element, facets=facets_of(mesh, case[f"side_{p['neumann']}"]), intorder=4)
 
     @skfem.LinearForm
     def traction(v, w):
@@ -41,8 +40,9 @@ def assemble(case, p):
         return dot(np.stack(t), v)
 
     load = skfem.asm(traction, neumann)
-    fixed = np.unique(np.concatenate([basis.get_dofs(facets=facets_of(mesh, case[f"side_{s}"])).all()
-                                      for s in p["dirichlet"]]))
+    fixed = np.unique(
+        np.concatenate([basis.get_dofs(facets=facets_of(mesh, case[f"side_{s}"])).all() for s in p["dirichlet"]])
+    )
     return mesh, basis, stiffness, load, fixed
 
 
@@ -63,6 +63,7 @@ def linear_solve(stiffness, load, fixed, basis, p):
         return skfem.solve(*skfem.condense(stiffness, load, D=fixed))
     import pyamg
     from scipy.sparse.linalg import cg
+
     A, b, x, interior = skfem.condense(stiffness, load, D=fixed)
     ml = pyamg.smoothed_aggregation_solver(A, B=rigid_modes(basis)[interior], symmetry="symmetric")
     solution, status = cg(A, b, M=ml.aspreconditioner(), rtol=p["cg_rtol"], atol=0.0, maxiter=1000)
@@ -79,8 +80,13 @@ def main(case_path, out_path):
     u = linear_solve(stiffness, load, fixed, basis, p)
     solved = time.perf_counter()
     u = np.stack([u[basis.nodal_dofs[0]], u[basis.nodal_dofs[1]]], axis=1)
-    info = {"setup_s": assembled - start, "solve_s": solved - assembled, "solver": p["solver"],
-            "n_dofs": int(basis.N), "skfem": skfem.__version__}
+    info = {
+        "setup_s": assembled - start,
+        "solve_s": solved - assembled,
+        "solver": p["solver"],
+        "n_dofs": int(basis.N),
+        "skfem": skfem.__version__,
+    }
     np.savez(out_path, u=u, info=json.dumps(info))
 
 

@@ -16,7 +16,7 @@ import yaml
 import vemkit
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
-sys.path.append(str(BENCHMARKS))   # appended: the benchmark scripts' names shadow nothing
+sys.path.append(str(BENCHMARKS))  # appended: the benchmark scripts' names shadow nothing
 peers = pytest.importorskip("peers", reason="benchmarks/peers.py")
 
 STICKING_K = 4000.0
@@ -79,5 +79,5 @@ def test_getfem_friction_with_sticking_vertices(tmp_path):
     params = peers.peer_params("friction", 100, friction_k=STICKING_K)
     u_getfem, record = peers.run_peer("getfem", "friction", case, tmp_path, params)
     bottom = np.unique(case["side_bottom"])
-    assert np.sum(np.abs(u_vem[bottom, 0]) < 1e-12) >= 3   # sticking vertices besides the clamped one
+    assert np.sum(np.abs(u_vem[bottom, 0]) < 1e-12) >= 3  # sticking vertices besides the clamped one
     assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record

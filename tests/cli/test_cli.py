@@ -14,7 +14,9 @@ PAPER = ROOT / "config" / "scenes" / "paper.yaml"
 
 
 def vemkit(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd
+    )
 
 
 def test_solve_writes_the_contract_file(tmp_path):
@@ -29,7 +31,14 @@ def test_solve_writes_the_contract_file(tmp_path):
             assert name in ds.variables
         assert ds["u1"].dims == ("mesh2d_nNodes",) and ds.sizes["mesh2d_nNodes"] == 81
         assert "_FillValue" in ds["mesh2d_face_nodes"].attrs
-        for name in ("normal_pressure", "tangential_stress", "friction_multiplier", "slip", "penetration", "contact_state"):
+        for name in (
+            "normal_pressure",
+            "tangential_stress",
+            "friction_multiplier",
+            "slip",
+            "penetration",
+            "contact_state",
+        ):
             assert ds[name].dims == ("contact_node",)
         scene = yaml.safe_load(ds.attrs["scene"])
         assert scene["discretization"]["mesh"]["n"] == 8 and scene["material"]["E"] == 2000.0
@@ -89,8 +98,18 @@ def test_missing_scene_and_divergence_are_one_line_errors(tmp_path):
     out = tmp_path / "x.nc"
     run = vemkit("solve", tmp_path / "nope.yaml", "-o", out)
     assert run.returncode != 0 and "nope.yaml" in run.stderr and len(run.stderr.strip().splitlines()) == 1
-    run = vemkit("solve", PAPER, "-o", out, "--set", "solver.method=uzawa", "--set", "contact.normal.k=1e7",
-                 "--set", "discretization.mesh.n=4")
+    run = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        out,
+        "--set",
+        "solver.method=uzawa",
+        "--set",
+        "contact.normal.k=1e7",
+        "--set",
+        "discretization.mesh.n=4",
+    )
     assert run.returncode != 0 and not out.exists()
     assert "ssn" in run.stderr and len(run.stderr.strip().splitlines()) == 1
 
@@ -113,19 +132,36 @@ def test_gauss_contact_quadrature_is_used_and_bad_point_counts_refused(tmp_path)
     from vemkit.solvers.ssn import solve_ssn
 
     out = tmp_path / "gauss.nc"
-    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.mesh.n=4",
-                 "--set", "discretization.contact_quadrature=gauss")
+    run = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        out,
+        "--set",
+        "discretization.mesh.n=4",
+        "--set",
+        "discretization.contact_quadrature=gauss",
+    )
     assert run.returncode == 0, run.stderr
     with xr.open_dataset(out) as ds:
         assert "contact_gauss_points: 3" in ds.attrs["scene"]
         u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
     for quadrature, differs in (("nodal", True), ("gauss", False)):
-        scene = load_scene(PAPER).with_overrides(["discretization.mesh.n=4",
-                                                  f"discretization.contact_quadrature={quadrature}"])
+        scene = load_scene(PAPER).with_overrides(
+            ["discretization.mesh.n=4", f"discretization.contact_quadrature={quadrature}"]
+        )
         pb = scene_problem(scene)
         expected = pb.dofs.expand(solve_ssn(pb, tol=1e-10).u)
         assert (np.max(np.abs(u - expected)) > 1e-8 * np.max(np.abs(expected))) == differs, quadrature
     out = tmp_path / "g.nc"
-    run = vemkit("solve", PAPER, "-o", out, "--set", "discretization.contact_quadrature=gauss",
-                 "--set", "discretization.contact_gauss_points=0")
+    run = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        out,
+        "--set",
+        "discretization.contact_quadrature=gauss",
+        "--set",
+        "discretization.contact_gauss_points=0",
+    )
     assert run.returncode != 0 and "contact_gauss_points" in run.stderr and not out.exists()

@@ -21,14 +21,17 @@ BOX_SIDES = ["left", "right", "front", "back", "bottom", "top"]
 
 def scene_text(family="octree", n=3, dirichlet=None, extra=""):
     dirichlet = dirichlet or "\n".join(f"    {side}: {LINEAR}" for side in BOX_SIDES)
-    return (f"name: patch3d\nmodel: 3d\ndomain: {{box: [[0, 0, 0], [1, 1, 0.5]]}}\n"
-            f"material: {{E: {E}, nu: {NU}}}\nboundary:\n  dirichlet:\n{dirichlet}\n{extra}"
-            f"discretization: {{mesh: {{family: {family}, n: {n}}}}}\n")
+    return (
+        f"name: patch3d\nmodel: 3d\ndomain: {{box: [[0, 0, 0], [1, 1, 0.5]]}}\n"
+        f"material: {{E: {E}, nu: {NU}}}\nboundary:\n  dirichlet:\n{dirichlet}\n{extra}"
+        f"discretization: {{mesh: {{family: {family}, n: {n}}}}}\n"
+    )
 
 
 def vemkit(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd
+    )
 
 
 @pytest.mark.parametrize("family", ["octree", "voronoi", "tet"])
@@ -44,7 +47,7 @@ def test_a_linear_displacement_is_reproduced_through_the_cli(tmp_path, family):
     assert np.abs(u - exact).max() < 1e-12
     eps = 0.5 * (GRADIENT + GRADIENT.T)
     sigma = 2 * E / (2 * (1 + NU)) * eps + E * NU / ((1 + NU) * (1 - 2 * NU)) * np.trace(eps) * np.eye(3)
-    for (i, j) in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
+    for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
         name = f"{i + 1}{j + 1}"
         assert np.allclose(ds[f"strain_{name}"].values, eps[i, j], rtol=0, atol=1e-13)
         assert np.allclose(ds[f"stress_{name}"].values, sigma[i, j], rtol=1e-11, atol=1e-11)
@@ -52,7 +55,9 @@ def test_a_linear_displacement_is_reproduced_through_the_cli(tmp_path, family):
     assert np.allclose(ds["von_mises"].values, np.sqrt(1.5 * np.sum(deviator**2)), rtol=1e-11)
     arrays = vtu_arrays(tmp_path / "s.vtu")
     assert (arrays["types"] == 42).all()
-    assert stream_cycles(arrays["faces"], arrays["faceoffsets"]) == [outward_cycles(mesh, c) for c in range(mesh.n_cells)]
+    assert stream_cycles(arrays["faces"], arrays["faceoffsets"]) == [
+        outward_cycles(mesh, c) for c in range(mesh.n_cells)
+    ]
     assert np.allclose(arrays["displacement"].reshape(-1, 3), u, rtol=0, atol=0)
     assert np.array_equal(arrays["von_mises"], ds["von_mises"].values)
 
@@ -63,9 +68,18 @@ def test_the_solution_file_carries_the_mesh3d_topology(tmp_path):
     with netCDF4.Dataset(tmp_path / "s.nc") as nc:
         topology = nc["mesh3d"]
         assert topology.cf_role == "mesh_topology" and int(topology.topology_dimension) == 3
-        for name in ("mesh3d_node_x", "mesh3d_node_y", "mesh3d_node_z", "mesh3d_face_nodes", "mesh3d_volume_faces",
-                     "u1", "u2", "u3", "von_mises", *(f"{q}_{ij}" for q in ("strain", "stress")
-                                                      for ij in ("11", "22", "33", "12", "13", "23"))):
+        for name in (
+            "mesh3d_node_x",
+            "mesh3d_node_y",
+            "mesh3d_node_z",
+            "mesh3d_face_nodes",
+            "mesh3d_volume_faces",
+            "u1",
+            "u2",
+            "u3",
+            "von_mises",
+            *(f"{q}_{ij}" for q in ("strain", "stress") for ij in ("11", "22", "33", "12", "13", "23")),
+        ):
             assert name in nc.variables, name
         assert nc["u3"].dimensions == ("mesh3d_nNodes",) and nc["von_mises"].dimensions == ("mesh3d_nVolumes",)
         assert nc.model == "3d" and "model: 3d" in nc.scene
@@ -104,11 +118,14 @@ def test_bad_3d_input_is_refused_in_one_line(tmp_path, override):
     assert not (tmp_path / "s.nc").exists()
 
 
-@pytest.mark.parametrize("extra, message", [
-    ("  contact: [top]\ncontact: {gap: -1, normal: {k: 1, m: 1}, friction: {k: 0, m: 0}}\n", "must be >= 0"),
-    ("  neumann: {top: {traction: [0, 1]}}\n", "traction has 2 components"),
-    ("body_force: [0, 0, '1/z']\n", "must be finite"),
-])
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ("  contact: [top]\ncontact: {gap: -1, normal: {k: 1, m: 1}, friction: {k: 0, m: 0}}\n", "must be >= 0"),
+        ("  neumann: {top: {traction: [0, 1]}}\n", "traction has 2 components"),
+        ("body_force: [0, 0, '1/z']\n", "must be finite"),
+    ],
+)
 def test_bad_3d_scene_keys_are_refused_in_one_line(tmp_path, extra, message):
     (tmp_path / "s.yaml").write_text(scene_text("hex", 2, dirichlet="    bottom: [0, 0, 0]", extra=extra))
     run = vemkit("solve", tmp_path / "s.yaml", "-o", tmp_path / "s.nc")
@@ -118,8 +135,9 @@ def test_bad_3d_scene_keys_are_refused_in_one_line(tmp_path, extra, message):
 
 def test_a_2d_domain_with_model_3d_and_adapt_on_3d_are_refused(tmp_path):
     text = scene_text("hex", 2).replace("domain: {box: [[0, 0, 0], [1, 1, 0.5]]}", "domain: unit_square")
-    (tmp_path / "flat.yaml").write_text(text.replace(scene_text("hex", 2).split("dirichlet:\n")[1].split("discr")[0],
-                                                     "    bottom: [0, 0, 0]\n"))
+    (tmp_path / "flat.yaml").write_text(
+        text.replace(scene_text("hex", 2).split("dirichlet:\n")[1].split("discr")[0], "    bottom: [0, 0, 0]\n")
+    )
     run = vemkit("solve", tmp_path / "flat.yaml", "-o", tmp_path / "s.nc")
     assert run.returncode == 2 and "model = '3d' needs a 3D body" in run.stderr, run.stderr
     (tmp_path / "s.yaml").write_text(scene_text("hex", 2))
@@ -131,13 +149,22 @@ def test_a_2d_domain_with_model_3d_and_adapt_on_3d_are_refused(tmp_path):
 def test_a_3d_scene_solves_on_its_mesh_file_and_a_2d_scene_refuses_it(tmp_path):
     (tmp_path / "s.yaml").write_text(scene_text("voronoi", 3))
     assert vemkit("mesh", "--scene", tmp_path / "s.yaml", "-o", tmp_path / "m.nc", "-q").returncode == 0
-    text = scene_text("voronoi", 3).replace("discretization: {mesh: {family: voronoi, n: 3}}",
-                                            "discretization: {mesh: {file: m.nc}}")
+    text = scene_text("voronoi", 3).replace(
+        "discretization: {mesh: {family: voronoi, n: 3}}", "discretization: {mesh: {file: m.nc}}"
+    )
     (tmp_path / "f.yaml").write_text(text.replace("domain: {box: [[0, 0, 0], [1, 1, 0.5]]}\n", ""))
     run = vemkit("solve", tmp_path / "f.yaml", "-o", tmp_path / "f.nc", "-q")
     assert run.returncode == 0, run.stderr
     mesh, ds = read_solution(tmp_path / "f.nc")
     assert np.abs(ds["u3"].values - mesh.vertices @ GRADIENT[2]).max() < 1e-12
-    run = vemkit("solve", tmp_path / "f.yaml", "-o", tmp_path / "g.nc", "--set", "model=plane_stress",
-                 "--set", "boundary.dirichlet=[bottom]")
+    run = vemkit(
+        "solve",
+        tmp_path / "f.yaml",
+        "-o",
+        tmp_path / "g.nc",
+        "--set",
+        "model=plane_stress",
+        "--set",
+        "boundary.dirichlet=[bottom]",
+    )
     assert run.returncode == 2 and "is a 3D mesh" in run.stderr and not (tmp_path / "g.nc").exists()

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
-
 from conftest import assert_no_nan_stored
+
 from vemkit.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -22,8 +22,9 @@ N4 = ("--set", "discretization.mesh.n=4")
 
 
 def vemkit(*args, cwd=None, timeout=120):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=timeout
+    )
 
 
 def test_a_small_adaptive_run_writes_the_final_solution_with_indicator_and_history(tmp_path):
@@ -64,8 +65,23 @@ def test_a_reference_file_gives_the_true_error_of_every_step(tmp_path, monkeypat
     scene.write_text(PAPER.read_text())
     assert main(["solve", str(scene), "-o", str(tmp_path / "ref.nc"), "--set", "discretization.mesh.n=32", "-q"]) == 0
     monkeypatch.chdir(ROOT)  # not the scene's directory: the reference is found next to the scene
-    assert main(["adapt", str(scene), "-o", str(tmp_path / "a.nc"), *N4, "--set", "adaptivity.reference=ref.nc",
-                 "--set", "adaptivity.max_steps=3", "-q"]) == 0
+    assert (
+        main(
+            [
+                "adapt",
+                str(scene),
+                "-o",
+                str(tmp_path / "a.nc"),
+                *N4,
+                "--set",
+                "adaptivity.reference=ref.nc",
+                "--set",
+                "adaptivity.max_steps=3",
+                "-q",
+            ]
+        )
+        == 0
+    )
     with xr.open_dataset(tmp_path / "a.nc") as ds:
         true = ds["adapt_true_error"].values
         assert true.size == 3 and np.all(np.diff(true) < 0) and 0.01 < true[0] < 0.5
@@ -75,8 +91,22 @@ def test_a_reference_file_gives_the_true_error_of_every_step(tmp_path, monkeypat
     assert main(["adapt", str(scene), "-o", str(tmp_path / "ref.nc"), *N4, "--set", "adaptivity.reference=ref.nc"]) == 2
     assert "input file" in capsys.readouterr().err
     # a reference of another problem (a softer material) is refused, naming the section that differs
-    assert main(["solve", str(scene), "-o", str(tmp_path / "other.nc"), "--set", "discretization.mesh.n=8",
-                 "--set", "material.E=1000", "-q"]) == 0
+    assert (
+        main(
+            [
+                "solve",
+                str(scene),
+                "-o",
+                str(tmp_path / "other.nc"),
+                "--set",
+                "discretization.mesh.n=8",
+                "--set",
+                "material.E=1000",
+                "-q",
+            ]
+        )
+        == 0
+    )
     assert main(["adapt", str(scene), "-o", str(tmp_path / "b.nc"), *N4, "--set", "adaptivity.reference=other.nc"]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "adaptivity.reference" in err and "'material'" in err
@@ -139,8 +169,22 @@ def test_bad_adaptivity_input_writes_nothing(bad_runs):
 def test_an_exact_solution_gives_the_true_error_of_every_step(tmp_path):
     """Kirsch's plate (config/scenes/kirsch.yaml, exact: the Kirsch field): the estimate tracks the error."""
     out = tmp_path / "kirsch.nc"
-    assert main(["adapt", str(ROOT / "config" / "scenes" / "kirsch.yaml"), "-o", str(out), "--set",
-                 "discretization.mesh.h=1", "--set", "adaptivity.max_steps=3", "-q"]) == 0
+    assert (
+        main(
+            [
+                "adapt",
+                str(ROOT / "config" / "scenes" / "kirsch.yaml"),
+                "-o",
+                str(out),
+                "--set",
+                "discretization.mesh.h=1",
+                "--set",
+                "adaptivity.max_steps=3",
+                "-q",
+            ]
+        )
+        == 0
+    )
     with xr.open_dataset(out) as ds:
         true, effectivity = ds["adapt_true_error"].values, ds["adapt_effectivity"].values
         assert true.size == 3 and np.all(np.diff(true) < 0) and 0.05 < true[0] < 0.5

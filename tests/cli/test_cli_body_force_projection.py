@@ -18,8 +18,12 @@ SLIDING = ROOT / "config" / "order2" / "sliding.yaml"
 def _solve(tmp_path, name, *sets):
     out = tmp_path / f"{name}.nc"
     args = [a for s in sets for a in ("--set", s)]
-    run = subprocess.run([sys.executable, "-m", "vemkit.cli", "solve", SLIDING, "-o", out, "-q", *args],
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", "solve", SLIDING, "-o", out, "-q", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
     with xr.open_dataset(out) as ds:
         scene = yaml.safe_load(ds.attrs["scene"])
@@ -38,13 +42,13 @@ def _vertex_error(u, xy):
 
 @pytest.mark.slow
 def test_order_2_loads_p1_by_default_and_reaches_l2_order_3(tmp_path):
-    found = {n: _solve(tmp_path, f"k2-{n}", "discretization.order=2", f"discretization.mesh.n={n}")
-             for n in (8, 16)}
+    found = {n: _solve(tmp_path, f"k2-{n}", "discretization.order=2", f"discretization.mesh.n={n}") for n in (8, 16)}
     attrs, discretization, u, xy = found[16]
     assert discretization["body_force_projection"] == "p1"  # recorded in the solution file's scene
     assert np.log2(found[8][0]["error_l2"] / attrs["error_l2"]) >= 2.8
-    p0, p0_discretization, p0_u, _ = _solve(tmp_path, "p0", "discretization.order=2", "discretization.mesh.n=16",
-                                            "discretization.body_force_projection=p0")
+    p0, p0_discretization, p0_u, _ = _solve(
+        tmp_path, "p0", "discretization.order=2", "discretization.mesh.n=16", "discretization.body_force_projection=p0"
+    )
     assert p0_discretization["body_force_projection"] == "p0"
     assert p0["error_l2"] > 10 * attrs["error_l2"] and p0["error_h1"] > 1.8 * attrs["error_h1"]
     k1, k1_discretization, k1_u, k1_xy = _solve(tmp_path, "k1", "discretization.mesh.n=16")

@@ -40,9 +40,18 @@ def test_a_3d_contact_solve_writes_the_contact_node_variables(tmp_path):
     mesh, ds = read_solution(tmp_path / "s.nc")
     n_c = 16  # the 4 x 4 vertices of the bottom
     assert ds.sizes["contact_node"] == n_c and ds.sizes["contact_tangent"] == 2
-    for name in ("contact_x", "contact_y", "contact_z", "contact_vertex", "contact_weight", "normal_pressure",
-                 "penetration", "friction_bound", "contact_state", *(f"contact_{v}_{a}" for v in
-                 ("normal", "tangent1", "tangent2") for a in "xyz")):
+    for name in (
+        "contact_x",
+        "contact_y",
+        "contact_z",
+        "contact_vertex",
+        "contact_weight",
+        "normal_pressure",
+        "penetration",
+        "friction_bound",
+        "contact_state",
+        *(f"contact_{v}_{a}" for v in ("normal", "tangent1", "tangent2") for a in "xyz"),
+    ):
         assert ds[name].dims == ("contact_node",), name
     for name in ("tangential_stress", "friction_multiplier", "slip"):
         assert ds[name].dims == ("contact_node", "contact_tangent"), name
@@ -51,8 +60,10 @@ def test_a_3d_contact_solve_writes_the_contact_node_variables(tmp_path):
     vertex = ds["contact_vertex"].values
     for k, axis in enumerate("xyz"):
         assert np.allclose(mesh.vertices[vertex, k], ds[f"contact_{axis}"])
-    basis = np.stack([np.stack([ds[f"contact_{v}_{a}"].values for a in "xyz"], axis=1)
-                      for v in ("tangent1", "tangent2", "normal")], axis=1)
+    basis = np.stack(
+        [np.stack([ds[f"contact_{v}_{a}"].values for a in "xyz"], axis=1) for v in ("tangent1", "tangent2", "normal")],
+        axis=1,
+    )
     assert np.allclose(basis @ basis.transpose(0, 2, 1), np.eye(3))
     # the slip in the basis is the displacement of the vertex projected on t1, t2
     u = np.stack([ds[f"u{c}"].values[vertex] for c in (1, 2, 3)], axis=1)
@@ -84,8 +95,7 @@ def test_bad_3d_contact_keys_are_refused_in_one_line(tmp_path, override):
     assert not (tmp_path / "s.nc").exists()
 
 
-@pytest.mark.parametrize("gap, message", [("'-0.01 + z'", "< 0 at x="), ("'1/(x - 0.5)'", "finite"),
-                                          ("'0.01*w'", "w")])
+@pytest.mark.parametrize("gap, message", [("'-0.01 + z'", "< 0 at x="), ("'1/(x - 0.5)'", "finite"), ("'0.01*w'", "w")])
 def test_a_bad_3d_gap_expression_is_refused_in_one_line(tmp_path, gap, message):
     text = SCENE.replace("  foundation: {point: [0, 0, 0], normal: [0, 0, 1]}", f"  gap: {gap}")
     (tmp_path / "s.yaml").write_text(text)
@@ -95,9 +105,11 @@ def test_a_bad_3d_gap_expression_is_refused_in_one_line(tmp_path, gap, message):
 
 
 def test_a_2d_scene_refuses_a_3d_foundation_in_one_line(tmp_path):
-    text = ("domain: unit_square\nmaterial: {E: 1000.0, nu: 0.3}\nboundary: {dirichlet: [top], contact: [bottom]}\n"
-            "contact:\n  foundation: {point: [0, 0, 0], normal: [0, 0, 1]}\n  normal: {k: 1.0, m: 1.0}\n"
-            "  friction: {k: 0.0, m: 0.0}\ndiscretization: {mesh: {family: square, n: 2}}\n")
+    text = (
+        "domain: unit_square\nmaterial: {E: 1000.0, nu: 0.3}\nboundary: {dirichlet: [top], contact: [bottom]}\n"
+        "contact:\n  foundation: {point: [0, 0, 0], normal: [0, 0, 1]}\n  normal: {k: 1.0, m: 1.0}\n"
+        "  friction: {k: 0.0, m: 0.0}\ndiscretization: {mesh: {family: square, n: 2}}\n"
+    )
     (tmp_path / "s.yaml").write_text(text)
     run = vemkit("solve", tmp_path / "s.yaml", "-o", tmp_path / "s.nc")
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1, run.stderr

@@ -16,9 +16,24 @@ REFERENCE = 23.96  # vertical displacement at the middle of the loaded edge (con
 @pytest.mark.parametrize("family", ["square", "triangle", "voronoi"])
 def test_cooks_membrane_meets_the_published_displacement(tmp_path, family):
     out = tmp_path / "cook.nc"
-    run = subprocess.run([sys.executable, "-m", "vemkit.cli", "solve", str(COOK), "-o", str(out), "-q",
-                          "--set", f"discretization.mesh.family={family}", "--set", "discretization.mesh.n=1"],
-                         capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "vemkit.cli",
+            "solve",
+            str(COOK),
+            "-o",
+            str(out),
+            "-q",
+            "--set",
+            f"discretization.mesh.family={family}",
+            "--set",
+            "discretization.mesh.n=1",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 0, run.stderr
     with xr.open_dataset(out) as ds:
         x, y, v = ds["mesh2d_node_x"].values, ds["mesh2d_node_y"].values, ds["u2"].values
@@ -29,8 +44,9 @@ def test_cooks_membrane_meets_the_published_displacement(tmp_path, family):
 
 
 def _vemkit(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd
+    )
 
 
 @pytest.mark.parametrize("family", ["square", "voronoi"])
@@ -47,8 +63,14 @@ def test_vemkit_mesh_scene_meshes_the_body_with_its_sides(tmp_path, family):
     assert np.allclose(loaded[:, 0], 48.0) and np.isclose(np.ptp(loaded[:, 1]), 16.0)
 
 
-@pytest.mark.parametrize("args", [["-o", "m.nc"], ["square", "4", "--scene", COOK, "-o", "m.nc"],
-                                  ["square", "4", "--set", "discretization.mesh.n=3", "-o", "m.nc"]])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["-o", "m.nc"],
+        ["square", "4", "--scene", COOK, "-o", "m.nc"],
+        ["square", "4", "--set", "discretization.mesh.n=3", "-o", "m.nc"],
+    ],
+)
 def test_vemkit_mesh_wants_a_family_or_a_scene_not_both(tmp_path, args):
     run = _vemkit("mesh", *args, cwd=tmp_path)
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
@@ -63,8 +85,10 @@ def test_a_scene_solves_on_a_mesh_file_named_relative_to_it(tmp_path):
     assert _vemkit("mesh", "--scene", COOK, "-o", folder / "cook-mesh.nc", "-q").returncode == 0
     text = COOK.read_text().replace("mesh: {family: square, n: 1}", "mesh: {file: cook-mesh.nc}")
     (folder / "cook-file.yaml").write_text(text)
-    solved = [_vemkit("solve", scene, "-o", tmp_path / f"{name}.nc", "-q", cwd=tmp_path)
-              for name, scene in (("family", COOK), ("file", folder / "cook-file.yaml"))]
+    solved = [
+        _vemkit("solve", scene, "-o", tmp_path / f"{name}.nc", "-q", cwd=tmp_path)
+        for name, scene in (("family", COOK), ("file", folder / "cook-file.yaml"))
+    ]
     assert all(run.returncode == 0 for run in solved), [run.stderr for run in solved]
     with xr.open_dataset(tmp_path / "family.nc") as a, xr.open_dataset(tmp_path / "file.nc") as b:
         np.testing.assert_allclose(a["u2"].values, b["u2"].values, rtol=1e-12)

@@ -44,8 +44,9 @@ BAD_TRACTIONS = {
 
 
 def vemkit(*args, cwd, timeout=120):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=timeout
+    )
 
 
 def write_scene(path: Path, data: dict) -> Path:
@@ -105,10 +106,16 @@ PLATE = {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right
 
 def test_the_errors_of_a_linear_exact_field_are_rounding(tmp_path):
     """The VEM reproduces a linear field exactly (patch test): every error attribute is rounding."""
-    data = {"name": "patch", "domain": PLATE, "material": {"E": 1.0, "nu": 0.3}, "body_force": [0.0, 0.0],
-            "boundary": {"dirichlet": {side: LINEAR for side in PLATE["sides"]}, "neumann": {}},
-            "exact": {"displacement": LINEAR}, "discretization": {"mesh": {"family": "voronoi", "n": 8}},
-            "solver": {"method": "ssn", "tol": 1e-12}}
+    data = {
+        "name": "patch",
+        "domain": PLATE,
+        "material": {"E": 1.0, "nu": 0.3},
+        "body_force": [0.0, 0.0],
+        "boundary": {"dirichlet": {side: LINEAR for side in PLATE["sides"]}, "neumann": {}},
+        "exact": {"displacement": LINEAR},
+        "discretization": {"mesh": {"family": "voronoi", "n": 8}},
+        "solver": {"method": "ssn", "tol": 1e-12},
+    }
     out = tmp_path / "out.nc"
     assert main(["solve", str(write_scene(tmp_path / "scene.yaml", data)), "-o", str(out), "-q"]) == 0
     with xr.open_dataset(out) as ds:
@@ -118,15 +125,24 @@ def test_the_errors_of_a_linear_exact_field_are_rounding(tmp_path):
 
 U1 = "5/3*sqrt(x**2+y**2)**(2/3)*cos(2*atan2(y,x)/3)"  # u = grad(r^(5/3) cos(5θ/3)): harmonic potential,
 U2 = "-5/3*sqrt(x**2+y**2)**(2/3)*sin(2*atan2(y,x)/3)"  # so div u = 0, Δu = 0 and -div σ(u) = 0
-LSHAPE = {"polygon": [[0, -1], [1, -1], [1, 1], [-1, 1], [-1, 0], [0, 0]],  # re-entrant corner at 0;
-          "sides": ["a", "b", "c", "d", "e", "f"]}  # θ in [-π/2, π]: atan2's cut is the side y = 0, x < 0
+LSHAPE = {
+    "polygon": [[0, -1], [1, -1], [1, 1], [-1, 1], [-1, 0], [0, 0]],  # re-entrant corner at 0;
+    "sides": ["a", "b", "c", "d", "e", "f"],
+}  # θ in [-π/2, π]: atan2's cut is the side y = 0, x < 0
 
 
 def test_adapt_at_a_singular_corner_measures_the_true_error_exactly(tmp_path):
-    data = {"name": "lshape", "domain": LSHAPE, "material": {"E": 1.0, "nu": 0.3}, "body_force": [0.0, 0.0],
-            "boundary": {"dirichlet": {side: [U1, U2] for side in LSHAPE["sides"]}, "neumann": {}},
-            "exact": {"displacement": [U1, U2]}, "discretization": {"mesh": {"family": "square", "n": 4}},
-            "solver": {"method": "ssn", "tol": 1e-10}, "adaptivity": {"target": 1e-6, "max_steps": 9}}
+    data = {
+        "name": "lshape",
+        "domain": LSHAPE,
+        "material": {"E": 1.0, "nu": 0.3},
+        "body_force": [0.0, 0.0],
+        "boundary": {"dirichlet": {side: [U1, U2] for side in LSHAPE["sides"]}, "neumann": {}},
+        "exact": {"displacement": [U1, U2]},
+        "discretization": {"mesh": {"family": "square", "n": 4}},
+        "solver": {"method": "ssn", "tol": 1e-10},
+        "adaptivity": {"target": 1e-6, "max_steps": 9},
+    }
     out = tmp_path / "out.nc"
     assert main(["adapt", str(write_scene(tmp_path / "scene.yaml", data)), "-o", str(out), "-q"]) == 0
     with xr.open_dataset(out) as ds:

@@ -40,26 +40,89 @@ SOLVE_CASES = {
     "m = 1000": (["solve", "SCENE", "-o", "out.nc", "--set", "contact.normal.m=1000"], "contact.normal.m"),
     "tol = 1e300": (["solve", "SCENE", "-o", "out.nc", "--set", "solver.tol=1e300"], "solver.tol"),
     "eps_u = 1e300": (["solve", "SCENE", "-o", "out.nc", "--set", "solver.eps_u=1e300"], "solver.eps_u"),
-    "max_iterations = 1e9": (["solve", "SCENE", "-o", "out.nc", "--set", "solver.max_iterations=1000000000"],
-                             "solver.max_iterations"),
+    "max_iterations = 1e9": (
+        ["solve", "SCENE", "-o", "out.nc", "--set", "solver.max_iterations=1000000000"],
+        "solver.max_iterations",
+    ),
     "negative time budget": (["solve", "SCENE", "-o", "out.nc", "--set", "solver.time_budget=-1"], "time_budget"),
-    "n = 1e9": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.n=1000000000"],
-                "discretization.mesh.n"),
-    "n beyond the DOF limit": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.n=5000"],
-                               "50,020,002 DOFs"),
+    "n = 1e9": (
+        ["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.n=1000000000"],
+        "discretization.mesh.n",
+    ),
+    "n beyond the DOF limit": (
+        ["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.n=5000"],
+        "50,020,002 DOFs",
+    ),
     "n beyond --max-dofs": (["solve", "SCENE", "-o", "out.nc", "--max-dofs", "100"], "limit of 100 DOFs"),
-    "levels = 60": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.family=hanging",
-                     "--set", "discretization.mesh.levels=60"], "discretization.mesh.levels"),
+    "levels = 60": (
+        [
+            "solve",
+            "SCENE",
+            "-o",
+            "out.nc",
+            "--set",
+            "discretization.mesh.family=hanging",
+            "--set",
+            "discretization.mesh.levels=60",
+        ],
+        "discretization.mesh.levels",
+    ),
     "levels within the schema, beyond the limit": (
-        ["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.family=hanging", "--set",
-         "discretization.mesh.levels=14", "--set", "discretization.mesh.rule=random", "--set",
-         "discretization.mesh.fraction=1"], "DOFs"),
-    "lloyd_iterations = 1e9": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.family=voronoi",
-                                "--set", "discretization.mesh.lloyd_iterations=1000000000"], "lloyd_iterations"),
-    "anisotropy = 1e-300": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.family=voronoi",
-                             "--set", "discretization.mesh.anisotropy=1e-300"], "anisotropy"),
-    "merge_tol = 1": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.family=voronoi",
-                       "--set", "discretization.mesh.merge_tol=1"], "merge_tol"),
+        [
+            "solve",
+            "SCENE",
+            "-o",
+            "out.nc",
+            "--set",
+            "discretization.mesh.family=hanging",
+            "--set",
+            "discretization.mesh.levels=14",
+            "--set",
+            "discretization.mesh.rule=random",
+            "--set",
+            "discretization.mesh.fraction=1",
+        ],
+        "DOFs",
+    ),
+    "lloyd_iterations = 1e9": (
+        [
+            "solve",
+            "SCENE",
+            "-o",
+            "out.nc",
+            "--set",
+            "discretization.mesh.family=voronoi",
+            "--set",
+            "discretization.mesh.lloyd_iterations=1000000000",
+        ],
+        "lloyd_iterations",
+    ),
+    "anisotropy = 1e-300": (
+        [
+            "solve",
+            "SCENE",
+            "-o",
+            "out.nc",
+            "--set",
+            "discretization.mesh.family=voronoi",
+            "--set",
+            "discretization.mesh.anisotropy=1e-300",
+        ],
+        "anisotropy",
+    ),
+    "merge_tol = 1": (
+        [
+            "solve",
+            "SCENE",
+            "-o",
+            "out.nc",
+            "--set",
+            "discretization.mesh.family=voronoi",
+            "--set",
+            "discretization.mesh.merge_tol=1",
+        ],
+        "merge_tol",
+    ),
     "seed on a square mesh": (["solve", "SCENE", "-o", "out.nc", "--set", "discretization.mesh.seed=3"], "seed"),
     "--set without =": (["solve", "SCENE", "-o", "out.nc", "--set", "material.E"], "key.path=value"),
     "--set alias": (["solve", "SCENE", "-o", "out.nc", "--set", "name=*a"], "aliases"),
@@ -88,8 +151,10 @@ MESH_CASES = {
     "anisotropy=1e-300": (["mesh", "voronoi", "4", "-o", "out.nc", "--option", "anisotropy=1e-300"], "anisotropy"),
     "fraction=yes": (["mesh", "hanging", "4", "-o", "out.nc", "--option", "fraction=yes"], "fraction"),
     "levels=60": (["mesh", "hanging", "4", "-o", "out.nc", "--option", "levels=60"], "levels"),
-    "lloyd_iterations=1e9": (["mesh", "voronoi", "4", "-o", "out.nc", "--option", "lloyd_iterations=1000000000"],
-                             "lloyd_iterations"),
+    "lloyd_iterations=1e9": (
+        ["mesh", "voronoi", "4", "-o", "out.nc", "--option", "lloyd_iterations=1000000000"],
+        "lloyd_iterations",
+    ),
     "seed for square": (["mesh", "square", "4", "-o", "out.nc", "--option", "seed=2"], "seed"),
     "kind=structured for square": (["mesh", "square", "4", "-o", "out.nc", "--option", "kind=structured"], "kind"),
     "option without =": (["mesh", "voronoi", "4", "-o", "out.nc", "--option", "seed"], "key=value"),
@@ -105,8 +170,9 @@ MESH_CASES = {
 
 
 def vemkit(*args, cwd, timeout=60):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=timeout
+    )
 
 
 def _workspace(path: Path) -> None:
@@ -117,9 +183,10 @@ def _workspace(path: Path) -> None:
     (path / "adir").mkdir()
     os.mkfifo(path / "fifo")
     (path / "huge.yaml").write_text(PAPER_TEXT + "#" * (1 << 20) + "\n")
-    (path / "laughs.yaml").write_text('a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
-                                      + "".join(f"{c}: &{c} [*{p},*{p},*{p},*{p},*{p},*{p},*{p},*{p},*{p}]\n"
-                                                for p, c in zip("abcdefgh", "bcdefghi")))
+    (path / "laughs.yaml").write_text(
+        'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
+        + "".join(f"{c}: &{c} [*{p},*{p},*{p},*{p},*{p},*{p},*{p},*{p},*{p}]\n" for p, c in zip("abcdefgh", "bcdefghi"))
+    )
     (path / "deep.yaml").write_text(PAPER_TEXT + "extra: " + "[" * 100 + "]" * 100 + "\n")
     (path / "twice.yaml").write_text(PAPER_TEXT + "material: {E: 1.0, nu: 0.3}\n")
     (path / "tagged.yaml").write_text(PAPER_TEXT.replace("name: paper", "name: !!python/object/apply:os.system [ls]"))
@@ -175,8 +242,19 @@ def test_an_unconverged_result_is_a_failure(tmp_path):
     """tol = 1e-2 is allowed, but Uzawa's stop (the paper's rule) at n = 2 leaves an independent
     check of 1.9e-3 > 1e-3: refused, the earlier result kept."""
     (tmp_path / "out.nc").write_bytes(b"an earlier result")
-    run = vemkit("solve", PAPER, "-o", "out.nc", "--set", "solver.method=uzawa", "--set", "solver.tol=1e-2",
-                 "--set", "discretization.mesh.n=2", cwd=tmp_path)
+    run = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        "out.nc",
+        "--set",
+        "solver.method=uzawa",
+        "--set",
+        "solver.tol=1e-2",
+        "--set",
+        "discretization.mesh.n=2",
+        cwd=tmp_path,
+    )
     _one_error_line(run, "independent check")
     assert (tmp_path / "out.nc").read_bytes() == b"an earlier result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.nc"]
@@ -197,16 +275,38 @@ def test_a_bug_is_one_line_exit_70_not_a_traceback(tmp_path):
     run = subprocess.run([sys.executable, "-c", BUG], capture_output=True, text=True, cwd=tmp_path, timeout=60)
     assert run.returncode == 70
     assert run.stderr.splitlines() == [
-        "vemkit: error: internal error (ZeroDivisionError: division by zero); please report"]
+        "vemkit: error: internal error (ZeroDivisionError: division by zero); please report"
+    ]
     assert not list(tmp_path.iterdir())
 
 
 def test_time_budget_and_floating_point_failures_are_one_line(tmp_path):
-    budget = vemkit("solve", PAPER, "-o", "out.nc", "--set", "discretization.mesh.n=4", "--set",
-                    "solver.time_budget=1e-9", cwd=tmp_path)
+    budget = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        "out.nc",
+        "--set",
+        "discretization.mesh.n=4",
+        "--set",
+        "solver.time_budget=1e-9",
+        cwd=tmp_path,
+    )
     _one_error_line(budget, "ran past solver.time_budget = 1e-09 s")
-    overflow = vemkit("solve", PAPER, "-o", "out.nc", "--set", "discretization.mesh.n=4", "--set", "material.E=1e-8",
-                      "--set", "contact.normal.m=10", "--set", "boundary.neumann.left.traction=[0, -1e100]",
-                      cwd=tmp_path)
+    overflow = vemkit(
+        "solve",
+        PAPER,
+        "-o",
+        "out.nc",
+        "--set",
+        "discretization.mesh.n=4",
+        "--set",
+        "material.E=1e-8",
+        "--set",
+        "contact.normal.m=10",
+        "--set",
+        "boundary.neumann.left.traction=[0, -1e100]",
+        cwd=tmp_path,
+    )
     _one_error_line(overflow, "floating-point failure during the solve")
     assert not list(tmp_path.iterdir())

@@ -19,13 +19,20 @@ SOLID = {"material": {"E": 1.0, "nu": 0.3}, "body_force": [0.0, -1.0], "solver":
 
 
 def vemkit(*args, cwd: Path):
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=300
+    )
 
 
 def _scene(folder: Path, name: str, domain: dict, dirichlet, mesh: dict, **extra) -> Path:
-    data = {"name": name, "domain": domain, **SOLID, "boundary": {"dirichlet": dirichlet, "neumann": {}, "contact": []},
-            "discretization": {"mesh": mesh}, **extra}
+    data = {
+        "name": name,
+        "domain": domain,
+        **SOLID,
+        "boundary": {"dirichlet": dirichlet, "neumann": {}, "contact": []},
+        "discretization": {"mesh": mesh},
+        **extra,
+    }
     (folder / f"{name}.yaml").write_text(json.dumps(data))
     return folder / f"{name}.yaml"
 
@@ -33,8 +40,11 @@ def _scene(folder: Path, name: str, domain: dict, dirichlet, mesh: dict, **extra
 def test_solve_refuses_the_mesh_that_mesh_refuses(tmp_path):
     """A square mesh cut around a small hole with a pinched cell (one cell touching itself at a
     vertex): refused by both commands with the same line, nothing written."""
-    domain = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-              "holes": [{"circle": [0.59, 0.2982, 0.01], "side": "hole"}]}
+    domain = {
+        "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+        "sides": ["bottom", "right", "top", "left"],
+        "holes": [{"circle": [0.59, 0.2982, 0.01], "side": "hole"}],
+    }
     _scene(tmp_path, "pinched", domain, ["bottom"], {"family": "square", "h": 0.1})
     meshed = vemkit("mesh", "--scene", "pinched.yaml", "-o", "m.nc", cwd=tmp_path)
     solved = vemkit("solve", "pinched.yaml", "-o", "s.nc", cwd=tmp_path)
@@ -45,17 +55,29 @@ def test_solve_refuses_the_mesh_that_mesh_refuses(tmp_path):
     assert not (tmp_path / "m.nc").exists() and not (tmp_path / "s.nc").exists()
 
 
-HALF_DISK = {"polygon": [[-1, 0], [-0.6, -0.8], [0.6, -0.8], [1, 0]], "sides": ["rim", "rim", "rim", "top"],
-             "arcs": [[0, 0], [0, 0], [0, 0], None]}
+HALF_DISK = {
+    "polygon": [[-1, 0], [-0.6, -0.8], [0.6, -0.8], [1, 0]],
+    "sides": ["rim", "rim", "rim", "top"],
+    "arcs": [[0, 0], [0, 0], [0, 0], None],
+}
 SLOT = [[-0.3, -0.5], [0.3, -0.5], [0.3, -0.3], [-0.3, -0.3]]
 PIECES = {
     # an arc and a polygonal hole named alike: the hole's new vertices stay on its straight edges
-    "arc and slot": ({**HALF_DISK, "holes": [{"polygon": SLOT, "sides": ["rim"] * 4}]}, ["top"],
-                     [("circle", (0.0, 0.0, 1.0)), ("box", (-0.3, -0.5, 0.3, -0.3))]),
+    "arc and slot": (
+        {**HALF_DISK, "holes": [{"polygon": SLOT, "sides": ["rim"] * 4}]},
+        ["top"],
+        [("circle", (0.0, 0.0, 1.0)), ("box", (-0.3, -0.5, 0.3, -0.3))],
+    ),
     # two circular holes named alike: each hole's new vertices on its own circle
-    "two bores": ({"polygon": [[0, 0], [3, 0], [3, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-                   "holes": [{"circle": [0.8, 0.5, 0.25], "side": "bore"}, {"circle": [2.2, 0.5, 0.2], "side": "bore"}]},
-                  ["left"], [("circle", (0.8, 0.5, 0.25)), ("circle", (2.2, 0.5, 0.2))]),
+    "two bores": (
+        {
+            "polygon": [[0, 0], [3, 0], [3, 1], [0, 1]],
+            "sides": ["bottom", "right", "top", "left"],
+            "holes": [{"circle": [0.8, 0.5, 0.25], "side": "bore"}, {"circle": [2.2, 0.5, 0.2], "side": "bore"}],
+        },
+        ["left"],
+        [("circle", (0.8, 0.5, 0.25)), ("circle", (2.2, 0.5, 0.2))],
+    ),
 }
 
 
@@ -67,10 +89,18 @@ def _on_piece(points, kind, shape, exact: bool = False) -> np.ndarray:
         d = np.hypot(points[:, 0] - cx, points[:, 1] - cy) - r
         return (np.abs(d) <= 1e-12) if exact else (d <= 1e-12) & (d >= -r * (1 - np.cos(np.pi / 8)))
     x0, y0, x1, y1 = shape
-    inside = (points[:, 0] >= x0 - 1e-12) & (points[:, 0] <= x1 + 1e-12) & (points[:, 1] >= y0 - 1e-12) \
+    inside = (
+        (points[:, 0] >= x0 - 1e-12)
+        & (points[:, 0] <= x1 + 1e-12)
+        & (points[:, 1] >= y0 - 1e-12)
         & (points[:, 1] <= y1 + 1e-12)
-    edge = np.isclose(points[:, 0], x0) | np.isclose(points[:, 0], x1) | np.isclose(points[:, 1], y0) \
+    )
+    edge = (
+        np.isclose(points[:, 0], x0)
+        | np.isclose(points[:, 0], x1)
+        | np.isclose(points[:, 1], y0)
         | np.isclose(points[:, 1], y1)
+    )
     return inside & edge
 
 
@@ -78,8 +108,14 @@ def _on_piece(points, kind, shape, exact: bool = False) -> np.ndarray:
 def test_refinement_keeps_each_boundary_vertex_on_its_own_piece(tmp_path, case):
     domain, dirichlet, pieces = PIECES[case]
     side = "rim" if case == "arc and slot" else "bore"
-    _scene(tmp_path, "pieces", domain, dirichlet, {"family": "square", "h": 0.2},
-           adaptivity={"marking": {"dorfler": 1.0}, "max_steps": 3, "target": 1e-6})
+    _scene(
+        tmp_path,
+        "pieces",
+        domain,
+        dirichlet,
+        {"family": "square", "h": 0.2},
+        adaptivity={"marking": {"dorfler": 1.0}, "max_steps": 3, "target": 1e-6},
+    )
     run = vemkit("adapt", "pieces.yaml", "-o", "a.nc", "-q", cwd=tmp_path)
     assert run.returncode == 0, run.stderr
     assert vemkit("mesh", "--scene", "pieces.yaml", "-o", "first.nc", "-q", cwd=tmp_path).returncode == 0
@@ -104,8 +140,9 @@ def test_the_hanging_family_follows_curved_sides_as_it_refines(tmp_path):
     contact arc: the arcs are chords of the finest squares (h / 8), not of the coarse ones, and the peak
     pressure is Hertz's p0 = 2 P / (pi a), a = 2 sqrt(R P / (pi E)), to 6 % (it was +45 % on the coarse
     chords; triangles: -1.3 %, squares: +17 % at this h)."""
-    mesh_run = vemkit("mesh", "--scene", HERTZ, "-o", tmp_path / "m.nc", "--set", f"discretization.mesh={HANGING}",
-                      "-q", cwd=tmp_path)
+    mesh_run = vemkit(
+        "mesh", "--scene", HERTZ, "-o", tmp_path / "m.nc", "--set", f"discretization.mesh={HANGING}", "-q", cwd=tmp_path
+    )
     assert mesh_run.returncode == 0, mesh_run.stderr
     mesh = read_ugrid(tmp_path / "m.nc")
     for side in ("contact", "flank"):

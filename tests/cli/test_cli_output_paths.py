@@ -17,8 +17,17 @@ SMALL = ("--set", "discretization.mesh.n=4")
 
 def vemkit(*args, cwd):
     """The real command; arguments may be bytes (file names that are not UTF-8)."""
-    return subprocess.run([os.fsencode(sys.executable), b"-m", b"vemkit.cli", *(os.fsencode(a if isinstance(a, bytes) else str(a)) for a in args)],
-                          cwd=cwd, capture_output=True, timeout=300)
+    return subprocess.run(
+        [
+            os.fsencode(sys.executable),
+            b"-m",
+            b"vemkit.cli",
+            *(os.fsencode(a if isinstance(a, bytes) else str(a)) for a in args),
+        ],
+        cwd=cwd,
+        capture_output=True,
+        timeout=300,
+    )
 
 
 def _parts(folder: Path) -> list:
@@ -79,8 +88,12 @@ def test_a_temporary_file_that_cannot_be_removed_is_named_in_a_true_message(tmp_
     temporary file is left, never only 'nothing was written'."""
     out = tmp_path / "out.nc"
     out.write_bytes(b"earlier")
-    run = subprocess.run([sys.executable, "-c", LEFT_BEHIND, "solve", PAPER, "-o", out, *SMALL],
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-c", LEFT_BEHIND, "solve", PAPER, "-o", out, *SMALL],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     (left,) = _parts(tmp_path)
     assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
     assert "nothing was written" in run.stderr and os.fsdecode(left) in run.stderr

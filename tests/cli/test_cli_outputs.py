@@ -27,8 +27,13 @@ def test_success_replaces_the_file_a_link_points_to(tmp_path):
     real = tmp_path / "real.nc"
     real.write_bytes(EARLIER)
     os.symlink(real, tmp_path / "link.nc")
-    run = subprocess.run(command("mesh", "square", 3, "-o", "link.nc", "--vtu", "m.vtu", "-q"),
-                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        command("mesh", "square", 3, "-o", "link.nc", "--vtu", "m.vtu", "-q"),
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 0 and not run.stderr, run.stderr
     assert (tmp_path / "link.nc").is_symlink()
     with xr.open_dataset(real) as ds:
@@ -59,8 +64,11 @@ def test_a_signal_at_any_moment_leaves_the_earlier_file_and_no_temporary(tmp_pat
     out = tmp_path / "out.nc"
     for delay in (0.3, 1.5, 3.0, 5.0):
         out.write_bytes(EARLIER)
-        process = subprocess.Popen(command("solve", PAPER, "-o", out, "-q", "--set", "discretization.mesh.n=96"),
-                                   stderr=subprocess.PIPE, text=True)
+        process = subprocess.Popen(
+            command("solve", PAPER, "-o", out, "-q", "--set", "discretization.mesh.n=96"),
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         time.sleep(delay)
         process.send_signal(getattr(signal, signame))
         start = time.perf_counter()
@@ -80,7 +88,9 @@ def test_a_signal_at_any_moment_leaves_the_earlier_file_and_no_temporary(tmp_pat
             _assert_earlier_or_complete(out, 97**2, earlier=False)
         else:
             assert process.returncode == status, (delay, process.returncode, stderr)
-            assert out.read_bytes() == EARLIER and stderr.strip() == f"vemkit: interrupted by {signame}; no output written"
+            assert (
+                out.read_bytes() == EARLIER and stderr.strip() == f"vemkit: interrupted by {signame}; no output written"
+            )
 
 
 WRITE_INTERRUPTED = """
@@ -104,9 +114,24 @@ def test_a_signal_inside_the_netcdf_write_is_delivered_after_it(tmp_path, signam
     half-made result is discarded."""
     out, marker = tmp_path / "out.nc", tmp_path / "marker"
     out.write_bytes(EARLIER)
-    run = subprocess.run([sys.executable, "-c", WRITE_INTERRUPTED.format(signame=signame), "solve", PAPER,
-                          "-o", out, "-q", "--set", "discretization.mesh.n=4", marker],
-                         capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            WRITE_INTERRUPTED.format(signame=signame),
+            "solve",
+            PAPER,
+            "-o",
+            out,
+            "-q",
+            "--set",
+            "discretization.mesh.n=4",
+            marker,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert marker.read_text() == "written, then signalled"
     assert run.returncode == status, run.stderr
     assert out.read_bytes() == EARLIER and not _leftovers(tmp_path)
@@ -116,8 +141,14 @@ def test_a_signal_inside_the_netcdf_write_is_delivered_after_it(tmp_path, signam
 def test_two_runs_writing_one_file_leave_one_complete_file(tmp_path):
     out = tmp_path / "out.nc"
     out.write_bytes(EARLIER)
-    runs = [subprocess.Popen(command("solve", PAPER, "-o", out, "-q", "--set", f"discretization.mesh.n={n}"),
-                             stderr=subprocess.PIPE, text=True) for n in (8, 9)]
+    runs = [
+        subprocess.Popen(
+            command("solve", PAPER, "-o", out, "-q", "--set", f"discretization.mesh.n={n}"),
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for n in (8, 9)
+    ]
     for process in runs:
         assert process.wait(timeout=240) == 0, process.stderr.read()
     with xr.open_dataset(out) as ds:

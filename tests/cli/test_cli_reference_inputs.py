@@ -20,8 +20,9 @@ PAPER = ROOT / "config" / "scenes" / "paper.yaml"
 def vemkit(*args, cwd: Path):
     """(exit status, stdout, stderr, peak resident bytes) of one vemkit process (wait4: its own usage)."""
     with open(cwd / "out.txt", "w") as out, open(cwd / "err.txt", "w") as err:
-        process = subprocess.Popen([sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, stdout=out,
-                                   stderr=err)
+        process = subprocess.Popen(
+            [sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, stdout=out, stderr=err
+        )
     _, status, usage = os.wait4(process.pid, 0)
     process.returncode = os.waitstatus_to_exitcode(status)
     return process.returncode, (cwd / "out.txt").read_text(), (cwd / "err.txt").read_text(), usage.ru_maxrss * 1024
@@ -32,17 +33,31 @@ def folder(tmp_path_factory):
     """The paper scene, its k = 1 reference (n = 8) and a k = 2 reference (n = 4)."""
     path = tmp_path_factory.mktemp("reference")
     shutil.copy(PAPER, path / "scene.yaml")
-    for name, extra in (("ref.nc", ["--set", "discretization.mesh.n=8"]),
-                        ("ref2.nc", ["--set", "discretization.mesh.n=4", "--set", "discretization.order=2"])):
+    for name, extra in (
+        ("ref.nc", ["--set", "discretization.mesh.n=8"]),
+        ("ref2.nc", ["--set", "discretization.mesh.n=4", "--set", "discretization.order=2"]),
+    ):
         status, _, err, _ = vemkit("solve", "scene.yaml", "-o", name, *extra, "-q", cwd=path)
         assert status == 0, err
     return path
 
 
 def _adapt(folder: Path, reference: str, *extra):
-    return vemkit("adapt", "scene.yaml", "-o", "adapted.nc", "--set", "discretization.mesh.n=4",
-                  "--set", f"adaptivity.reference={reference}", "--set", "adaptivity.max_steps=1", *extra, "-q",
-                  cwd=folder)
+    return vemkit(
+        "adapt",
+        "scene.yaml",
+        "-o",
+        "adapted.nc",
+        "--set",
+        "discretization.mesh.n=4",
+        "--set",
+        f"adaptivity.reference={reference}",
+        "--set",
+        "adaptivity.max_steps=1",
+        *extra,
+        "-q",
+        cwd=folder,
+    )
 
 
 def _broken(folder: Path, name: str, edit) -> str:
@@ -95,9 +110,11 @@ def test_an_order_2_solution_file_is_refused_as_a_reference(folder):
 def test_only_the_variables_a_reference_needs_are_read(folder):
     """A reference with one extra variable of 1 GiB (never written: the file stays small, reading it
     would allocate it) costs no more memory than the plain reference."""
+
     def huge(nc):
         nc.createDimension("big", 2**27)
         nc.createVariable("extra", "f8", ("big",), fill_value=0.0)
+
     name = _broken(folder, "extra.nc", huge)
     assert (folder / name).stat().st_size < 2**20
     start = time.perf_counter()

@@ -26,23 +26,33 @@ def run_measured(args, cwd: Path, timeout: float = 300.0):
     """(exit status, stderr, seconds, peak resident bytes) of one vemkit process (wait4: its own rusage)."""
     start = time.perf_counter()
     with open(cwd / "stderr.txt", "w") as err:
-        process = subprocess.Popen([sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd,
-                                   stdout=subprocess.DEVNULL, stderr=err)
+        process = subprocess.Popen(
+            [sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, stdout=subprocess.DEVNULL, stderr=err
+        )
     try:
         _, status, usage = os.wait4(process.pid, 0)
     finally:
         process.returncode = 0 if process.poll() is None else process.returncode
-    return (os.waitstatus_to_exitcode(status), (cwd / "stderr.txt").read_text(), time.perf_counter() - start,
-            usage.ru_maxrss * 1024)
+    return (
+        os.waitstatus_to_exitcode(status),
+        (cwd / "stderr.txt").read_text(),
+        time.perf_counter() - start,
+        usage.ru_maxrss * 1024,
+    )
 
 
 def test_a_polygon_of_3000_clamped_corners_is_solved_in_linear_memory(tmp_path):
     t = 2.0 * np.pi * np.arange(3000) / 3000
     corners = [[round(float(np.cos(a)), 6), round(float(np.sin(a)), 6)] for a in t]
-    scene = {"name": "many-corners", "domain": {"polygon": corners, "sides": ["rim"] * len(corners)},
-             "material": {"E": 1.0, "nu": 0.3}, "body_force": [0.0, -1.0],
-             "boundary": {"dirichlet": ["rim"], "neumann": {}, "contact": []},
-             "discretization": {"mesh": {"family": "square", "h": 0.1}}, "solver": {"method": "ssn"}}
+    scene = {
+        "name": "many-corners",
+        "domain": {"polygon": corners, "sides": ["rim"] * len(corners)},
+        "material": {"E": 1.0, "nu": 0.3},
+        "body_force": [0.0, -1.0],
+        "boundary": {"dirichlet": ["rim"], "neumann": {}, "contact": []},
+        "discretization": {"mesh": {"family": "square", "h": 0.1}},
+        "solver": {"method": "ssn"},
+    }
     (tmp_path / "many.yaml").write_text(json.dumps(scene))
     status, stderr, seconds, peak = run_measured(["solve", "many.yaml", "-o", "out.nc", "-q"], tmp_path)
     assert status == 0, stderr
@@ -62,8 +72,21 @@ def test_adapt_stops_before_a_refined_mesh_the_machine_cannot_hold(tmp_path, mon
     room = limits.BASE_BYTES + limits.BYTES_PER_DOF * 700
     monkeypatch.setattr(limits, "available_memory", lambda: int(room / limits.MEMORY_FRACTION))
     out = tmp_path / "a.nc"
-    code = main(["adapt", str(PAPER), "-o", str(out), "--set", "discretization.mesh.n=4",
-                 "--set", "adaptivity.max_steps=30", "--set", "adaptivity.target=1e-6", "-q"])
+    code = main(
+        [
+            "adapt",
+            str(PAPER),
+            "-o",
+            str(out),
+            "--set",
+            "discretization.mesh.n=4",
+            "--set",
+            "adaptivity.max_steps=30",
+            "--set",
+            "adaptivity.target=1e-6",
+            "-q",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 0, err
     assert "not reached" in err and "memory" in err and len(err.splitlines()) == 1, err

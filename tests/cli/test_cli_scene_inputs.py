@@ -28,24 +28,50 @@ def gmsh_text(nodes=NODES) -> str:
     names = [f'1 {tag} "{name}"' for tag, name in enumerate(LINES, start=1)]
     elements = [f"1 2 {tag} {tag} {a} {b}" for tag, lines in enumerate(LINES.values(), start=1) for a, b in lines]
     elements += ["3 2 9 9 1 2 5 6", "3 2 9 9 2 3 4 5"]
-    return "\n".join(["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names)), *names,
-                      "$EndPhysicalNames", "$Nodes", str(len(nodes)), *(f"{t} {x} {y} 0" for t, (x, y) in nodes.items()),
-                      "$EndNodes", "$Elements", str(len(elements)),
-                      *(f"{k} {text}" for k, text in enumerate(elements, start=1)), "$EndElements", ""])
+    return "\n".join(
+        [
+            "$MeshFormat",
+            "2.2 0 8",
+            "$EndMeshFormat",
+            "$PhysicalNames",
+            str(len(names)),
+            *names,
+            "$EndPhysicalNames",
+            "$Nodes",
+            str(len(nodes)),
+            *(f"{t} {x} {y} 0" for t, (x, y) in nodes.items()),
+            "$EndNodes",
+            "$Elements",
+            str(len(elements)),
+            *(f"{k} {text}" for k, text in enumerate(elements, start=1)),
+            "$EndElements",
+            "",
+        ]
+    )
 
 
 PLATE = {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
-BASE = {"name": "plate", "domain": PLATE, "material": {"E": 100.0, "nu": 0.3}, "body_force": [0.0, 0.0],
-        "boundary": {"dirichlet": {"left": [0.0, 0.0]}, "neumann": {"right": {"traction": [1.0, 0.0]}}},
-        "discretization": {"mesh": {"family": "square", "n": 4}}, "solver": {"method": "ssn", "tol": 1e-10}}
+BASE = {
+    "name": "plate",
+    "domain": PLATE,
+    "material": {"E": 100.0, "nu": 0.3},
+    "body_force": [0.0, 0.0],
+    "boundary": {"dirichlet": {"left": [0.0, 0.0]}, "neumann": {"right": {"traction": [1.0, 0.0]}}},
+    "discretization": {"mesh": {"family": "square", "n": 4}},
+    "solver": {"method": "ssn", "tol": 1e-10},
+}
 CONTACT = {"normal": {"k": 10.0, "m": 1.0}, "friction": {"k": 1.0, "m": 0.0}}
 FILE_BOUNDARY = {"dirichlet": {"clamped": [0.0, 0.0]}, "neumann": {"load": {"traction": [0.0, 1.0]}}}
 FOUNDATION = {"foundation": {"point": [0.0, -0.01], "normal": [0.0, 1.0]}, **CONTACT}
 MAX_PEAK_BYTES = 400 << 20  # a refusal never needs more than the imports and a small mesh (250 MiB) ...
 BEFORE_MESH_PEAK_BYTES = 120 << 20  # ... and one made before any mesh exists not even the mesh stack (45 MiB)
 # refused once the mesh is read or built (a pole at a vertex, a node number in the file's body)
-AFTER_MESH = {"pressure with a pole at a vertex", "gmsh node number 2e9", "gmsh plate at x = 1e9",
-              "foundation behind a mesh file's body"}
+AFTER_MESH = {
+    "pressure with a pole at a vertex",
+    "gmsh node number 2e9",
+    "gmsh plate at x = 1e9",
+    "foundation behind a mesh file's body",
+}
 
 
 def scene(*changes, **top):
@@ -78,54 +104,116 @@ CASES = {
     "h = 1e-300": (scene(mesh("square", h=1e-300)), [], "cells of size 1e-300 across"),
     "h = 1e12 on a 2 x 1 plate": (scene(mesh("voronoi", h=1e12)), [], "cells of size 1e+12 on a body of 2 x 1"),
     "cells = 1e10": (scene(mesh("square", cells=1e10)), [], "DOFs"),
-    "n = 4 on a body of 1e-12": (scene(domain={**PLATE, "polygon": [[0, 0], [2e-12, 0], [2e-12, 1e-12], [0, 1e-12]]}),
-                                 [], "on a body of 2e-12 x 1e-12"),
+    "n = 4 on a body of 1e-12": (
+        scene(domain={**PLATE, "polygon": [[0, 0], [2e-12, 0], [2e-12, 1e-12], [0, 1e-12]]}),
+        [],
+        "on a body of 2e-12 x 1e-12",
+    ),
     "body at 1e11 with cells of 0.25": (
-        scene(domain={**PLATE, "polygon": [[1e11, 0], [1e11 + 2, 0], [1e11 + 2, 1], [1e11, 1]]}), [],
-        "too fine for double precision"),
-    "coordinate beyond 1e12": (scene(domain={**PLATE, "polygon": [[0, 0], [2e12, 0], [2e12, 1], [0, 1]]}), [],
-                               "[0] = 2000000000000.0: must be <= 1000000000000.0"),
+        scene(domain={**PLATE, "polygon": [[1e11, 0], [1e11 + 2, 0], [1e11 + 2, 1], [1e11, 1]]}),
+        [],
+        "too fine for double precision",
+    ),
+    "coordinate beyond 1e12": (
+        scene(domain={**PLATE, "polygon": [[0, 0], [2e12, 0], [2e12, 1], [0, 1]]}),
+        [],
+        "[0] = 2000000000000.0: must be <= 1000000000000.0",
+    ),
     "--set h replaces n": (scene(), ["--set", "discretization.mesh.h=1e-300"], "(h = 1e-300)"),
     "--set reaches into domain": (scene(), ["--set", "domain.polygon[1][0]=1e300"], "domain.polygon[1][0] = 1e+300"),
-    "a strip 1e-9 thin": (scene(domain={**STRIP, "polygon": [[0, 0], [1, 0], [1, 1e-9], [0, 1e-9]]}), [],
-                          "feature of 1e-09"),
-    "triangles fill a thin strip": (scene(mesh("triangle", h=0.25), domain=STRIP), ["--max-dofs", "100000"],
-                                    "more than the limit of 100,000 DOFs"),
+    "a strip 1e-9 thin": (
+        scene(domain={**STRIP, "polygon": [[0, 0], [1, 0], [1, 1e-9], [0, 1e-9]]}),
+        [],
+        "feature of 1e-09",
+    ),
+    "triangles fill a thin strip": (
+        scene(mesh("triangle", h=0.25), domain=STRIP),
+        ["--max-dofs", "100000"],
+        "more than the limit of 100,000 DOFs",
+    ),
     "a hole 1e-12 from the boundary": (scene(domain=CIRCLE_HOLE), [], "feature of 1e-12"),
     "voronoi cells larger than a hole": (
-        scene(mesh("voronoi", n=10), domain={**PLATE, "holes": [{"circle": [1, 0.5, 0.01], "side": "bore"}]}), [],
-        "too small for voronoi cells"),
-    "hanging towards a missing side": (scene(mesh("hanging", n=4), domain={**PLATE, "sides": ["b", "right", "top", "left"]}),
-                                       [], "contact_side = 'bottom'"),
+        scene(mesh("voronoi", n=10), domain={**PLATE, "holes": [{"circle": [1, 0.5, 0.01], "side": "bore"}]}),
+        [],
+        "too small for voronoi cells",
+    ),
+    "hanging towards a missing side": (
+        scene(mesh("hanging", n=4), domain={**PLATE, "sides": ["b", "right", "top", "left"]}),
+        [],
+        "contact_side = 'bottom'",
+    ),
     # boundary conditions
     "dirichlet null, null": (scene(("boundary.dirichlet", {"left": [None, None]})), [], "prescribes nothing"),
     "only a roller": (scene(("boundary.dirichlet", {"left": [0.0, None]})), [], "leaves a translation in y"),
-    "no dirichlet, only contact": (scene(("boundary.dirichlet", {}), ("boundary.contact", ["bottom"]), contact=FOUNDATION),
-                                   [], "no Dirichlet part"),
-    "pressure on a contact side": (scene(("boundary.neumann", {"bottom": {"pressure": 1.0}}), ("boundary.contact", ["bottom"]),
-                                         contact=FOUNDATION), [], "listed in both neumann and contact"),
-    "pressure with a pole at a vertex": (scene(("boundary.neumann", {"right": {"pressure": "1/(y-0.5)"}})), [],
-                                         "evaluates to inf at x=2, y=0.5"),
-    "foundation normal [0, 0]": (scene(("boundary.contact", ["bottom"]), contact={**FOUNDATION, "foundation": {
-        "point": [0, -0.01], "normal": [0, 0]}}), [], "contact.foundation.normal = [0, 0]"),
-    "foundation behind the body": (scene(("boundary.contact", ["bottom"]), contact={**FOUNDATION, "foundation": {
-        "point": [0, 0.5], "normal": [0, 1]}}), [], "beyond the foundation line"),
-    "foundation point at 1e300": (scene(("boundary.contact", ["bottom"]), contact={**FOUNDATION, "foundation": {
-        "point": [0, -1e300], "normal": [0, 1]}}), [], "contact.foundation.point[1]"),
+    "no dirichlet, only contact": (
+        scene(("boundary.dirichlet", {}), ("boundary.contact", ["bottom"]), contact=FOUNDATION),
+        [],
+        "no Dirichlet part",
+    ),
+    "pressure on a contact side": (
+        scene(
+            ("boundary.neumann", {"bottom": {"pressure": 1.0}}), ("boundary.contact", ["bottom"]), contact=FOUNDATION
+        ),
+        [],
+        "listed in both neumann and contact",
+    ),
+    "pressure with a pole at a vertex": (
+        scene(("boundary.neumann", {"right": {"pressure": "1/(y-0.5)"}})),
+        [],
+        "evaluates to inf at x=2, y=0.5",
+    ),
+    "foundation normal [0, 0]": (
+        scene(
+            ("boundary.contact", ["bottom"]),
+            contact={**FOUNDATION, "foundation": {"point": [0, -0.01], "normal": [0, 0]}},
+        ),
+        [],
+        "contact.foundation.normal = [0, 0]",
+    ),
+    "foundation behind the body": (
+        scene(
+            ("boundary.contact", ["bottom"]),
+            contact={**FOUNDATION, "foundation": {"point": [0, 0.5], "normal": [0, 1]}},
+        ),
+        [],
+        "beyond the foundation line",
+    ),
+    "foundation point at 1e300": (
+        scene(
+            ("boundary.contact", ["bottom"]),
+            contact={**FOUNDATION, "foundation": {"point": [0, -1e300], "normal": [0, 1]}},
+        ),
+        [],
+        "contact.foundation.point[1]",
+    ),
     "exact field overflows": (scene(exact={"displacement": ["exp(1000*x)", 0]}), [], "evaluates to inf"),
     "expression of 2001 characters": (scene(exact={"displacement": ["x" + "+x" * 1000, 0]}), [], "2000"),
-    "expression nested 150 deep": (scene(exact={"displacement": ["sin(" * 150 + "x" + ")" * 150, 0]}), [],
-                                   "nested more than"),
+    "expression nested 150 deep": (
+        scene(exact={"displacement": ["sin(" * 150 + "x" + ")" * 150, 0]}),
+        [],
+        "nested more than",
+    ),
     # the body
-    "holes touching": (scene(domain={**PLATE, "holes": [{"circle": [0.5, 0.5, 0.25], "side": "a"},
-                                                        {"circle": [1.0, 0.5, 0.25], "side": "b"}]}), [],
-                       "domain.holes[1] overlaps domain.holes[0]"),
+    "holes touching": (
+        scene(
+            domain={
+                **PLATE,
+                "holes": [{"circle": [0.5, 0.5, 0.25], "side": "a"}, {"circle": [1.0, 0.5, 0.25], "side": "b"}],
+            }
+        ),
+        [],
+        "domain.holes[1] overlaps domain.holes[0]",
+    ),
     "arc of zero radius": (scene(domain={**PLATE, "arcs": [[0, 0], None, None, None]}), [], "domain.arcs[0]"),
     "arc of half a circle": (scene(domain={**PLATE, "arcs": [[1, 0], None, None, None]}), [], "half circle"),
     # YAML in the new keys
-    "a number as a side name": ("name: plate\ndomain: {polygon: [[0, 0], [2, 0], [2, 1], [0, 1]], sides: [bottom, right, "
-                                "top, left]}\nmaterial: {E: 100.0, nu: 0.3}\nboundary:\n  dirichlet: {1: [0, 0]}\n"
-                                "discretization: {mesh: {family: square, n: 4}}\n", [], "1 is not a side name"),
+    "a number as a side name": (
+        "name: plate\ndomain: {polygon: [[0, 0], [2, 0], [2, 1], [0, 1]], sides: [bottom, right, "
+        "top, left]}\nmaterial: {E: 100.0, nu: 0.3}\nboundary:\n  dirichlet: {1: [0, 0]}\n"
+        "discretization: {mesh: {family: square, n: 4}}\n",
+        [],
+        "1 is not a side name",
+    ),
     "domain: unit_circle": (scene(domain="unit_circle"), [], "must be unit_square or a mapping"),
     "mesh file as a list": (scene(("discretization.mesh", {"file": ["m.msh"]})), [], "must be a string"),
     # mesh files (SPEC §8)
@@ -143,11 +231,20 @@ CASES = {
     "netCDF of random bytes": (on_file("random.nc"), [], "not a netCDF file"),
     "netCDF that inflates": (on_file("bomb.nc"), [], "face table of 3,000,000 x 4"),
     "UGRID side list not JSON": (on_file("sides.nc"), [], "vemkit_boundary_parts"),
-    "side not in the mesh file": (on_file("good.msh", boundary={"dirichlet": {"left": [0, 0]}}), [],
-                                  "side 'left' is not in the mesh file good.msh"),
+    "side not in the mesh file": (
+        on_file("good.msh", boundary={"dirichlet": {"left": [0, 0]}}),
+        [],
+        "side 'left' is not in the mesh file good.msh",
+    ),
     "foundation behind a mesh file's body": (
-        on_file("good.msh", boundary={**FILE_BOUNDARY, "contact": ["bottom"]},
-                contact={**FOUNDATION, "foundation": {"point": [0, 1], "normal": [0, 1]}}), [], "contact.foundation"),
+        on_file(
+            "good.msh",
+            boundary={**FILE_BOUNDARY, "contact": ["bottom"]},
+            contact={**FOUNDATION, "foundation": {"point": [0, 1], "normal": [0, 1]}},
+        ),
+        [],
+        "contact.foundation",
+    ),
     "-o is the mesh file": (on_file("good.msh"), ["-o", "good.msh"], "input file"),
     "mesh --scene -o is the mesh file": (on_file("good.msh"), ["mesh", "-o", "good.msh"], "input file"),
 }
@@ -202,8 +299,12 @@ def _snapshot(path: Path) -> dict:
     for item in path.iterdir():
         info = item.lstat()
         small = stat.S_ISREG(info.st_mode) and info.st_size < (1 << 20)
-        state[item.name] = (stat.S_IFMT(info.st_mode), info.st_mtime_ns, info.st_size,
-                            item.read_bytes() if small else None)
+        state[item.name] = (
+            stat.S_IFMT(info.st_mode),
+            info.st_mtime_ns,
+            info.st_size,
+            item.read_bytes() if small else None,
+        )
     return state
 
 
@@ -223,8 +324,9 @@ def _run(args, cwd: Path, timeout: float = 120.0):
     out, err = cwd / f".out.{os.getpid()}.{id(args)}", cwd / f".err.{os.getpid()}.{id(args)}"
     start, peak = time.perf_counter(), 0
     with open(out, "w") as stdout, open(err, "w") as stderr:
-        process = subprocess.Popen([sys.executable, "-m", "vemkit.cli", *args], cwd=cwd, stdout=stdout,
-                                   stderr=stderr, text=True)
+        process = subprocess.Popen(
+            [sys.executable, "-m", "vemkit.cli", *args], cwd=cwd, stdout=stdout, stderr=stderr, text=True
+        )
     while process.poll() is None:
         if time.perf_counter() - start > timeout:
             process.kill()

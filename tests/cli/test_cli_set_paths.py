@@ -16,8 +16,12 @@ PAPER = ROOT / "config" / "scenes" / "paper.yaml"
 
 def solve(tmp_path, *sets):
     args = [a for s in (*sets, "discretization.mesh.n=4") for a in ("--set", s)]
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", "solve", PAPER, "-o", tmp_path / "out.nc", "-q",
-                           *args], capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", "solve", PAPER, "-o", tmp_path / "out.nc", "-q", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_a_list_entry_is_set_by_its_index(tmp_path):
@@ -32,21 +36,30 @@ SUM = "+".join(["x"] * 300)  # a flat chain: 299 BinOps deep, nesting 1
 GROUPED = "+".join(["(" + "+".join(["x"] * 30) + ")"] * 10)
 
 
-@pytest.mark.parametrize("override, says", [
-    ("boundary.dirichlet[1]=left", "boundary.dirichlet = [\"right\"] has 1 entry: give the index 0, or set the "
-                                   "whole list, e.g. --set 'boundary.dirichlet=[...]'"),
-    ("body_force[2]=1", "body_force = [0.0, 0.0] has 2 entries: give an index 0 ... 1"),
-    ("boundary.dirichlet[0]=3", "boundary.dirichlet[0] = 3: must be a string"),
-    ("boundary.dirichlet[0][1]=x", "boundary.dirichlet[0] = 'right' is not a list; drop [1]"),
-    ("material[0]=1", "material = {\"E\": 2000.0, \"nu\": 0.4} is not a list; drop [0]"),
-    ("boundary.dirichlet.left=[0,0]", "boundary.dirichlet = [\"right\"] is a list: index it (boundary.dirichlet[0])"),
-    ("boundary.dirichlet[-1]=left", "a list index is a whole number from 0 in brackets"),
-    ("material..E=3", "a key component is empty"),
-    ("material.E.=3", "a key component is empty"),
-    (".material.E=3", "a key component is empty"),
-    (f"body_force[0]={SUM}", "more than 100 operations in one chain (a sum or product of that many terms); "
-                             "group the terms in parentheses"),
-])
+@pytest.mark.parametrize(
+    "override, says",
+    [
+        (
+            "boundary.dirichlet[1]=left",
+            'boundary.dirichlet = ["right"] has 1 entry: give the index 0, or set the '
+            "whole list, e.g. --set 'boundary.dirichlet=[...]'",
+        ),
+        ("body_force[2]=1", "body_force = [0.0, 0.0] has 2 entries: give an index 0 ... 1"),
+        ("boundary.dirichlet[0]=3", "boundary.dirichlet[0] = 3: must be a string"),
+        ("boundary.dirichlet[0][1]=x", "boundary.dirichlet[0] = 'right' is not a list; drop [1]"),
+        ("material[0]=1", 'material = {"E": 2000.0, "nu": 0.4} is not a list; drop [0]'),
+        ("boundary.dirichlet.left=[0,0]", 'boundary.dirichlet = ["right"] is a list: index it (boundary.dirichlet[0])'),
+        ("boundary.dirichlet[-1]=left", "a list index is a whole number from 0 in brackets"),
+        ("material..E=3", "a key component is empty"),
+        ("material.E.=3", "a key component is empty"),
+        (".material.E=3", "a key component is empty"),
+        (
+            f"body_force[0]={SUM}",
+            "more than 100 operations in one chain (a sum or product of that many terms); "
+            "group the terms in parentheses",
+        ),
+    ],
+)
 def test_bad_key_paths_and_long_sums_are_one_true_line(tmp_path, override, says):
     run = solve(tmp_path, override)
     assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr

@@ -69,8 +69,12 @@ def _signalled(tmp_path, patch, args, signame, wait_for_mark=True, delay=0.0):
     mark, out = tmp_path / "mark", tmp_path / "out.nc"
     mark.unlink(missing_ok=True)
     out.write_bytes(EARLIER)
-    process = subprocess.Popen([sys.executable, "-c", HARNESS.format(patch=patch), mark, *args, "-o", out],
-                               stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    process = subprocess.Popen(
+        [sys.executable, "-c", HARNESS.format(patch=patch), mark, *args, "-o", out],
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
     deadline = time.monotonic() + 120
     while wait_for_mark and not mark.exists() and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
@@ -157,9 +161,16 @@ def test_a_signal_during_the_final_write_waits_for_the_writer_then_discards_it(t
 def test_the_supervised_command_keeps_every_exit_status_and_stream(tmp_path):
     """The parent exits with the worker's status: --version / --help (argparse's own exits) 0, a
     usage error 2 in one line, a solve 0 with its summary on stdout."""
+
     def run(*args):
-        return subprocess.run([sys.executable, "-m", "vemkit.cli", *map(str, args)], capture_output=True,
-                              text=True, timeout=300, cwd=tmp_path)
+        return subprocess.run(
+            [sys.executable, "-m", "vemkit.cli", *map(str, args)],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
+        )
+
     version = run("--version")
     assert version.returncode == 0 and version.stdout.startswith("vemkit ") and not version.stderr
     assert run("--help").returncode == 0

@@ -17,8 +17,11 @@ from vemkit.exceptions import InputError, SceneError
 R = 2.0
 HALF_DISK = {"polygon": [[-R, 0], [0, -R], [R, 0]], "sides": ["rim", "rim", "top"], "arcs": [[0, 0], [0, 0], None]}
 # the quarter of a plate with a hole: the arc of radius 1 bulges into the body (centre outside)
-QUARTER_PLATE = {"polygon": [[1, 0], [4, 0], [4, 4], [0, 4], [0, 1]], "sides": ["sym_x", "right", "top", "sym_y", "hole"],
-                 "arcs": [None, None, None, None, [0, 0]]}
+QUARTER_PLATE = {
+    "polygon": [[1, 0], [4, 0], [4, 4], [0, 4], [0, 1]],
+    "sides": ["sym_x", "right", "top", "sym_y", "hole"],
+    "arcs": [None, None, None, None, [0, 0]],
+}
 
 
 def test_exact_area_and_bounds_account_for_arcs():
@@ -65,19 +68,23 @@ def test_to_spec_round_trips_and_all_null_arcs_are_a_polygon():
     half = domain_from_spec(HALF_DISK)
     assert domain_from_spec(half.to_spec()) == half
     straight = domain_from_spec({**HALF_DISK, "arcs": [None, None, None]})
-    assert straight == Domain(tuple(map(tuple, map(lambda p: map(float, p), HALF_DISK["polygon"]))),
-                              ("rim", "rim", "top"))
+    assert straight == Domain(
+        tuple(map(tuple, map(lambda p: map(float, p), HALF_DISK["polygon"]))), ("rim", "rim", "top")
+    )
     assert "arcs" not in straight.to_spec()
 
 
-@pytest.mark.parametrize("arcs, key, words", [
-    ([[0, 0], [0, 0]], "domain.arcs", "has 2 entries but the polygon has 3 edges"),
-    ("curved", "domain.arcs", "no list of entries"),
-    ([[0, 0], [0.1, 0], None], "domain.arcs[1]", "give a centre equally far from both"),
-    ([[0, 0], [0, "a"], None], "domain.arcs[1]", "two finite numbers"),
-    ([[0, 0], [0, 0], [0, 0]], "domain.arcs[2]", "half circle"),
-    ([[0, 0], [1.01, -1.01], None], "domain.arcs", "crosses itself"),
-])
+@pytest.mark.parametrize(
+    "arcs, key, words",
+    [
+        ([[0, 0], [0, 0]], "domain.arcs", "has 2 entries but the polygon has 3 edges"),
+        ("curved", "domain.arcs", "no list of entries"),
+        ([[0, 0], [0.1, 0], None], "domain.arcs[1]", "give a centre equally far from both"),
+        ([[0, 0], [0, "a"], None], "domain.arcs[1]", "two finite numbers"),
+        ([[0, 0], [0, 0], [0, 0]], "domain.arcs[2]", "half circle"),
+        ([[0, 0], [1.01, -1.01], None], "domain.arcs", "crosses itself"),
+    ],
+)
 def test_bad_arcs_are_refused_with_one_line_naming_the_entry(arcs, key, words):
     with pytest.raises(InputError) as info:
         domain_from_spec({**HALF_DISK, "arcs": arcs})
@@ -92,8 +99,13 @@ def test_a_hole_must_clear_the_curved_side_not_just_the_corners():
         domain_from_spec({**HALF_DISK, "holes": [{"circle": [0.0, -1.9, 0.15], "side": "bore"}]})
 
 
-SCENE = {"name": "half-disk", "domain": HALF_DISK, "material": {"E": 1.0, "nu": 0.3},
-         "boundary": {"dirichlet": ["top"]}, "discretization": {"mesh": {"family": "triangle", "n": 4}}}
+SCENE = {
+    "name": "half-disk",
+    "domain": HALF_DISK,
+    "material": {"E": 1.0, "nu": 0.3},
+    "boundary": {"dirichlet": ["top"]},
+    "discretization": {"mesh": {"family": "triangle", "n": 4}},
+}
 
 
 def test_the_scene_loader_takes_arcs_and_names_a_bad_one():
@@ -110,7 +122,11 @@ def test_vemkit_mesh_refuses_a_bad_arc_in_one_line(tmp_path):
     bad = {**SCENE, "domain": {**HALF_DISK, "arcs": [[0, 0], [0, 0.5], None]}}
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(bad))
-    run = subprocess.run([sys.executable, "-m", "vemkit.cli", "mesh", "--scene", str(path), "-o", "m.nc", "-q"],
-                         capture_output=True, text=True, cwd=tmp_path)
+    run = subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", "mesh", "--scene", str(path), "-o", "m.nc", "-q"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert run.returncode != 0 and not (tmp_path / "m.nc").exists()
     assert len(run.stderr.strip().splitlines()) == 1 and "domain.arcs[1]" in run.stderr

@@ -16,26 +16,71 @@ from vemkit.exceptions import ExpressionError
 
 x, y, z = sympy.symbols("x y z", real=True)
 SYMPY_NAMES = {
-    "x": x, "y": y, "z": z, "pi": sympy.pi, "sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan,
-    "asin": sympy.asin, "acos": sympy.acos, "atan": sympy.atan, "atan2": sympy.atan2, "sinh": sympy.sinh,
-    "cosh": sympy.cosh, "tanh": sympy.tanh, "exp": sympy.exp, "log": sympy.log, "sqrt": sympy.sqrt,
-    "abs": sympy.Abs, "sign": sympy.sign, "min": sympy.Min, "max": sympy.Max,
+    "x": x,
+    "y": y,
+    "z": z,
+    "pi": sympy.pi,
+    "sin": sympy.sin,
+    "cos": sympy.cos,
+    "tan": sympy.tan,
+    "asin": sympy.asin,
+    "acos": sympy.acos,
+    "atan": sympy.atan,
+    "atan2": sympy.atan2,
+    "sinh": sympy.sinh,
+    "cosh": sympy.cosh,
+    "tanh": sympy.tanh,
+    "exp": sympy.exp,
+    "log": sympy.log,
+    "sqrt": sympy.sqrt,
+    "abs": sympy.Abs,
+    "sign": sympy.sign,
+    "min": sympy.Min,
+    "max": sympy.Max,
     "where": lambda c, a, b: sympy.Piecewise((a, c), (b, True)),
 }
 RNG = np.random.default_rng(6)
 POINTS = [RNG.uniform(0.05, 0.95, 400) for _ in range(3)]  # inside (0, 1)^3: log, sqrt, asin defined
 
 EXPRESSIONS = [
-    "3*x**2*y - y**3 + 7", "x*y*z + z**2", "(x - y)/(x + y)", "1/(x + 2*y)**3", "-x/y", "x**-0.5", "+x*(-y)",
-    "x**y", "2**(x*y)", "(1 + x)**(y + 1)", "pi*x**pi",
-    "sin(x)*cos(y)", "tan(x*y)", "asin(x*y)", "acos(x - y)", "atan(y/x)", "atan2(y, x)",
-    "atan2(y - 0.5, x - 0.5)", "sinh(x) + cosh(y)*tanh(x*y)", "exp(-x*y)", "log(x + y)", "sqrt(x**2 + y**2)",
-    "exp(sin(x))*log(1 + y**2)", "cos(2*pi*x)*sin(pi*y)",
-    "sqrt(x**2+y**2)**(2/3)*cos(2*atan2(y,x)/3)", "5/3*sqrt(x**2+y**2)**(2/3)*sin(2*atan2(y - 0.5, x - 0.5)/3)",
-    "abs(x - 0.5)*y", "abs(sin(3*x) - y)", "sign(y - 0.4)*x**2", "min(x, y)", "max(x, y, 0.5)",
-    "min(x**2, y, x*y)", "max(x - y, y**2)*min(x, 1 - y)",
-    "where(x < y, x*y, x + y)", "where((x > 0.3) & (y < 0.6), sin(x), cos(y))", "where(x >= 0.5, x**2, 0.25)",
-    "where(x > y, 2, 3)*x", "where(x <= 0.5, where(y > 0.5, x*y, y), exp(x))",
+    "3*x**2*y - y**3 + 7",
+    "x*y*z + z**2",
+    "(x - y)/(x + y)",
+    "1/(x + 2*y)**3",
+    "-x/y",
+    "x**-0.5",
+    "+x*(-y)",
+    "x**y",
+    "2**(x*y)",
+    "(1 + x)**(y + 1)",
+    "pi*x**pi",
+    "sin(x)*cos(y)",
+    "tan(x*y)",
+    "asin(x*y)",
+    "acos(x - y)",
+    "atan(y/x)",
+    "atan2(y, x)",
+    "atan2(y - 0.5, x - 0.5)",
+    "sinh(x) + cosh(y)*tanh(x*y)",
+    "exp(-x*y)",
+    "log(x + y)",
+    "sqrt(x**2 + y**2)",
+    "exp(sin(x))*log(1 + y**2)",
+    "cos(2*pi*x)*sin(pi*y)",
+    "sqrt(x**2+y**2)**(2/3)*cos(2*atan2(y,x)/3)",
+    "5/3*sqrt(x**2+y**2)**(2/3)*sin(2*atan2(y - 0.5, x - 0.5)/3)",
+    "abs(x - 0.5)*y",
+    "abs(sin(3*x) - y)",
+    "sign(y - 0.4)*x**2",
+    "min(x, y)",
+    "max(x, y, 0.5)",
+    "min(x**2, y, x*y)",
+    "max(x - y, y**2)*min(x, 1 - y)",
+    "where(x < y, x*y, x + y)",
+    "where((x > 0.3) & (y < 0.6), sin(x), cos(y))",
+    "where(x >= 0.5, x**2, 0.25)",
+    "where(x > y, 2, 3)*x",
+    "where(x <= 0.5, where(y > 0.5, x*y, y), exp(x))",
 ]
 
 
@@ -56,8 +101,9 @@ def test_derivatives_equal_sympy_diff(text):
 
 
 def test_a_polynomial_field_has_its_polynomial_gradient_to_rounding():
-    field = vector_field([compile_expression("1e-3*(2*x - 3*y + 1)", name="u1"),
-                          compile_expression("x**2*y", name="u2")])
+    field = vector_field(
+        [compile_expression("1e-3*(2*x - 3*y + 1)", name="u1"), compile_expression("x**2*y", name="u2")]
+    )
     px, py = POINTS[0], POINTS[1]
     gradient = field.gradient(px, py)
     assert gradient.shape == (2, 2, px.size)

@@ -37,8 +37,9 @@ FUNCTIONS = {
     "where((x > 0) & (y < 0) | (x < -0.5), 1, 0)": lambda x, y: (((x > 0) & (y < 0)) | (x < -0.5)).astype(float),
     "where(-0.5 < x < 0.5, x, 0)": lambda x, y: np.where((-0.5 < x) & (x < 0.5), x, 0.0),
     # a singular corner solution r^(2/3) cos(2 theta / 3) and a load in polar coordinates
-    "sqrt(x**2+y**2)**(2/3)*cos(2*atan2(y,x)/3)":
-        lambda x, y: np.hypot(x, y) ** (2 / 3) * np.cos(2 * np.arctan2(y, x) / 3),
+    "sqrt(x**2+y**2)**(2/3)*cos(2*atan2(y,x)/3)": lambda x, y: (
+        np.hypot(x, y) ** (2 / 3) * np.cos(2 * np.arctan2(y, x) / 3)
+    ),
     "100*cos(atan2(y, x))*exp(-sqrt(x**2+y**2))": lambda x, y: 100 * np.cos(np.arctan2(y, x)) * np.exp(-np.hypot(x, y)),
     "where(x > 0, sqrt(x), 0)": lambda x, y: np.sqrt(np.maximum(x, 0.0)),  # the unused branch may be NaN
 }
@@ -64,14 +65,17 @@ def test_z_is_a_variable_of_the_language_evaluated_with_three_coordinates():
     assert compile_expression("x + y")(1.0, 2.0, 5.0) == 3.0  # z given, not used
 
 
-@pytest.mark.parametrize("text, x, y, shown", [
-    ("log(x)", [0.5, -0.25], 0.0, "nan"),
-    ("log(x)", [0.5, 0.0], 0.0, "-inf"),
-    ("1/(x - y)", [0.5, 0.25], [0.0, 0.25], "inf"),
-    ("asin(2*x)", [0.1, 0.75], 0.0, "nan"),
-    ("tan(x)**1000", [0.1, 1.5], 0.0, "inf"),
-    ("where(x > 0, 1/y, 0)", [1.0], [0.0], "inf"),
-])
+@pytest.mark.parametrize(
+    "text, x, y, shown",
+    [
+        ("log(x)", [0.5, -0.25], 0.0, "nan"),
+        ("log(x)", [0.5, 0.0], 0.0, "-inf"),
+        ("1/(x - y)", [0.5, 0.25], [0.0, 0.25], "inf"),
+        ("asin(2*x)", [0.1, 0.75], 0.0, "nan"),
+        ("tan(x)**1000", [0.1, 1.5], 0.0, "inf"),
+        ("where(x > 0, 1/y, 0)", [1.0], [0.0], "inf"),
+    ],
+)
 def test_domain_errors_raise_at_the_point_like_sqrt_does(text, x, y, shown):
     expression = compile_expression(text, name="boundary.neumann.left.traction[0]")
     with pytest.raises(ExpressionError) as caught:
@@ -113,13 +117,16 @@ def test_bad_text_is_refused_naming_the_key_and_the_fix(text):
     assert "where(condition, a, b)" in ALLOWED and "atan2" in ALLOWED
 
 
-@pytest.mark.parametrize("override, key", [
-    ("body_force=[0, 'z']", "body_force[1]"),
-    ("contact.gap=0.1+z", "contact.gap"),
-    ("boundary.neumann.top.traction=['sin(z)', 0]", "boundary.neumann.top.traction[0]"),
-    ("boundary.dirichlet={right: [0, 'z*y']}", "boundary.dirichlet.right[1]"),
-    ("exact={displacement: [x, 'x*z']}", "exact.displacement[1]"),
-])
+@pytest.mark.parametrize(
+    "override, key",
+    [
+        ("body_force=[0, 'z']", "body_force[1]"),
+        ("contact.gap=0.1+z", "contact.gap"),
+        ("boundary.neumann.top.traction=['sin(z)', 0]", "boundary.neumann.top.traction[0]"),
+        ("boundary.dirichlet={right: [0, 'z*y']}", "boundary.dirichlet.right[1]"),
+        ("exact={displacement: [x, 'x*z']}", "exact.displacement[1]"),
+    ],
+)
 def test_a_2d_scene_refuses_z_naming_the_key(override, key):
     from pathlib import Path
 

@@ -9,6 +9,8 @@ import pytest
 
 from vemkit.config.expressions import ALLOWED, compile_expression
 from vemkit.exceptions import ExpressionError
+
+
 def test_traction_of_the_paper_is_evaluated_vectorised():
     traction = compile_expression("200*(5-y)", name="boundary.neumann.left.traction[0]")
     x = np.zeros((3, 1))
@@ -23,9 +25,10 @@ def test_traction_of_the_paper_is_evaluated_vectorised():
     assert traction.constant_value is None
 
 
-@pytest.mark.parametrize("value, expected", [(0.1, 0.1), (2, 2.0), ("-200", -200.0),
-                                             ("2*pi", 2 * math.pi), ("1.5e-3", 1.5e-3),
-                                             ("+(3)", 3.0), ("2**-1", 0.5)])
+@pytest.mark.parametrize(
+    "value, expected",
+    [(0.1, 0.1), (2, 2.0), ("-200", -200.0), ("2*pi", 2 * math.pi), ("1.5e-3", 1.5e-3), ("+(3)", 3.0), ("2**-1", 0.5)],
+)
 def test_constants_broadcast_to_the_shape_of_the_points(value, expected):
     expression = compile_expression(value, name="contact.gap")
     assert expression.is_constant
@@ -41,10 +44,16 @@ def test_every_function_and_operator_of_the_grammar():
     x = np.linspace(0.1, 0.9, 7)
     y = np.linspace(0.9, 0.2, 7)
     expression = compile_expression(
-        "sin(x)*cos(y) + exp(-x)/sqrt(y) - abs(x-y)**2 + min(x, y, 0.5) - max(x, 2*y) + -pi*x",
-        name="body_force[0]")
-    expected = (np.sin(x) * np.cos(y) + np.exp(-x) / np.sqrt(y) - np.abs(x - y) ** 2
-                + np.minimum(np.minimum(x, y), 0.5) - np.maximum(x, 2 * y) - np.pi * x)
+        "sin(x)*cos(y) + exp(-x)/sqrt(y) - abs(x-y)**2 + min(x, y, 0.5) - max(x, 2*y) + -pi*x", name="body_force[0]"
+    )
+    expected = (
+        np.sin(x) * np.cos(y)
+        + np.exp(-x) / np.sqrt(y)
+        - np.abs(x - y) ** 2
+        + np.minimum(np.minimum(x, y), 0.5)
+        - np.maximum(x, 2 * y)
+        - np.pi * x
+    )
     np.testing.assert_allclose(expression(x, y), expected, rtol=1e-14)
     assert expression.variables == frozenset({"x", "y"})
 
@@ -110,18 +119,20 @@ def test_non_expressions_are_rejected(value):
 
 
 def test_overflowing_constants_are_rejected_when_compiled():
-    for text in ("9**9**9", "1e400", "1" * 400, "exp(1000)", "1/0", "sqrt(-1)", "(-8)**(1/3)",
-                 "10**400/10**399"):
+    for text in ("9**9**9", "1e400", "1" * 400, "exp(1000)", "1/0", "sqrt(-1)", "(-8)**(1/3)", "10**400/10**399"):
         with pytest.raises(ExpressionError, match="must be finite"):
             compile_expression(text, name="contact.gap")
 
 
-@pytest.mark.parametrize("text, x, y, shown", [
-    ("1e400*x", [0.5], [0.5], "inf"),
-    ("1/x", [1.0, 0.0], [0.0, 0.0], "inf"),
-    ("sqrt(y-0.5)", 0.0, [1.0, 0.25], "nan"),
-    ("9**9**9*x", 1.0, 1.0, "inf"),
-])
+@pytest.mark.parametrize(
+    "text, x, y, shown",
+    [
+        ("1e400*x", [0.5], [0.5], "inf"),
+        ("1/x", [1.0, 0.0], [0.0, 0.0], "inf"),
+        ("sqrt(y-0.5)", 0.0, [1.0, 0.25], "nan"),
+        ("9**9**9*x", 1.0, 1.0, "inf"),
+    ],
+)
 def test_non_finite_values_raise_at_every_evaluation(text, x, y, shown):
     expression = compile_expression(text, name="boundary.neumann.left.traction[1]")
     with pytest.raises(ExpressionError) as caught:

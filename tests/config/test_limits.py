@@ -3,16 +3,21 @@
 import pytest
 
 from vemkit.config import limits
-from vemkit.config.limits import (check_resources, check_scene_resources, domain_area, estimate_mesh,
-                                  estimate_resources)
+from vemkit.config.limits import check_resources, check_scene_resources, domain_area, estimate_mesh, estimate_resources
 from vemkit.config.scene import scene_from_dict
 from vemkit.exceptions import ResourceLimitError
 from vemkit.mesh.families import build_mesh
 
 CASES = [
-    ("square", {}), ("triangle", {}), ("triangle", {"kind": "structured"}), ("voronoi", {}),
-    ("voronoi", {"lloyd_iterations": 0, "seed": 3}), ("hanging", {"levels": 0}), ("hanging", {"levels": 3}),
-    ("hanging", {"levels": 3, "rule": "random"}), ("hanging", {"levels": 2, "rule": "random", "fraction": 1.0}),
+    ("square", {}),
+    ("triangle", {}),
+    ("triangle", {"kind": "structured"}),
+    ("voronoi", {}),
+    ("voronoi", {"lloyd_iterations": 0, "seed": 3}),
+    ("hanging", {"levels": 0}),
+    ("hanging", {"levels": 3}),
+    ("hanging", {"levels": 3, "rule": "random"}),
+    ("hanging", {"levels": 2, "rule": "random", "fraction": 1.0}),
 ]
 
 
@@ -50,8 +55,13 @@ def test_the_machine_memory_is_known_here():
 
 
 def test_a_scene_is_checked_before_its_mesh_exists():
-    scene = scene_from_dict({"material": {"E": 1.0, "nu": 0.3}, "boundary": {"dirichlet": ["left"]},
-                             "discretization": {"mesh": {"family": "hanging", "n": 64, "levels": 20}}})
+    scene = scene_from_dict(
+        {
+            "material": {"E": 1.0, "nu": 0.3},
+            "boundary": {"dirichlet": ["left"]},
+            "discretization": {"mesh": {"family": "hanging", "n": 64, "levels": 20}},
+        }
+    )
     with pytest.raises(ResourceLimitError, match=r"the scene \(hanging mesh, n = 64\) needs about"):
         check_scene_resources(scene)
     assert limits.scene_resources(scene).dofs == 2 * ((3 * (4096 + 3 * 64 * (2**20 - 1))) // 2 + 4 * 64 * 2**20 + 1)

@@ -13,7 +13,10 @@ SIDES = ["a", "b", "c", "d"]
 THIN = {
     "strip 1e-3": {"polygon": [[0, 0], [1, 0], [1, 1e-3], [0, 1e-3]], "sides": SIDES},
     "strip 1e-4": {"polygon": [[0, 0], [1, 0], [1, 1e-4], [0, 1e-4]], "sides": SIDES},
-    "fin": {"polygon": [[0, 0], [1, 0], [1, 1], [0.5, 1], [0.5, 2], [0.499, 2], [0.499, 1], [0, 1]], "sides": ["a"] * 8},
+    "fin": {
+        "polygon": [[0, 0], [1, 0], [1, 1], [0.5, 1], [0.5, 2], [0.499, 2], [0.499, 1], [0, 1]],
+        "sides": ["a"] * 8,
+    },
 }
 
 
@@ -25,21 +28,37 @@ def test_thin_parts_are_counted_before_triangle_fills_them(name):
     assert made <= predicted <= 3.5 * made, (made, predicted)
 
 
-@pytest.mark.parametrize("spec", [
-    {"polygon": [[0, 0], [48, 44], [48, 60], [0, 44]], "sides": SIDES},  # Cook's membrane
-    {"polygon": [[0, 0], [1, 0], [0, 0.01]], "sides": SIDES[:3]},  # a sharp wedge: Triangle leaves it alone
-])
+@pytest.mark.parametrize(
+    "spec",
+    [
+        {"polygon": [[0, 0], [48, 44], [48, 60], [0, 44]], "sides": SIDES},  # Cook's membrane
+        {"polygon": [[0, 0], [1, 0], [0, 0.01]], "sides": SIDES[:3]},  # a sharp wedge: Triangle leaves it alone
+    ],
+)
 def test_bodies_without_thin_parts_add_nothing(spec):
     assert thin_part_triangles(domain_from_spec(spec), 2.0 if len(spec["sides"]) == 4 else 0.25) == 0
 
 
-@pytest.mark.parametrize("mesh, spec, message", [
-    ({"family": "square", "h": 30.0}, {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": SIDES}, "larger side"),
-    ({"family": "voronoi", "n": 4}, {"polygon": [[1e6, 0], [1e6 + 2, 0], [1e6 + 2, 1], [1e6, 1]], "sides": SIDES},
-     "too fine for double precision"),
-    ({"family": "triangle", "n": 4}, {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": SIDES,
-                                      "holes": [{"circle": [1, 0.5, 1e-7], "side": "h"}]}, "feature of"),
-])
+@pytest.mark.parametrize(
+    "mesh, spec, message",
+    [
+        ({"family": "square", "h": 30.0}, {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": SIDES}, "larger side"),
+        (
+            {"family": "voronoi", "n": 4},
+            {"polygon": [[1e6, 0], [1e6 + 2, 0], [1e6 + 2, 1], [1e6, 1]], "sides": SIDES},
+            "too fine for double precision",
+        ),
+        (
+            {"family": "triangle", "n": 4},
+            {
+                "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+                "sides": SIDES,
+                "holes": [{"circle": [1, 0.5, 1e-7], "side": "h"}],
+            },
+            "feature of",
+        ),
+    ],
+)
 def test_a_size_beyond_the_body_is_refused(mesh, spec, message):
     with pytest.raises(SceneError, match=message) as error:
         check_mesh_resolution(mesh, domain_from_spec(spec))

@@ -38,16 +38,22 @@ def test_random_small_sets_agree_with_the_dense_rank_2d_and_3d():
         assert (free is None) == (_dense_rank(points, prescribed) == full), (points, prescribed, free)
 
 
-@pytest.mark.parametrize("points, prescribed, motion", [
-    ([[0, 0], [1, 0]], [[True, False], [True, False]], "a translation in y"),
-    ([[0, 0], [0, 1]], [[False, True], [False, True]], "a translation in x"),
-    ([[2.0, 3.0]], [[True, True]], "a rotation about (2, 3)"),
-    # u1 held along y = 0.5 (rollers), u2 at one point x = 4: rotation about (4, 0.5)
-    ([[0, 0.5], [1, 0.5], [4, 0.5], [4, 7]], [[True, False], [True, False], [False, False], [False, True]],
-     "a rotation about (4, 0.5)"),
-    ([[1e6, 1e6], [1e6 + 1, 1e6]], [[True, True], [False, True]], None),
-    ([[0, 0], [1, 0], [1, 1]], [[False, False], [False, False], [False, False]], "every rigid motion"),
-])
+@pytest.mark.parametrize(
+    "points, prescribed, motion",
+    [
+        ([[0, 0], [1, 0]], [[True, False], [True, False]], "a translation in y"),
+        ([[0, 0], [0, 1]], [[False, True], [False, True]], "a translation in x"),
+        ([[2.0, 3.0]], [[True, True]], "a rotation about (2, 3)"),
+        # u1 held along y = 0.5 (rollers), u2 at one point x = 4: rotation about (4, 0.5)
+        (
+            [[0, 0.5], [1, 0.5], [4, 0.5], [4, 7]],
+            [[True, False], [True, False], [False, False], [False, True]],
+            "a rotation about (4, 0.5)",
+        ),
+        ([[1e6, 1e6], [1e6 + 1, 1e6]], [[True, True], [False, True]], None),
+        ([[0, 0], [1, 0], [1, 1]], [[False, False], [False, False], [False, False]], "every rigid motion"),
+    ],
+)
 def test_the_free_motion_is_named_with_its_point(points, prescribed, motion):
     found = free_rigid_motion(np.array(points, float), np.array(prescribed))
     assert found == motion if motion is None else found.startswith(motion), found

@@ -13,6 +13,7 @@ import yaml
 
 from vemkit.config.scene import Scene, load_scene, scene_from_dict, scene_from_yaml, scene_schema
 from vemkit.exceptions import InputError, SceneError
+
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 
 # SPEC §6, "minimal form of the paper scene", verbatim.
@@ -27,8 +28,11 @@ SPEC_PAPER_SCENE = {
         "contact": ["bottom"],
     },
     "contact": {"gap": 0.1, "normal": {"k": 10.0, "m": 1.0}, "friction": {"k": 450.0, "m": 0.0}},
-    "discretization": {"mesh": {"family": "square", "n": 16}, "stabilization": "dofi-2mu",
-                       "contact_quadrature": "nodal"},
+    "discretization": {
+        "mesh": {"family": "square", "n": 16},
+        "stabilization": "dofi-2mu",
+        "contact_quadrature": "nodal",
+    },
     "solver": {"method": "ssn", "tol": 1.0e-10},
 }
 
@@ -68,9 +72,17 @@ def test_paper_scene_has_the_paper_numbers(paper):
     assert paper.mesh_options == {"family": "square", "n": 16}
     assert isinstance(paper.mesh_options["n"], int)
     assert paper.stabilization == "dofi-2mu" and paper.contact_quadrature == "nodal"
-    assert paper.solver_options == {"method": "ssn", "tol": 1e-10, "max_iterations": None,
-                                    "linear": "auto", "rho": None, "eps_u": None,
-                                    "eps_lambda": None, "stop": "either", "time_budget": None}
+    assert paper.solver_options == {
+        "method": "ssn",
+        "tol": 1e-10,
+        "max_iterations": None,
+        "linear": "auto",
+        "rho": None,
+        "eps_u": None,
+        "eps_lambda": None,
+        "stop": "either",
+        "time_budget": None,
+    }
 
 
 def test_paper_loads_and_tractions_evaluate_vectorised(paper):
@@ -145,32 +157,40 @@ def test_scene_is_immutable_and_data_is_a_copy(paper):
 
 
 def test_overrides_change_the_scene(paper):
-    scene = paper.with_overrides(["solver.method=uzawa", "discretization.mesh.n=32",
-                                  "contact.friction.k=0", "solver.tol=1e-8",
-                                  "boundary.neumann.left.traction[1]=-100*x",
-                                  "discretization.mesh.family=voronoi",
-                                  "discretization.mesh.seed=7"])
+    scene = paper.with_overrides(
+        [
+            "solver.method=uzawa",
+            "discretization.mesh.n=32",
+            "contact.friction.k=0",
+            "solver.tol=1e-8",
+            "boundary.neumann.left.traction[1]=-100*x",
+            "discretization.mesh.family=voronoi",
+            "discretization.mesh.seed=7",
+        ]
+    )
     assert scene.solver_options["method"] == "uzawa" and scene.solver_options["tol"] == 1e-8
     assert scene.mesh_options == {"family": "voronoi", "n": 32, "seed": 7}
     assert scene.friction_bound.k == 0.0
     assert scene.traction("left")[1](np.array([0.5]), 0.0)[0] == -50.0
     assert load_scene(PAPER, ["solver.method=uzawa"]).solver_options["method"] == "uzawa"
     assert paper.solver_options["method"] == "ssn"  # the original is untouched
-    assert scene_from_dict(SPEC_PAPER_SCENE, "solver.max_iterations=5").solver_options[
-        "max_iterations"] == 5
+    assert scene_from_dict(SPEC_PAPER_SCENE, "solver.max_iterations=5").solver_options["max_iterations"] == 5
 
 
-@pytest.mark.parametrize("override, named", [
-    ("solver.foo=1", "solver.foo"),
-    ("foo=1", "foo"),
-    ("material.G=1", "material.G"),
-    ("contact.frction.k=1", "contact.frction"),
-    ("material.E.x=1", "material.E"),
-    ("body_force[2]=1", "body_force"),
-    ("solver.method", "solver.method"),
-    ("=3", "=3"),
-    ("solver.tol=[1,", "solver.tol"),
-])
+@pytest.mark.parametrize(
+    "override, named",
+    [
+        ("solver.foo=1", "solver.foo"),
+        ("foo=1", "foo"),
+        ("material.G=1", "material.G"),
+        ("contact.frction.k=1", "contact.frction"),
+        ("material.E.x=1", "material.E"),
+        ("body_force[2]=1", "body_force"),
+        ("solver.method", "solver.method"),
+        ("=3", "=3"),
+        ("solver.tol=[1,", "solver.tol"),
+    ],
+)
 def test_unknown_or_malformed_overrides_are_rejected(override, named):
     message = rejection(overrides=[override])
     assert message.startswith(f"--set {override}")
@@ -189,71 +209,78 @@ def with_change(path, value):
     return data
 
 
-@pytest.mark.parametrize("override, named, says", [
-    ("contact.normal.k=-1", "contact.normal.k = -1", ">= 0"),
-    ("contact.normal.m=-1", "contact.normal.m = -1", ">= 0"),
-    ("contact.friction.k=-450", "contact.friction.k = -450", ">= 0"),
-    ("contact.friction.m=-0.5", "contact.friction.m = -0.5", ">= 0"),
-    ("material.E=0", "material.E = 0", ">= 1e-12"),
-    ("material.E=-2000", "material.E = -2000", ">= 1e-12"),
-    ("material.E=abc", "material.E = 'abc'", "must be a number"),
-    ("material.E=true", "material.E = true", "must be a number"),
-    ("material.E=.nan", "material.E = nan", "finite"),
-    ("material.nu=0.5", "material.nu = 0.5", "< 0.5"),
-    ("material.nu=0.7", "material.nu = 0.7", "< 0.5"),
-    ("material.nu=-1", "material.nu = -1", ">= -0.999"),
-    ("discretization.mesh.n=0", "discretization.mesh.n = 0", ">= 1"),
-    ("discretization.mesh.n=2.5", "discretization.mesh.n = 2.5", "integer"),
-    ("discretization.mesh.n=sixteen", "discretization.mesh.n = 'sixteen'", "integer"),
-    ("discretization.mesh.family=hexagon", "discretization.mesh.family", "square"),
-    ("discretization.stabilization=none", "discretization.stabilization", "dofi-2mu"),
-    ("solver.method=newton", "solver.method", "ssn, uzawa"),
-    ("solver.tol=0", "solver.tol = 0", ">= 1e-15"),
-    ("solver.max_iterations=0", "solver.max_iterations = 0", ">= 1"),
-    ("solver.rho=-1", "solver.rho = -1", "> 0"),
-    ("body_force=[0]", "body_force", "2"),
-    ("boundary.dirichlet=[front]", "boundary.dirichlet[0] = 'front'", "unknown boundary name"),
-    ("boundary.contact=[bottom, bottom]", "boundary.contact", "twice"),
-    ("boundary.contact=[bottom, left]", "'left'", "both neumann and contact"),
-    ("boundary.contact=[right]", "'right'", "both dirichlet and contact"),
-    ("boundary.dirichlet=[]", "boundary.dirichlet", "no Dirichlet part: the body is not held; "
-                                                    "add boundary.dirichlet: [right]"),
-    ("boundary.neumann.left.traction[0]=200*(5-", "boundary.neumann.left.traction[0]",
-     "not a valid expression"),
-    ("boundary.neumann.left.traction[0]=__import__('os')", "boundary.neumann.left.traction[0]",
-     "'__import__'"),
-    ("boundary.neumann.left.traction[0]=x.real", "boundary.neumann.left.traction[0]", "x.real"),
-    ("boundary.neumann.left.traction[0]=open('f')", "boundary.neumann.left.traction[0]", "'open'"),
-    ("body_force[0]=lambda: 1", "body_force[0]", "lambda"),
-    ("body_force[1]=[1,2]", "body_force[1]", "must be a number or a string"),
-    ("body_force[1]='[1,2]'", "body_force[1]", "a list"),
-    ("contact.gap=y if x else 1", "contact.gap", "conditional"),
-    ("boundary.neumann.left.traction[1]=1e400*x", "boundary.neumann.left.traction[1]", "finite"),
-    ("contact.gap=1/x", "contact.gap", "finite"),
-    ("contact.gap=-0.1", "contact.gap = -0.1", ">= 0"),
-    ("contact.gap=0.05-x", "contact.gap", "g_a must be >= 0"),
-])
+@pytest.mark.parametrize(
+    "override, named, says",
+    [
+        ("contact.normal.k=-1", "contact.normal.k = -1", ">= 0"),
+        ("contact.normal.m=-1", "contact.normal.m = -1", ">= 0"),
+        ("contact.friction.k=-450", "contact.friction.k = -450", ">= 0"),
+        ("contact.friction.m=-0.5", "contact.friction.m = -0.5", ">= 0"),
+        ("material.E=0", "material.E = 0", ">= 1e-12"),
+        ("material.E=-2000", "material.E = -2000", ">= 1e-12"),
+        ("material.E=abc", "material.E = 'abc'", "must be a number"),
+        ("material.E=true", "material.E = true", "must be a number"),
+        ("material.E=.nan", "material.E = nan", "finite"),
+        ("material.nu=0.5", "material.nu = 0.5", "< 0.5"),
+        ("material.nu=0.7", "material.nu = 0.7", "< 0.5"),
+        ("material.nu=-1", "material.nu = -1", ">= -0.999"),
+        ("discretization.mesh.n=0", "discretization.mesh.n = 0", ">= 1"),
+        ("discretization.mesh.n=2.5", "discretization.mesh.n = 2.5", "integer"),
+        ("discretization.mesh.n=sixteen", "discretization.mesh.n = 'sixteen'", "integer"),
+        ("discretization.mesh.family=hexagon", "discretization.mesh.family", "square"),
+        ("discretization.stabilization=none", "discretization.stabilization", "dofi-2mu"),
+        ("solver.method=newton", "solver.method", "ssn, uzawa"),
+        ("solver.tol=0", "solver.tol = 0", ">= 1e-15"),
+        ("solver.max_iterations=0", "solver.max_iterations = 0", ">= 1"),
+        ("solver.rho=-1", "solver.rho = -1", "> 0"),
+        ("body_force=[0]", "body_force", "2"),
+        ("boundary.dirichlet=[front]", "boundary.dirichlet[0] = 'front'", "unknown boundary name"),
+        ("boundary.contact=[bottom, bottom]", "boundary.contact", "twice"),
+        ("boundary.contact=[bottom, left]", "'left'", "both neumann and contact"),
+        ("boundary.contact=[right]", "'right'", "both dirichlet and contact"),
+        (
+            "boundary.dirichlet=[]",
+            "boundary.dirichlet",
+            "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]",
+        ),
+        ("boundary.neumann.left.traction[0]=200*(5-", "boundary.neumann.left.traction[0]", "not a valid expression"),
+        ("boundary.neumann.left.traction[0]=__import__('os')", "boundary.neumann.left.traction[0]", "'__import__'"),
+        ("boundary.neumann.left.traction[0]=x.real", "boundary.neumann.left.traction[0]", "x.real"),
+        ("boundary.neumann.left.traction[0]=open('f')", "boundary.neumann.left.traction[0]", "'open'"),
+        ("body_force[0]=lambda: 1", "body_force[0]", "lambda"),
+        ("body_force[1]=[1,2]", "body_force[1]", "must be a number or a string"),
+        ("body_force[1]='[1,2]'", "body_force[1]", "a list"),
+        ("contact.gap=y if x else 1", "contact.gap", "conditional"),
+        ("boundary.neumann.left.traction[1]=1e400*x", "boundary.neumann.left.traction[1]", "finite"),
+        ("contact.gap=1/x", "contact.gap", "finite"),
+        ("contact.gap=-0.1", "contact.gap = -0.1", ">= 0"),
+        ("contact.gap=0.05-x", "contact.gap", "g_a must be >= 0"),
+    ],
+)
 def test_rejections_are_one_line_and_name_the_key(override, named, says):
     message = rejection(overrides=[override])
     assert named in message
     assert says in message
 
 
-@pytest.mark.parametrize("path, value, named", [
-    (("colour",), "red", "colour: unknown key"),
-    (("material", "G"), 1.0, "material.G: unknown key"),
-    (("contact", "normal", "exponent"), 1.0, "contact.normal.exponent: unknown key"),
-    (("discretization", "mesh", "size"), 0.1, "discretization.mesh.size: unknown key"),
-    (("boundary", "neumann", "front"), {"traction": [0, 0]}, "unknown boundary name 'front'"),
-    (("boundary", "dirichlet"), KeyError, "no Dirichlet part"),
-    (("material", "E"), KeyError, "material.E is missing"),
-    (("discretization", "mesh"), KeyError, "discretization.mesh is missing"),
-    (("contact", "friction"), KeyError, "contact.friction is missing"),
-    (("contact",), KeyError, "contact is missing: boundary.contact lists bottom"),
-    (("material", "E"), True, "material.E = true: must be a number"),
-    (("material", "E"), "2000", "material.E = '2000': must be a number"),
-    (("discretization", "mesh", "n"), 16.5, "discretization.mesh.n = 16.5"),
-])
+@pytest.mark.parametrize(
+    "path, value, named",
+    [
+        (("colour",), "red", "colour: unknown key"),
+        (("material", "G"), 1.0, "material.G: unknown key"),
+        (("contact", "normal", "exponent"), 1.0, "contact.normal.exponent: unknown key"),
+        (("discretization", "mesh", "size"), 0.1, "discretization.mesh.size: unknown key"),
+        (("boundary", "neumann", "front"), {"traction": [0, 0]}, "unknown boundary name 'front'"),
+        (("boundary", "dirichlet"), KeyError, "no Dirichlet part"),
+        (("material", "E"), KeyError, "material.E is missing"),
+        (("discretization", "mesh"), KeyError, "discretization.mesh is missing"),
+        (("contact", "friction"), KeyError, "contact.friction is missing"),
+        (("contact",), KeyError, "contact is missing: boundary.contact lists bottom"),
+        (("material", "E"), True, "material.E = true: must be a number"),
+        (("material", "E"), "2000", "material.E = '2000': must be a number"),
+        (("discretization", "mesh", "n"), 16.5, "discretization.mesh.n = 16.5"),
+    ],
+)
 def test_scene_data_rejections(path, value, named):
     assert named in rejection(with_change(path, value))
 
@@ -306,8 +333,8 @@ def test_scientific_notation_without_a_dot_is_a_number(tmp_path):
 
 def test_message_of_an_out_of_range_poisson_ratio():
     assert rejection(overrides=["material.nu=0.7"]) == (
-        "material.nu = 0.7: must be < 0.5 (Poisson ratio of plane stress); "
-        "fix the scene or --set material.nu=...")
+        "material.nu = 0.7: must be < 0.5 (Poisson ratio of plane stress); fix the scene or --set material.nu=..."
+    )
 
 
 def test_first_problem_in_file_order_is_reported():
@@ -328,8 +355,11 @@ def test_an_unknown_side_in_an_override_names_the_sides_of_the_domain():
 # -- any domain (SPEC §7) -------------------------------------------------------------------------
 def _plate(**extra):
     data = yaml.safe_load(PAPER.read_text())
-    data["domain"] = {"polygon": [[0, 0], [4, 0], [4, 2], [0, 2]], "sides": ["base", "right", "top", "left"],
-                      "holes": [{"circle": [2.0, 1.0, 0.4], "side": "hole"}]}
+    data["domain"] = {
+        "polygon": [[0, 0], [4, 0], [4, 2], [0, 2]],
+        "sides": ["base", "right", "top", "left"],
+        "holes": [{"circle": [2.0, 1.0, 0.4], "side": "hole"}],
+    }
     data["boundary"] = {"dirichlet": ["left"], "neumann": {"right": {"traction": [1.0, 0.0]}}, "contact": ["base"]}
     data.update(extra)
     return data
@@ -339,19 +369,37 @@ def test_a_scene_describes_its_own_body_and_its_sides():
     scene = scene_from_dict(_plate())
     assert scene.sides == ("base", "right", "top", "left", "hole")
     assert scene.neumann_sides == ("right",) and scene.contact_sides == ("base",)
-    with pytest.raises(SceneError, match=r"boundary.neumann.front: unknown boundary name 'front'; the domain has "
-                                         r"sides base, right, top, left, hole"):
+    with pytest.raises(
+        SceneError,
+        match=r"boundary.neumann.front: unknown boundary name 'front'; the domain has "
+        r"sides base, right, top, left, hole",
+    ):
         scene_from_dict(_plate(boundary={"dirichlet": ["left"], "neumann": {"front": {"traction": [0, 0]}}}))
 
 
-@pytest.mark.parametrize("domain, says", [
-    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c"]}, "domain.sides"),
-    ({"polygon": [[0, 0], [0, 1], [1, 1], [1, 0]], "sides": ["a", "b", "c", "d"]}, "clockwise"),
-    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c", "d"],
-      "holes": [{"circle": [3.0, 3.0, 0.5], "side": "h"}]}, "domain.holes[0]"),
-    ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c", "d"],
-      "holes": [{"circle": [0.5, 0.5, 0.0], "side": "h"}]}, "domain.holes[0]"),
-])
+@pytest.mark.parametrize(
+    "domain, says",
+    [
+        ({"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["a", "b", "c"]}, "domain.sides"),
+        ({"polygon": [[0, 0], [0, 1], [1, 1], [1, 0]], "sides": ["a", "b", "c", "d"]}, "clockwise"),
+        (
+            {
+                "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                "sides": ["a", "b", "c", "d"],
+                "holes": [{"circle": [3.0, 3.0, 0.5], "side": "h"}],
+            },
+            "domain.holes[0]",
+        ),
+        (
+            {
+                "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                "sides": ["a", "b", "c", "d"],
+                "holes": [{"circle": [0.5, 0.5, 0.0], "side": "h"}],
+            },
+            "domain.holes[0]",
+        ),
+    ],
+)
 def test_a_broken_body_is_refused_in_one_line(domain, says):
     data = yaml.safe_load(PAPER.read_text())
     data["domain"] = domain

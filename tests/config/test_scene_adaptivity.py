@@ -9,8 +9,13 @@ from vemkit.config.scene import SceneError, load_scene, scene_schema
 from vemkit.studies.adaptivity import AdaptivitySettings
 
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
-SPEC_DEFAULTS = {"estimator": "residual", "marking": {"dorfler": 0.5}, "target": 0.01, "max_dofs": 200000,
-                 "max_steps": 30}
+SPEC_DEFAULTS = {
+    "estimator": "residual",
+    "marking": {"dorfler": 0.5},
+    "target": 0.01,
+    "max_dofs": 200000,
+    "max_steps": 30,
+}
 
 
 def test_the_defaults_are_those_of_spec_9_and_the_filled_block_validates():
@@ -34,19 +39,22 @@ def test_a_partial_block_is_completed_and_becomes_the_settings():
     assert again.adaptivity_options["marking"] == {"dorfler": 0.3}
 
 
-@pytest.mark.parametrize("override, named", [
-    ("adaptivity.marking.dorfler=0", "adaptivity.marking.dorfler = 0: must be > 0"),
-    ("adaptivity.marking.dorfler=1.01", "adaptivity.marking.dorfler = 1.01: must be <= 1"),
-    ("adaptivity.target=-0.1", "adaptivity.target = -0.1: must be > 0"),
-    ("adaptivity.target=2", "adaptivity.target = 2: must be <= 1"),
-    ("adaptivity.max_dofs=0", "adaptivity.max_dofs = 0: must be >= 1"),
-    ("adaptivity.max_steps=1.5", "adaptivity.max_steps = 1.5: must be an integer"),
-    ("adaptivity.max_hanging=-1", "adaptivity.max_hanging = -1: must be >= 1"),
-    ("adaptivity.estimator=recovery", "adaptivity.estimator = 'recovery': must be one of residual"),
-    ("adaptivity.marking.theta=0.5", "unknown key 'adaptivity.marking.theta'"),
-    ("adaptivity=[1, 2]", "adaptivity = [1, 2]: must be a mapping"),
-    ("adaptivity.reference=''", "adaptivity.reference = '': must not be empty"),
-])
+@pytest.mark.parametrize(
+    "override, named",
+    [
+        ("adaptivity.marking.dorfler=0", "adaptivity.marking.dorfler = 0: must be > 0"),
+        ("adaptivity.marking.dorfler=1.01", "adaptivity.marking.dorfler = 1.01: must be <= 1"),
+        ("adaptivity.target=-0.1", "adaptivity.target = -0.1: must be > 0"),
+        ("adaptivity.target=2", "adaptivity.target = 2: must be <= 1"),
+        ("adaptivity.max_dofs=0", "adaptivity.max_dofs = 0: must be >= 1"),
+        ("adaptivity.max_steps=1.5", "adaptivity.max_steps = 1.5: must be an integer"),
+        ("adaptivity.max_hanging=-1", "adaptivity.max_hanging = -1: must be >= 1"),
+        ("adaptivity.estimator=recovery", "adaptivity.estimator = 'recovery': must be one of residual"),
+        ("adaptivity.marking.theta=0.5", "unknown key 'adaptivity.marking.theta'"),
+        ("adaptivity=[1, 2]", "adaptivity = [1, 2]: must be a mapping"),
+        ("adaptivity.reference=''", "adaptivity.reference = '': must not be empty"),
+    ],
+)
 def test_bad_values_are_one_line_errors_naming_the_key(override, named):
     with pytest.raises(SceneError) as error:
         load_scene(PAPER, [override])

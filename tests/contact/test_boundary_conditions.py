@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from manufactured import elasticity_solution
+
 from vemkit.config.scene import load_scene, scene_from_dict
 from vemkit.exceptions import SceneError
 from vemkit.studies.scene_solve import solve_scene
@@ -18,13 +18,22 @@ PAPER = ROOT / "config" / "scenes" / "paper.yaml"
 FAMILIES = ["square", "triangle", "voronoi", "hanging"]
 E, NU, P = 100.0, 0.25, 3.0
 SHRINK = P * (1 - NU) / E  # plane stress, sigma = -p I: eps = -p (1 - nu) / E in every direction
-PLATE = {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-         "holes": [{"circle": [1.2, 0.5, 0.2], "side": "hole"}]}
+PLATE = {
+    "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+    "sides": ["bottom", "right", "top", "left"],
+    "holes": [{"circle": [1.2, 0.5, 0.2], "side": "hole"}],
+}
 
 
 def _scene(boundary, domain=PLATE, family="voronoi", size=("h", 0.2), **extra):
-    data = {"name": "bc", "domain": domain, "material": {"E": E, "nu": NU}, "boundary": boundary,
-            "discretization": {"mesh": {"family": family, size[0]: size[1]}}, **extra}
+    data = {
+        "name": "bc",
+        "domain": domain,
+        "material": {"E": E, "nu": NU},
+        "boundary": boundary,
+        "discretization": {"mesh": {"family": family, size[0]: size[1]}},
+        **extra,
+    }
     return scene_from_dict(data)
 
 
@@ -32,9 +41,14 @@ def _scene(boundary, domain=PLATE, family="voronoi", size=("h", 0.2), **extra):
 def test_pressure_on_every_free_side_and_the_hole_with_rollers_is_uniform_compression(family):
     """Patch test with a hole: pressure p on right, top and the hole, rollers on left and bottom
     give sigma = -p I exactly, u = -p (1 - nu) / E (x, y); the exact-error attributes are ~0."""
-    scene = _scene({"dirichlet": {"left": [0.0, None], "bottom": [None, 0.0]},
-                    "neumann": {side: {"pressure": P} for side in ("right", "top", "hole")}},
-                   family=family, exact={"displacement": [f"-{SHRINK}*x", f"-{SHRINK}*y"]})
+    scene = _scene(
+        {
+            "dirichlet": {"left": [0.0, None], "bottom": [None, 0.0]},
+            "neumann": {side: {"pressure": P} for side in ("right", "top", "hole")},
+        },
+        family=family,
+        exact={"displacement": [f"-{SHRINK}*x", f"-{SHRINK}*y"]},
+    )
     problem, solution, ds = solve_scene(scene)
     u = problem.dofs.expand(solution.u)
     np.testing.assert_allclose(u, -SHRINK * problem.mesh.vertices, atol=1e-12)
@@ -48,13 +62,18 @@ def test_prescribed_linear_displacement_on_the_boundary_is_reproduced_inside(fam
     """Nonzero Dirichlet expressions on every side (a kept vertex per dof, held by identity rows):
     the linear field is the exact solution, reproduced at every vertex."""
     field = ("0.01*x + 0.02*y", "-0.005*x + 0.03*y")
-    scene = _scene({"dirichlet": {side: list(field) for side in ("bottom", "right", "top", "left")}},
-                   domain="unit_square", family=family, size=("n", 6),
-                   exact={"displacement": list(field)})
+    scene = _scene(
+        {"dirichlet": {side: list(field) for side in ("bottom", "right", "top", "left")}},
+        domain="unit_square",
+        family=family,
+        size=("n", 6),
+        exact={"displacement": list(field)},
+    )
     problem, solution, ds = solve_scene(scene)
     x, y = problem.mesh.vertices.T
-    np.testing.assert_allclose(problem.dofs.expand(solution.u),
-                               np.stack([0.01 * x + 0.02 * y, -0.005 * x + 0.03 * y], axis=1), atol=1e-12)
+    np.testing.assert_allclose(
+        problem.dofs.expand(solution.u), np.stack([0.01 * x + 0.02 * y, -0.005 * x + 0.03 * y], axis=1), atol=1e-12
+    )
     assert ds.attrs["error_h1"] < 1e-9
 
 
@@ -66,19 +85,28 @@ def test_exact_errors_of_a_nonpolynomial_field_fall_at_the_expected_rates():
     sides = ("bottom", "right", "top", "left")
     errors = []
     for n in (8, 16):
-        scene = _scene({"dirichlet": {side: field for side in sides}}, domain="unit_square", family="square",
-                       size=("n", n), exact={"displacement": field}, body_force=force)
+        scene = _scene(
+            {"dirichlet": {side: field for side in sides}},
+            domain="unit_square",
+            family="square",
+            size=("n", n),
+            exact={"displacement": field},
+            body_force=force,
+        )
         errors.append(solve_scene(scene)[2].attrs)
     h1 = np.log2(errors[0]["error_h1"] / errors[1]["error_h1"])
     l2 = np.log2(errors[0]["error_l2"] / errors[1]["error_l2"])
     assert 0.9 < h1 < 1.2 and 1.8 < l2 < 2.3, (h1, l2)
 
 
-@pytest.mark.parametrize("dirichlet, motion", [
-    ({"bottom": [None, 0.0]}, "a translation in x"),
-    ({"left": [0.0, None]}, "a translation in y"),
-    ({"left": [0.0, None], "right": [0.0, None]}, "a translation in y"),
-])
+@pytest.mark.parametrize(
+    "dirichlet, motion",
+    [
+        ({"bottom": [None, 0.0]}, "a translation in x"),
+        ({"left": [0.0, None]}, "a translation in y"),
+        ({"left": [0.0, None], "right": [0.0, None]}, "a translation in y"),
+    ],
+)
 def test_a_free_rigid_motion_is_refused_naming_it(dirichlet, motion):
     """Refused when the scene is read (on the domain's sides), before any mesh exists."""
     with pytest.raises(SceneError, match=motion) as caught:
@@ -101,8 +129,9 @@ def test_a_rotation_left_free_is_named_with_its_centre():
 def test_the_rigid_motion_error_is_one_line_through_the_cli(tmp_path):
     scene = tmp_path / "free.yaml"
     scene.write_text(PAPER.read_text().replace("dirichlet: [right]", "dirichlet: {right: [null, 0.0]}"))
-    run = subprocess.run([sys.executable, "-m", "vemkit.cli", "solve", scene, "-o", tmp_path / "out.nc"],
-                         capture_output=True, text=True)
+    run = subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", "solve", scene, "-o", tmp_path / "out.nc"], capture_output=True, text=True
+    )
     assert run.returncode == 2 and len(run.stderr.splitlines()) == 1, run.stderr
     assert "translation in x" in run.stderr and not (tmp_path / "out.nc").exists()
 
@@ -135,11 +164,14 @@ def test_a_foundation_along_a_slanted_normal_divides_by_the_cosine():
     assert line.along(np.array([[5.0, 0.5]]), tilted)[0] == pytest.approx(0.5 / np.cos(0.3))
 
 
-@pytest.mark.parametrize("change, named", [
-    ({"gap": 0.0}, "either gap or foundation"),
-    ({"foundation": {"point": [0, 0.5], "normal": [0, 1]}}, "beyond the foundation line"),
-    ({"foundation": {"point": [0, 0], "normal": [0, 0]}}, "contact.foundation.normal"),
-])
+@pytest.mark.parametrize(
+    "change, named",
+    [
+        ({"gap": 0.0}, "either gap or foundation"),
+        ({"foundation": {"point": [0, 0.5], "normal": [0, 1]}}, "beyond the foundation line"),
+        ({"foundation": {"point": [0, 0], "normal": [0, 0]}}, "contact.foundation.normal"),
+    ],
+)
 def test_bad_foundations_are_refused(change, named):
     data = load_scene(PAPER).data
     del data["contact"]["gap"]
@@ -150,25 +182,31 @@ def test_bad_foundations_are_refused(change, named):
         scene_from_dict(data)
 
 
-@pytest.mark.parametrize("boundary, named", [
-    ({"dirichlet": {"left": [None, None]}}, "prescribes nothing"),
-    ({"dirichlet": ["left"], "neumann": {"right": {"traction": [0, 1], "pressure": 1}}}, "exactly one of"),
-    ({"dirichlet": ["left"], "neumann": {"right": {}}}, "exactly one of"),
-    ({"dirichlet": {"nowhere": [0, 0]}}, "unknown boundary name"),
-    ({"dirichlet": {"left": ["sqrt(x-1)", 0]}}, "boundary.dirichlet.left"),
-])
+@pytest.mark.parametrize(
+    "boundary, named",
+    [
+        ({"dirichlet": {"left": [None, None]}}, "prescribes nothing"),
+        ({"dirichlet": ["left"], "neumann": {"right": {"traction": [0, 1], "pressure": 1}}}, "exactly one of"),
+        ({"dirichlet": ["left"], "neumann": {"right": {}}}, "exactly one of"),
+        ({"dirichlet": {"nowhere": [0, 0]}}, "unknown boundary name"),
+        ({"dirichlet": {"left": ["sqrt(x-1)", 0]}}, "boundary.dirichlet.left"),
+    ],
+)
 def test_bad_boundary_conditions_are_one_line_errors(boundary, named):
     with pytest.raises(SceneError, match=named) as caught:
         _scene(boundary, domain="unit_square", size=("n", 2))
     assert "\n" not in str(caught.value)
 
 
-@pytest.mark.parametrize("mesh, named", [
-    ({"family": "square"}, "exactly one of n, h and cells"),
-    ({"family": "square", "n": 4, "h": 0.25}, "exactly one of n, h and cells"),
-    ({"n": 4}, "family is missing"),
-    ({"file": "m.msh", "family": "square"}, "drop family"),
-])
+@pytest.mark.parametrize(
+    "mesh, named",
+    [
+        ({"family": "square"}, "exactly one of n, h and cells"),
+        ({"family": "square", "n": 4, "h": 0.25}, "exactly one of n, h and cells"),
+        ({"n": 4}, "family is missing"),
+        ({"file": "m.msh", "family": "square"}, "drop family"),
+    ],
+)
 def test_the_mesh_size_is_exactly_one_of_n_h_cells_or_a_file(mesh, named):
     data = load_scene(PAPER).data
     data["discretization"]["mesh"] = mesh

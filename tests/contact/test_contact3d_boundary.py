@@ -27,17 +27,28 @@ def pressed_box(family: str, n: int = 3, dimension: int = 3, foundation: bool = 
     the same), total contact force K t |Gamma_C|."""
     if dimension == 3:
         contact = {"foundation": {"point": [0, 0, 0], "normal": [0, 0, 1]}} if foundation else {"gap": "0*x*y*z"}
-        return {"model": "3d", "domain": {"box": [[0, 0, 0], [1, 1, H]]}, "material": {"E": E, "nu": NU},
-                "boundary": {"dirichlet": {"top": [None, None, -DELTA], "left": [0.0, None, None],
-                                           "front": [None, 0.0, None]}, "contact": ["bottom"]},
-                "contact": dict(contact, normal={"k": K, "m": 1.0}, friction={"k": 0.0, "m": 0.0}),
-                "discretization": {"mesh": {"family": family, "n": n}}}
-    return {"domain": {"polygon": [[0, 0], [1, 0], [1, H], [0, H]], "sides": ["bottom", "right", "top", "left"]},
+        return {
+            "model": "3d",
+            "domain": {"box": [[0, 0, 0], [1, 1, H]]},
             "material": {"E": E, "nu": NU},
-            "boundary": {"dirichlet": {"top": [None, -DELTA], "left": [0.0, None]}, "contact": ["bottom"]},
-            "contact": {"foundation": {"point": [0, 0], "normal": [0, 1]}, "normal": {"k": K, "m": 1.0},
-                        "friction": {"k": 0.0, "m": 0.0}},
-            "discretization": {"mesh": {"family": family, "n": 2 * n}}}
+            "boundary": {
+                "dirichlet": {"top": [None, None, -DELTA], "left": [0.0, None, None], "front": [None, 0.0, None]},
+                "contact": ["bottom"],
+            },
+            "contact": dict(contact, normal={"k": K, "m": 1.0}, friction={"k": 0.0, "m": 0.0}),
+            "discretization": {"mesh": {"family": family, "n": n}},
+        }
+    return {
+        "domain": {"polygon": [[0, 0], [1, 0], [1, H], [0, H]], "sides": ["bottom", "right", "top", "left"]},
+        "material": {"E": E, "nu": NU},
+        "boundary": {"dirichlet": {"top": [None, -DELTA], "left": [0.0, None]}, "contact": ["bottom"]},
+        "contact": {
+            "foundation": {"point": [0, 0], "normal": [0, 1]},
+            "normal": {"k": K, "m": 1.0},
+            "friction": {"k": 0.0, "m": 0.0},
+        },
+        "discretization": {"mesh": {"family": family, "n": 2 * n}},
+    }
 
 
 @pytest.mark.parametrize("family", ["hex", "voronoi"])
@@ -62,13 +73,23 @@ def test_the_tangent_rule_on_a_slanted_normal():
 
 def test_prism_weights_are_the_2d_trapezoid_times_the_layer_trapezoid():
     base = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
-    common = {"material": {"E": E, "nu": NU}, "contact": {"gap": 0.0, "normal": {"k": K, "m": 1.0},
-                                                          "friction": {"k": 0.0, "m": 0.0}}}
-    d2 = dict(common, domain=base, boundary={"dirichlet": ["top"], "contact": ["bottom"]},
-              discretization={"mesh": {"family": "voronoi", "n": 5}})
-    d3 = dict(common, model="3d", domain=dict(base, extrude={"depth": 0.3}),
-              boundary={"dirichlet": ["top"], "contact": ["bottom"]},
-              discretization={"mesh": {"family": "voronoi", "n": 5, "layers": 2}})
+    common = {
+        "material": {"E": E, "nu": NU},
+        "contact": {"gap": 0.0, "normal": {"k": K, "m": 1.0}, "friction": {"k": 0.0, "m": 0.0}},
+    }
+    d2 = dict(
+        common,
+        domain=base,
+        boundary={"dirichlet": ["top"], "contact": ["bottom"]},
+        discretization={"mesh": {"family": "voronoi", "n": 5}},
+    )
+    d3 = dict(
+        common,
+        model="3d",
+        domain=dict(base, extrude={"depth": 0.3}),
+        boundary={"dirichlet": ["top"], "contact": ["bottom"]},
+        discretization={"mesh": {"family": "voronoi", "n": 5, "layers": 2}},
+    )
     c2, c3 = scene_problem(scene_from_dict(d2)).contact, scene_problem(scene_from_dict(d3)).contact
     w2 = dict(zip(np.round(c2.coords[:, 0], 12), c2.weight))
     across = np.where(np.isclose(c3.coords[:, 2], 0.15), 0.15, 0.075)  # two layers of 0.15

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
 import sympy
-
 from manufactured import X, elasticity_solution
+
 from vemkit.config.scene import load_scene, scene_from_dict
 from vemkit.contact.laws import ContactLaw
 from vemkit.contact.problem import discrete_problem, scene_problem
@@ -45,9 +45,16 @@ def _uniform_penetration(family, k_nu=50.0, depth=0.3, gap=0.1):
     s11 = LAM * eps22
     mesh = build_mesh(family, 4)
     problem = discrete_problem(
-        mesh, E, NU, order=2, dirichlet={"top": (0.0, -depth)},
+        mesh,
+        E,
+        NU,
+        order=2,
+        dirichlet={"top": (0.0, -depth)},
         neumann={"left": lambda x, y: (-s11 + 0 * x, 0 * x), "right": lambda x, y: (s11 + 0 * x, 0 * x)},
-        contact=["bottom"], gap=lambda x, y: np.full_like(x, gap), law=ContactLaw(k_nu, 1.0, 450.0, 0.0))
+        contact=["bottom"],
+        gap=lambda x, y: np.full_like(x, gap),
+        law=ContactLaw(k_nu, 1.0, 450.0, 0.0),
+    )
     y = VirtualElementSpace(mesh, 2).node_coordinates[:, 1]
     exact = np.stack([0 * y, eps22 * (y - 1) - depth], axis=1)
     return problem, exact, depth + eps22 - gap
@@ -83,13 +90,23 @@ def test_the_change_of_variables_gives_the_plain_k2_solution():
     of the untransformed k = 2 system (clamped right side, traction on the left)."""
     mesh = build_mesh("voronoi", 5, seed=2)
     traction = lambda x, y: (200 * (5 - y), -200 + 0 * y)  # noqa: E731
-    problem = discrete_problem(mesh, E, NU, order=2, dirichlet=("right",), neumann={"left": traction},
-                               contact=["bottom"], law=ContactLaw(0.0, 1.0, 0.0, 0.0))
+    problem = discrete_problem(
+        mesh,
+        E,
+        NU,
+        order=2,
+        dirichlet=("right",),
+        neumann={"left": traction},
+        contact=["bottom"],
+        law=ContactLaw(0.0, 1.0, 0.0, 0.0),
+    )
     assert problem.dofs.change.nnz > 0
     space = VirtualElementSpace(mesh, 2)
     nodes = space.numbering(space.clamped_on(mesh.boundary["right"]))
     K = space.stiffness_matrix(LAM, MU, "dofi-2mu", nodes)
-    plain = nodes.node_values(spla.spsolve(K.tocsc(), nodes.restrict(traction_load_k2(mesh, mesh.boundary["left"], traction))))
+    plain = nodes.node_values(
+        spla.spsolve(K.tocsc(), nodes.restrict(traction_load_k2(mesh, mesh.boundary["left"], traction)))
+    )
     solution = solve(problem, {"method": "ssn", "tol": 1e-12, "linear": "direct"})
     np.testing.assert_allclose(problem.node_values(solution.u), plain, atol=1e-12 * np.abs(plain).max())
 
@@ -98,8 +115,15 @@ def test_the_change_of_variables_gives_the_plain_k2_solution():
 def test_ssn_and_uzawa_agree_on_the_paper_scene_at_order_2(family):
     solutions = {}
     for method in ("ssn", "uzawa"):
-        scene = load_scene(PAPER, ["discretization.order=2", f"discretization.mesh.family={family}",
-                                   "discretization.mesh.n=8", f"solver.method={method}"])
+        scene = load_scene(
+            PAPER,
+            [
+                "discretization.order=2",
+                f"discretization.mesh.family={family}",
+                "discretization.mesh.n=8",
+                f"solver.method={method}",
+            ],
+        )
         problem = scene_problem(scene)
         solutions[method] = solve(problem, scene.solver_options)
         assert verify_solution(problem, solutions[method].u, solutions[method].multiplier, 1e-8)["passed"]
@@ -138,9 +162,12 @@ def manufactured_problem(case, mesh, order):
 
     kwargs = dict(
         dirichlet={"right": (lambda x, y: u(x, y)[0], lambda x, y: u(x, y)[1])},
-        neumann={"left": traction((-1, 0)), "top": traction((0, 1)), "bottom": extra}, contact=["bottom"],
-        gap=lambda x, y: -u(x, 0 * x)[1] - np.broadcast_to(t(x), np.shape(x)), law=LAW,
-        body_force=lambda x, y: tuple(np.broadcast_to(v, np.shape(x)) for v in force(x, y)))
+        neumann={"left": traction((-1, 0)), "top": traction((0, 1)), "bottom": extra},
+        contact=["bottom"],
+        gap=lambda x, y: -u(x, 0 * x)[1] - np.broadcast_to(t(x), np.shape(x)),
+        law=LAW,
+        body_force=lambda x, y: tuple(np.broadcast_to(v, np.shape(x)) for v in force(x, y)),
+    )
     problem = discrete_problem(mesh, E, NU, order=order, **kwargs)
     return problem, exact, multiplier
 
@@ -152,7 +179,9 @@ def manufactured_errors(case, order, ns=(4, 8, 16)):
         mesh = build_mesh("square", n)
         problem, exact, multiplier = manufactured_problem(case, mesh, order)
         solution = solve(problem, {"method": "ssn", "tol": 1e-12})
-        proj = problem.projected(solution.u) if order == 2 else projected_solution(mesh, problem.dofs.expand(solution.u))
+        proj = (
+            problem.projected(solution.u) if order == 2 else projected_solution(mesh, problem.dofs.expand(solution.u))
+        )
         errors.append(exact_errors(mesh, proj, exact["u"], exact["grad"])["h1_semi"])
     return np.array(errors), problem, solution, multiplier
 
@@ -175,11 +204,14 @@ def test_order_2_reproduces_a_prescribed_quadratic_field_through_the_scene():
     quadratic Dirichlet data elsewhere (edge means on the new dofs) and the constant body force of u:
     the k = 2 solution is exact, and so are the errors the solution file reports."""
     field = ["0.01*x*x + 0.02*x*y", "-0.005*y*y + 0.03*x*x"]  # eps12 = 0.04 x: zero on x = 0
-    data = {"name": "quadratic", "material": {"E": E, "nu": NU},
-            "body_force": elasticity_solution(*field, E, NU)["body_force"],
-            "boundary": {"dirichlet": {"left": [field[0], None], "bottom": field, "right": field, "top": field}},
-            "discretization": {"mesh": {"family": "voronoi", "n": 4}, "order": 2},
-            "exact": {"displacement": field}}
+    data = {
+        "name": "quadratic",
+        "material": {"E": E, "nu": NU},
+        "body_force": elasticity_solution(*field, E, NU)["body_force"],
+        "boundary": {"dirichlet": {"left": [field[0], None], "bottom": field, "right": field, "top": field}},
+        "discretization": {"mesh": {"family": "voronoi", "n": 4}, "order": 2},
+        "exact": {"displacement": field},
+    }
     problem, solution, ds = solve_scene(scene_from_dict(data))
     assert problem.dofs.fixed_dofs.size > 0
     assert ds.attrs["order"] == 2 and ds.attrs["error_h1"] < 1e-9 and ds.attrs["error_l2"] < 1e-9
@@ -192,19 +224,22 @@ def test_the_order_2_solution_file_has_the_edge_means_and_the_contact_midpoints(
     problem, solution, ds = solve_scene(scene, verify=True)
     assert ds.attrs["order"] == 2 and ds.attrs["n_dofs"] == problem.n_dofs
     edges = problem.mesh.edges
-    means = problem.node_values(solution.u)[problem.mesh.n_vertices:][: edges.shape[0]]
+    means = problem.node_values(solution.u)[problem.mesh.n_vertices :][: edges.shape[0]]
     np.testing.assert_array_equal(ds["u1_edge_mean"].values, means[:, 0])
     assert ds["u1_edge_mean"].dims == ("mesh2d_nEdges",)
     vertex, edge = ds["contact_vertex"].values, ds["contact_edge"].values
     assert np.all((vertex >= 0) != (edge >= 0)) and (edge >= 0).sum() == 4 and (vertex >= 0).sum() == 4
-    np.testing.assert_allclose(ds["contact_x"].values[edge >= 0], 0.5 * problem.mesh.vertices[edges[edge[edge >= 0]]].sum(axis=1)[:, 0])
+    np.testing.assert_allclose(
+        ds["contact_x"].values[edge >= 0], 0.5 * problem.mesh.vertices[edges[edge[edge >= 0]]].sum(axis=1)[:, 0]
+    )
     k1 = solve_scene(load_scene(PAPER, ["discretization.mesh.n=4"]))[2]
     assert k1.attrs["order"] == 1 and "u1_edge_mean" not in k1
 
 
 def test_gauss_contact_quadrature_is_refused_at_order_2():
-    scene = load_scene(PAPER, ["discretization.order=2", "discretization.contact_quadrature=gauss",
-                               "discretization.mesh.n=2"])
+    scene = load_scene(
+        PAPER, ["discretization.order=2", "discretization.contact_quadrature=gauss", "discretization.mesh.n=2"]
+    )
     with pytest.raises(SceneError, match="contact_quadrature.*order = 2") as error:
         scene_problem(scene)
     assert error.value.key == "discretization.contact_quadrature"
@@ -218,8 +253,11 @@ def test_contact_on_a_slanted_side_at_order_2_has_the_edge_normals_at_the_midpoi
 
     data = yaml.safe_load(open(PAPER, encoding="utf-8").read())
     data["domain"] = {"polygon": [[0, 0], [2, 0], [3, 1], [0, 1]], "sides": ["base", "slope", "top", "left"]}
-    data["boundary"] = {"dirichlet": ["left"], "neumann": {"top": {"traction": [0.0, -200.0]}},
-                        "contact": ["base", "slope"]}
+    data["boundary"] = {
+        "dirichlet": ["left"],
+        "neumann": {"top": {"traction": [0.0, -200.0]}},
+        "contact": ["base", "slope"],
+    }
     data["discretization"] = {"mesh": {"family": "voronoi", "n": 4}, "order": 2}
     scene = scene_from_dict(data)
     problem = scene_problem(scene)
@@ -238,21 +276,28 @@ def _cli(tmp_path, *args):
     import subprocess
     import sys
 
-    return subprocess.run([sys.executable, "-m", "vemkit.cli", *args], capture_output=True, text=True, cwd=tmp_path,
-                          timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "vemkit.cli", *args], capture_output=True, text=True, cwd=tmp_path, timeout=300
+    )
 
 
-@pytest.mark.parametrize("args, named", [
-    (["solve", "--set", "discretization.order=3"], "discretization.order = 3"),
-    (["solve", "--set", "discretization.order=2", "--set", "discretization.contact_quadrature=gauss"],
-     "discretization.contact_quadrature"),
-    (["solve", "--set", "discretization.body_force_projection=p1"], "discretization.body_force_projection"),
-    (["solve", "--set", "discretization.order=2", "--set", "discretization.body_force_projection=p2"],
-     "discretization.body_force_projection"),
-])
+@pytest.mark.parametrize(
+    "args, named",
+    [
+        (["solve", "--set", "discretization.order=3"], "discretization.order = 3"),
+        (
+            ["solve", "--set", "discretization.order=2", "--set", "discretization.contact_quadrature=gauss"],
+            "discretization.contact_quadrature",
+        ),
+        (["solve", "--set", "discretization.body_force_projection=p1"], "discretization.body_force_projection"),
+        (
+            ["solve", "--set", "discretization.order=2", "--set", "discretization.body_force_projection=p2"],
+            "discretization.body_force_projection",
+        ),
+    ],
+)
 def test_bad_order_2_requests_are_one_line_errors_through_the_cli(tmp_path, args, named):
-    run = _cli(tmp_path, args[0], PAPER, "-o", "out.nc", *args[1:],
-               "--set", "discretization.mesh.n=2")
+    run = _cli(tmp_path, args[0], PAPER, "-o", "out.nc", *args[1:], "--set", "discretization.mesh.n=2")
     assert run.returncode == 2 and len(run.stderr.splitlines()) == 1 and named in run.stderr, run.stderr
     assert not (tmp_path / "out.nc").exists()
 
@@ -261,8 +306,9 @@ def test_bad_order_2_requests_are_one_line_errors_through_the_cli(tmp_path, args
 def test_order_2_through_the_cli_writes_a_k2_solution_file(tmp_path):
     from vemkit.io.solution_file import read_solution
 
-    run = _cli(tmp_path, "solve", PAPER, "-o", "out.nc", "--set", "discretization.order=2",
-               "--set", "discretization.mesh.n=4")
+    run = _cli(
+        tmp_path, "solve", PAPER, "-o", "out.nc", "--set", "discretization.order=2", "--set", "discretization.mesh.n=4"
+    )
     assert run.returncode == 0, run.stderr
     mesh, ds = read_solution(tmp_path / "out.nc")
     assert ds.attrs["order"] == 2 and ds["u2_edge_mean"].size == mesh.edges.shape[0]

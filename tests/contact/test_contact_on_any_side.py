@@ -15,8 +15,11 @@ PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 def test_a_slanted_contact_side_has_its_own_normal_and_the_solution_passes_the_check():
     data = yaml.safe_load(PAPER.read_text())
     data["domain"] = {"polygon": [[0, 0], [2, 0], [3, 1], [0, 1]], "sides": ["base", "slope", "top", "left"]}
-    data["boundary"] = {"dirichlet": ["left"], "neumann": {"top": {"traction": [0.0, -200.0]}},
-                        "contact": ["base", "slope"]}
+    data["boundary"] = {
+        "dirichlet": ["left"],
+        "neumann": {"top": {"traction": [0.0, -200.0]}},
+        "contact": ["base", "slope"],
+    }
     data["discretization"]["mesh"] = {"family": "voronoi", "n": 6}
     scene = scene_from_dict(data)
     problem = vemkit.scene_problem(scene)

@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-
 from conftest import PAPER
+
 from vemkit.contact.laws import ContactLaw
 from vemkit.contact.problem import discrete_problem
 from vemkit.exceptions import SceneError
@@ -19,10 +19,18 @@ TRACTIONS = {"left": lambda x, y: (200 * (5 - y), -200 + 0 * y), "top": lambda x
 
 
 def problem(n, quadrature, law=PAPER["law"], points=3, dirichlet=("right",), neumann=None):
-    return discrete_problem(square(n), PAPER["E"], PAPER["nu"], dirichlet=dirichlet,
-                            neumann=TRACTIONS if neumann is None else neumann, contact=("bottom",),
-                            gap=lambda x, y: 0.1 + 0 * x, law=law, contact_quadrature=quadrature,
-                            contact_gauss_points=points)
+    return discrete_problem(
+        square(n),
+        PAPER["E"],
+        PAPER["nu"],
+        dirichlet=dirichlet,
+        neumann=TRACTIONS if neumann is None else neumann,
+        contact=("bottom",),
+        gap=lambda x, y: 0.1 + 0 * x,
+        law=law,
+        contact_quadrature=quadrature,
+        contact_gauss_points=points,
+    )
 
 
 def pushed_down(pb, penetration):
@@ -105,6 +113,7 @@ def test_ssn_and_uzawa_agree_with_gauss(law):
 
 def test_gauss_keeps_the_order_of_convergence():
     """H1 errors against a 2^-6 reference: ratios ~2 at n = 4, 8, 16, with either quadrature."""
+
     def vertex_solution(pb):
         return pb.dofs.expand(solve_ssn(pb, linear="direct", tol=1e-12).u)
 

@@ -26,9 +26,18 @@ from vemkit.solvers.solution import SEPARATED, SLIP, STICK, contact_state
 
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 BASE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
-OPTIONS = {"uzawa": {"method": "uzawa", "tol": 1e-12, "linear": "direct", "stop": "both", "eps_u": 1e-13,
-                     "eps_lambda": 1e-13, "max_iterations": 20000},
-           "ssn": {"method": "ssn", "tol": 1e-12, "linear": "direct"}}
+OPTIONS = {
+    "uzawa": {
+        "method": "uzawa",
+        "tol": 1e-12,
+        "linear": "direct",
+        "stop": "both",
+        "eps_u": 1e-13,
+        "eps_lambda": 1e-13,
+        "max_iterations": 20000,
+    },
+    "ssn": {"method": "ssn", "tol": 1e-12, "linear": "direct"},
+}
 
 
 def scenes(family: str, n: int, layers: int, friction: float):
@@ -68,8 +77,11 @@ def test_the_extruded_paper_body_is_the_plane_strain_solve(method, friction, lay
         assert np.sum(states == STICK) > 0
 
 
-@pytest.mark.xfail(strict=True, reason="the 3D stabilization on polygonal prisms is not the 2D one: the "
-                                       "elasticity alone differs (module docstring)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="the 3D stabilization on polygonal prisms is not the 2D one: the "
+    "elasticity alone differs (module docstring)",
+)
 @pytest.mark.parametrize("family", ["square", "voronoi"])
 def test_on_polygonal_prisms_the_elasticity_differs_already(family):
     difference, _, _, _ = compare(family, 4, 1, 450.0, "ssn")
@@ -105,8 +117,12 @@ def test_a_curved_contact_side_on_a_foundation_plane_is_the_plane_strain_solve()
     body.update(model="3d", body_force=[0, 0, 0])
     body["domain"]["extrude"] = {"depth": 0.1}
     body["discretization"]["mesh"]["layers"] = 1
-    body["boundary"]["dirichlet"] = {"top": [None, -0.01, None], "pin": [0.0, -0.01, None],
-                                     "front": [None, None, 0], "back": [None, None, 0]}
+    body["boundary"]["dirichlet"] = {
+        "top": [None, -0.01, None],
+        "pin": [0.0, -0.01, None],
+        "front": [None, None, 0],
+        "back": [None, None, 0],
+    }
     body["contact"]["foundation"] = {"point": [0, -1, 0], "normal": [0, 1, 0]}
     p2, p3 = scene_problem(scene_from_dict(flat)), scene_problem(scene_from_dict(body))
     s2, s3 = solve(p2, OPTIONS["ssn"]), solve(p3, OPTIONS["ssn"])
@@ -114,7 +130,9 @@ def test_a_curved_contact_side_on_a_foundation_plane_is_the_plane_strain_solve()
     base = {tuple(np.round(x, 10)): i for i, x in enumerate(p2.mesh.vertices)}
     below = np.array([base[tuple(np.round(x[:2], 10))] for x in p3.mesh.vertices])
     assert np.max(np.abs(u3[:, :2] - u2[below])) / np.max(np.abs(u2)) < 1e-12
-    forces = [np.sum(p.contact.weight * p.law.normal_pressure(p.contact.normal_displacement(s.u) - p.contact.gap))
-              for p, s in ((p2, s2), (p3, s3))]
+    forces = [
+        np.sum(p.contact.weight * p.law.normal_pressure(p.contact.normal_displacement(s.u) - p.contact.gap))
+        for p, s in ((p2, s2), (p3, s3))
+    ]
     assert forces[0] > 0 and abs(forces[1] / 0.1 / forces[0] - 1) < 1e-12
     assert np.allclose(p3.contact.normal[:, 2], 0.0) and not np.allclose(p3.contact.normal[:, 0], 0.0)

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 import sympy
 import yaml
-
 from manufactured_contact import KINDS, SEPARATION_POINT, scene_text
+
 from vemkit.config.scene import load_scene
 from vemkit.solvers.solution import SEPARATED, SLIP, STICK, contact_state
 from vemkit.studies.scene_solve import solve_scene
@@ -58,7 +58,9 @@ def test_the_exact_solution_solves_the_scene_and_meets_the_contact_law_on_gamma_
     eps = (grad + grad.T) / 2
     sigma = lam * eps.trace() * sympy.eye(2) + 2 * mu * eps
     # interior: f = -div sigma(u); sides: tractions sigma n on left and top, u on the right
-    residual = [_sym(f) + sympy.diff(sigma[i, 0], X) + sympy.diff(sigma[i, 1], Y) for i, f in enumerate(data["body_force"])]
+    residual = [
+        _sym(f) + sympy.diff(sigma[i, 0], X) + sympy.diff(sigma[i, 1], Y) for i, f in enumerate(data["body_force"])
+    ]
     px, py = np.meshgrid(SAMPLES, SAMPLES)
     scale = np.abs(_numeric(sympy.diff(sigma[1, 1], Y))(px, py)).max()
     for r in residual:
@@ -67,11 +69,15 @@ def test_the_exact_solution_solves_the_scene_and_meets_the_contact_law_on_gamma_
     for side, normal, line in (("left", (-1, 0), (0 * SAMPLES, SAMPLES)), ("top", (0, 1), (SAMPLES, 0 * SAMPLES + 1))):
         for i in range(2):
             given = _numeric(_sym(neumann[side]["traction"][i]))(*line)
-            np.testing.assert_allclose(given, _numeric(sigma[i, 0] * normal[0] + sigma[i, 1] * normal[1])(*line),
-                                       atol=1e-10 * scale)
+            np.testing.assert_allclose(
+                given, _numeric(sigma[i, 0] * normal[0] + sigma[i, 1] * normal[1])(*line), atol=1e-10 * scale
+            )
     for i in range(2):
-        np.testing.assert_allclose(_numeric(_sym(data["boundary"]["dirichlet"]["right"][i]))(1 + 0 * SAMPLES, SAMPLES),
-                                   _numeric(u[i])(1 + 0 * SAMPLES, SAMPLES), atol=1e-14)
+        np.testing.assert_allclose(
+            _numeric(_sym(data["boundary"]["dirichlet"]["right"][i]))(1 + 0 * SAMPLES, SAMPLES),
+            _numeric(u[i])(1 + 0 * SAMPLES, SAMPLES),
+            atol=1e-14,
+        )
     # Gamma_C: nu = (0, -1), tau = (1, 0); u_nu = -u2, u_tau = u1; sigma_nu = sigma22, sigma_tau = -sigma12
     law = data["contact"]
     x0 = 0 * SAMPLES
@@ -119,8 +125,14 @@ def test_the_p1_body_force_load_gives_k2_its_l2_order_3_with_contact(kind):
     found = {}
     for projection in ("p0", "p1"):
         for n in (8, 16):
-            scene = load_scene(path, [f"discretization.mesh.n={n}", "discretization.order=2",
-                                      f"discretization.body_force_projection={projection}"])
+            scene = load_scene(
+                path,
+                [
+                    f"discretization.mesh.n={n}",
+                    "discretization.order=2",
+                    f"discretization.body_force_projection={projection}",
+                ],
+            )
             ds = solve_scene(scene, verify=True)[2]
             found[projection, n] = (ds.attrs["error_h1"], ds.attrs["error_l2"])
     l2 = {p: np.log2(found[p, 8][1] / found[p, 16][1]) for p in ("p0", "p1")}

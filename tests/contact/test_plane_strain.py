@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import FAMILY_CASES  # noqa: F401  (the families' options)
+
 from vemkit.config.scene import scene_from_dict
 from vemkit.studies.scene_solve import solve_scene
 
@@ -33,15 +33,20 @@ def radial(model: str) -> str:
 
 def cylinder(model: str, exact_model: str, h: float, order: int = 1) -> dict:
     g = radial(exact_model)
-    return {"name": "lame", "model": model,
-            "domain": {"polygon": [[A, 0], [B, 0], [0, B], [0, A]], "sides": ["bottom", "outer", "left", "bore"],
-                       "arcs": [None, [0, 0], None, [0, 0]]},
-            "material": {"E": E, "nu": NU},
-            "boundary": {"dirichlet": {"bottom": [None, 0.0], "left": [0.0, None]},
-                         "neumann": {"bore": {"pressure": P}}},
-            "discretization": {"mesh": {"family": "triangle", "h": h}, "order": order},
-            "exact": {"displacement": [f"x*{g}", f"y*{g}"]},
-            "solver": {"method": "ssn", "tol": 1e-12}}
+    return {
+        "name": "lame",
+        "model": model,
+        "domain": {
+            "polygon": [[A, 0], [B, 0], [0, B], [0, A]],
+            "sides": ["bottom", "outer", "left", "bore"],
+            "arcs": [None, [0, 0], None, [0, 0]],
+        },
+        "material": {"E": E, "nu": NU},
+        "boundary": {"dirichlet": {"bottom": [None, 0.0], "left": [0.0, None]}, "neumann": {"bore": {"pressure": P}}},
+        "discretization": {"mesh": {"family": "triangle", "h": h}, "order": order},
+        "exact": {"displacement": [f"x*{g}", f"y*{g}"]},
+        "solver": {"method": "ssn", "tol": 1e-12},
+    }
 
 
 @pytest.mark.parametrize("model", ["plane_stress", "plane_strain"])
@@ -54,18 +59,27 @@ def test_the_thick_cylinder_converges_to_lames_closed_form_of_its_model(model):
 
 
 def test_plane_strain_with_k2_converges_at_order_two():
-    errors = [solve_scene(scene_from_dict(cylinder("plane_strain", "plane_strain", h, 2)))[2].attrs["error_h1_semi"]
-              for h in (0.4, 0.2)]
+    errors = [
+        solve_scene(scene_from_dict(cylinder("plane_strain", "plane_strain", h, 2)))[2].attrs["error_h1_semi"]
+        for h in (0.4, 0.2)
+    ]
     assert np.log2(errors[0] / errors[1]) > 1.7, errors
 
 
 @pytest.mark.parametrize("family", ["square", "triangle", "voronoi", "hanging"])
 @pytest.mark.parametrize("model, factor", [("plane_stress", (1 - NU)), ("plane_strain", (1 + NU) * (1 - 2 * NU))])
 def test_uniform_pressure_gives_the_models_exact_strain_on_every_family(family, model, factor):
-    scene = {"name": "compression", "model": model, "material": {"E": E, "nu": NU},
-             "boundary": {"dirichlet": {"left": [0.0, None], "bottom": [None, 0.0]},
-                          "neumann": {"right": {"pressure": P}, "top": {"pressure": P}}},
-             "discretization": {"mesh": {"family": family, "n": 4}}, "solver": {"method": "ssn", "tol": 1e-12}}
+    scene = {
+        "name": "compression",
+        "model": model,
+        "material": {"E": E, "nu": NU},
+        "boundary": {
+            "dirichlet": {"left": [0.0, None], "bottom": [None, 0.0]},
+            "neumann": {"right": {"pressure": P}, "top": {"pressure": P}},
+        },
+        "discretization": {"mesh": {"family": family, "n": 4}},
+        "solver": {"method": "ssn", "tol": 1e-12},
+    }
     _, _, ds = solve_scene(scene_from_dict(scene))
     x, y = ds["mesh2d_node_x"].values, ds["mesh2d_node_y"].values
     assert np.max(np.abs(ds["u1"].values + P * factor / E * x)) < 1e-12

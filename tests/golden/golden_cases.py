@@ -20,40 +20,92 @@ _PAPER, _SCENES, _ORDER2 = "config/scenes/paper.yaml", "config/scenes", "config/
 #: name -> (command, scene, overrides)
 CASES = {
     "k1_paper_square_ssn": ("solve", _PAPER, ["discretization.mesh.n=8"]),
-    "k1_paper_voronoi_uzawa": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.mesh.family=voronoi",
-                                                 "solver.method=uzawa"]),
-    "k1_paper_triangle_gauss": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.mesh.family=triangle",
-                                                  "discretization.contact_quadrature=gauss"]),
-    "k1_paper_hanging_trace": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.mesh.family=hanging",
-                                                 "discretization.stabilization=trace"]),
+    "k1_paper_voronoi_uzawa": (
+        "solve",
+        _PAPER,
+        ["discretization.mesh.n=8", "discretization.mesh.family=voronoi", "solver.method=uzawa"],
+    ),
+    "k1_paper_triangle_gauss": (
+        "solve",
+        _PAPER,
+        ["discretization.mesh.n=8", "discretization.mesh.family=triangle", "discretization.contact_quadrature=gauss"],
+    ),
+    "k1_paper_hanging_trace": (
+        "solve",
+        _PAPER,
+        ["discretization.mesh.n=8", "discretization.mesh.family=hanging", "discretization.stabilization=trace"],
+    ),
     "k1_sliding_body_force": ("solve", f"{_ORDER2}/sliding.yaml", []),
     "k1_kirsch_triangle": ("solve", f"{_SCENES}/kirsch.yaml", ["discretization.mesh.h=0.4"]),
     "k1_hertz_curved_contact": ("solve", f"{_SCENES}/hertz.yaml", ["discretization.mesh.h=0.04"]),
     "k1_lbracket_rollers": ("solve", f"{_SCENES}/lbracket.yaml", ["discretization.mesh.h=2.0"]),
     "k1_paper_adapt": ("adapt", _PAPER, ["discretization.mesh.n=4", "adaptivity.max_steps=3"]),
     "k2_paper_square_ssn": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.order=2"]),
-    "k2_paper_voronoi_uzawa": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.order=2",
-                                                 "discretization.mesh.family=voronoi", "solver.method=uzawa"]),
-    "k2_paper_hanging": ("solve", _PAPER, ["discretization.mesh.n=8", "discretization.order=2",
-                                           "discretization.mesh.family=hanging"]),
-    "k2_sliding_p0": ("solve", f"{_ORDER2}/sliding.yaml", ["discretization.order=2",
-                                                          "discretization.body_force_projection=p0"]),
-    "k2_sticking_p1": ("solve", f"{_ORDER2}/sticking.yaml", ["discretization.order=2",
-                                                            "discretization.body_force_projection=p1"]),
-    "k2_separation_p0": ("solve", f"{_ORDER2}/separation.yaml", ["discretization.order=2",
-                                                                "discretization.body_force_projection=p0",
-                                                                "discretization.mesh.family=voronoi"]),
-    "k2_lbracket_rollers": ("solve", f"{_SCENES}/lbracket.yaml", ["discretization.mesh.h=2.0",
-                                                                 "discretization.order=2"]),
-    "k2_kirsch_triangle": ("solve", f"{_SCENES}/kirsch.yaml", ["discretization.mesh.h=0.4",
-                                                              "discretization.order=2"]),
+    "k2_paper_voronoi_uzawa": (
+        "solve",
+        _PAPER,
+        [
+            "discretization.mesh.n=8",
+            "discretization.order=2",
+            "discretization.mesh.family=voronoi",
+            "solver.method=uzawa",
+        ],
+    ),
+    "k2_paper_hanging": (
+        "solve",
+        _PAPER,
+        ["discretization.mesh.n=8", "discretization.order=2", "discretization.mesh.family=hanging"],
+    ),
+    "k2_sliding_p0": (
+        "solve",
+        f"{_ORDER2}/sliding.yaml",
+        ["discretization.order=2", "discretization.body_force_projection=p0"],
+    ),
+    "k2_sticking_p1": (
+        "solve",
+        f"{_ORDER2}/sticking.yaml",
+        ["discretization.order=2", "discretization.body_force_projection=p1"],
+    ),
+    "k2_separation_p0": (
+        "solve",
+        f"{_ORDER2}/separation.yaml",
+        ["discretization.order=2", "discretization.body_force_projection=p0", "discretization.mesh.family=voronoi"],
+    ),
+    "k2_lbracket_rollers": (
+        "solve",
+        f"{_SCENES}/lbracket.yaml",
+        ["discretization.mesh.h=2.0", "discretization.order=2"],
+    ),
+    "k2_kirsch_triangle": ("solve", f"{_SCENES}/kirsch.yaml", ["discretization.mesh.h=0.4", "discretization.order=2"]),
 }
 
 #: the numbers of a solution file that the code computes (not timings, versions or paths)
-VARIABLES = ("u1", "u2", "strain_11", "strain_22", "strain_12", "stress_11", "stress_22", "stress_12",
-             "shear_energy_density", "normal_pressure", "tangential_stress", "friction_multiplier", "slip",
-             "penetration", "contact_state", "contact_weight", "u1_edge_mean", "u2_edge_mean", "u1_face_mean",
-             "u2_face_mean", "error_indicator", "mesh2d_node_x", "mesh2d_node_y", "mesh2d_face_nodes")
+VARIABLES = (
+    "u1",
+    "u2",
+    "strain_11",
+    "strain_22",
+    "strain_12",
+    "stress_11",
+    "stress_22",
+    "stress_12",
+    "shear_energy_density",
+    "normal_pressure",
+    "tangential_stress",
+    "friction_multiplier",
+    "slip",
+    "penetration",
+    "contact_state",
+    "contact_weight",
+    "u1_edge_mean",
+    "u2_edge_mean",
+    "u1_face_mean",
+    "u2_face_mean",
+    "error_indicator",
+    "mesh2d_node_x",
+    "mesh2d_node_y",
+    "mesh2d_face_nodes",
+)
 ATTRIBUTES = ("iterations", "linear_iterations", "n_dofs", "n_space_dofs")
 
 
@@ -66,12 +118,17 @@ def machine() -> str:
 
     cpu = ""
     try:
-        cpu = next(line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                   if line.startswith("model name"))
+        cpu = next(
+            line.split(":", 1)[1].strip()
+            for line in Path("/proc/cpuinfo").read_text().splitlines()
+            if line.startswith("model name")
+        )
     except (OSError, StopIteration):
         cpu = platform.processor()
-    return (f"{cpu} | python {platform.python_version()} numpy {numpy.__version__} scipy {scipy.__version__} "
-            f"numba {numba.__version__} pyamg {pyamg.__version__}")
+    return (
+        f"{cpu} | python {platform.python_version()} numpy {numpy.__version__} scipy {scipy.__version__} "
+        f"numba {numba.__version__} pyamg {pyamg.__version__}"
+    )
 
 
 def run_case(name: str, directory: Path):

@@ -18,7 +18,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import xarray as xr
-
 from golden_cases import ATTRIBUTES, CASES, GOLDEN, VARIABLES, machine, run_case
 
 pytestmark = pytest.mark.slow

@@ -13,11 +13,18 @@ from vemkit.mesh.families import build_mesh
 
 R = 1.0
 # corners (-1, 0), (-0.6, -0.8), (0.6, -0.8), (1, 0) on the unit circle: three arcs and the flat top
-HALF_DISK = {"polygon": [[-R, 0], [-0.6, -0.8], [0.6, -0.8], [R, 0]], "sides": ["flank", "contact", "flank", "top"],
-             "arcs": [[0, 0], [0, 0], [0, 0], None]}
-CASES = [("square", {}), ("triangle", {"seed": 1}), ("voronoi", {"seed": 2}),
-         ("hanging", {"levels": 2, "contact_side": "contact"}),
-         ("hanging", {"levels": 1, "rule": "random", "seed": 3, "fraction": 0.3})]
+HALF_DISK = {
+    "polygon": [[-R, 0], [-0.6, -0.8], [0.6, -0.8], [R, 0]],
+    "sides": ["flank", "contact", "flank", "top"],
+    "arcs": [[0, 0], [0, 0], [0, 0], None],
+}
+CASES = [
+    ("square", {}),
+    ("triangle", {"seed": 1}),
+    ("voronoi", {"seed": 2}),
+    ("hanging", {"levels": 2, "contact_side": "contact"}),
+    ("hanging", {"levels": 1, "rule": "random", "seed": 3, "fraction": 0.3}),
+]
 IDS = ["square", "triangle", "voronoi", "hanging-contact", "hanging-random"]
 N = 8
 

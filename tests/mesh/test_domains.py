@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 import shapely
 
+from vemkit.config.domain import UNIT_SQUARE, UNIT_SQUARE_SIDES, CircleHole, domain_from_spec
 from vemkit.exceptions import InputError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.config.domain import UNIT_SQUARE, UNIT_SQUARE_SIDES, CircleHole, domain_from_spec
 from vemkit.mesh.families import build_mesh
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.space import VirtualElementSpace
@@ -18,12 +18,18 @@ from vemkit.vem.space import VirtualElementSpace
 BRACKET = {
     "polygon": [[0, 0], [3, 0], [3, 1], [1.2, 1], [1.2, 2], [0, 2]],
     "sides": ["bottom", "right", "shelf", "step", "top", "left"],
-    "holes": [{"circle": [0.6, 0.6, 0.25], "side": "bore"},
-              {"polygon": [[2.0, 0.3], [2.2, 0.7], [2.5, 0.3]], "sides": ["slot_a", "slot_b", "slot_c"]}],
+    "holes": [
+        {"circle": [0.6, 0.6, 0.25], "side": "bore"},
+        {"polygon": [[2.0, 0.3], [2.2, 0.7], [2.5, 0.3]], "sides": ["slot_a", "slot_b", "slot_c"]},
+    ],
 }
-FAMILY_CASES = [("square", {}), ("triangle", {"seed": 3}), ("voronoi", {"seed": 2}),
-                ("hanging", {"levels": 2, "contact_side": "bore"}),
-                ("hanging", {"levels": 2, "rule": "random", "seed": 4, "fraction": 0.4})]
+FAMILY_CASES = [
+    ("square", {}),
+    ("triangle", {"seed": 3}),
+    ("voronoi", {"seed": 2}),
+    ("hanging", {"levels": 2, "contact_side": "bore"}),
+    ("hanging", {"levels": 2, "rule": "random", "seed": 4, "fraction": 0.4}),
+]
 IDS = [f"{f}-{'-'.join(f'{k}={v}' for k, v in o.items())}" for f, o in FAMILY_CASES]
 N = 6
 
@@ -137,8 +143,12 @@ def test_unit_square_spec_is_the_old_mesh():
     for family, options in [("square", {}), ("voronoi", {"seed": 1}), ("triangle", {}), ("hanging", {"levels": 2})]:
         old = build_mesh(family, 8, **options)
         new = build_mesh(family, 8, domain="unit_square", **options)
-        same = build_mesh(family, h=0.125, domain={"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
-                                                    "sides": ["bottom", "right", "top", "left"]}, **options)
+        same = build_mesh(
+            family,
+            h=0.125,
+            domain={"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]},
+            **options,
+        )
         for m in (new, same):
             assert np.array_equal(m.vertices, old.vertices) and np.array_equal(m.cell_vertices, old.cell_vertices)
             assert m.meta == old.meta and list(m.boundary) == list(old.boundary)
@@ -161,34 +171,87 @@ BAD_DOMAINS = [
     ({"polygon": [[0, 0], [2, 0], [0, 2], [2, 2]], "sides": SIDES4}, "domain.polygon", "crosses itself"),
     ({"polygon": SQUARE[::-1], "sides": SIDES4}, "domain.polygon", "is clockwise; list its corners counter-clockwise"),
     ({"polygon": SQUARE, "sides": ["a", "b", "c"]}, "domain.sides", "has 3 names but the polygon has 4 edges"),
-    ({"polygon": [[0, 0], [2, 0], [2, 0], [2, 2], [0, 2]], "sides": SIDES4 + ["e"]}, "domain.polygon",
-     "edge 1 from (2, 0) to (2, 0) has zero length"),
+    (
+        {"polygon": [[0, 0], [2, 0], [2, 0], [2, 2], [0, 2]], "sides": SIDES4 + ["e"]},
+        "domain.polygon",
+        "edge 1 from (2, 0) to (2, 0) has zero length",
+    ),
     ({"polygon": SQUARE + [[0, 0]], "sides": SIDES4 + ["e"]}, "domain.polygon", "do not repeat the first corner"),
     ({"polygon": SQUARE, "sides": ["a", "b c", "c", "d"]}, "domain.sides", "side name 'b c' is not an identifier"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, 0], "side": "h"}]}, "domain.holes[0].circle",
-     "radius 0 must be a positive"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, -0.5], "side": "h"}]}, "domain.holes[0].circle",
-     "radius -0.5 must be a positive"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [5, 5, 0.5], "side": "h"}]}, "domain.holes[0]",
-     "lies outside the body"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[3, 3], [4, 3], [4, 4]], "sides": ["h"] * 3}]},
-     "domain.holes[0]", "lies outside the body"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1.8, 1, 0.5], "side": "h"}]}, "domain.holes[0]",
-     "overlaps the outer boundary"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[1, 1], [2.5, 1], [1, 1.5]], "sides": ["h"] * 3}]},
-     "domain.holes[0]", "overlaps the outer boundary"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [0.7, 1, 0.3], "side": "h"},
-                                                    {"circle": [1.2, 1, 0.3], "side": "k"}]},
-     "domain.holes[1]", "overlaps domain.holes[0]"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[0.5, 0.5], [1.5, 0.5], [1, 1.5]], "sides": ["h"] * 3},
-                                                    {"circle": [1, 0.8, 0.1], "side": "k"}]},
-     "domain.holes[1]", "overlaps domain.holes[0]"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[0.5, 0.5], [1.5, 1.5], [1.5, 0.5], [0.5, 1.5]],
-                                                     "sides": ["h"] * 4}]}, "domain.holes[0].polygon", "crosses itself"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, 0.2], "side": "h?"}]}, "domain.holes[0].side",
-     "is not an identifier"),
-    ({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[0.5, 0.5], [1.5, 0.5], [1, 1.5]], "sides": ["h"]}]},
-     "domain.holes[0].sides", "has 1 names but the polygon has 3 edges"),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, 0], "side": "h"}]},
+        "domain.holes[0].circle",
+        "radius 0 must be a positive",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, -0.5], "side": "h"}]},
+        "domain.holes[0].circle",
+        "radius -0.5 must be a positive",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [5, 5, 0.5], "side": "h"}]},
+        "domain.holes[0]",
+        "lies outside the body",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[3, 3], [4, 3], [4, 4]], "sides": ["h"] * 3}]},
+        "domain.holes[0]",
+        "lies outside the body",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1.8, 1, 0.5], "side": "h"}]},
+        "domain.holes[0]",
+        "overlaps the outer boundary",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": [[1, 1], [2.5, 1], [1, 1.5]], "sides": ["h"] * 3}]},
+        "domain.holes[0]",
+        "overlaps the outer boundary",
+    ),
+    (
+        {
+            "polygon": SQUARE,
+            "sides": SIDES4,
+            "holes": [{"circle": [0.7, 1, 0.3], "side": "h"}, {"circle": [1.2, 1, 0.3], "side": "k"}],
+        },
+        "domain.holes[1]",
+        "overlaps domain.holes[0]",
+    ),
+    (
+        {
+            "polygon": SQUARE,
+            "sides": SIDES4,
+            "holes": [
+                {"polygon": [[0.5, 0.5], [1.5, 0.5], [1, 1.5]], "sides": ["h"] * 3},
+                {"circle": [1, 0.8, 0.1], "side": "k"},
+            ],
+        },
+        "domain.holes[1]",
+        "overlaps domain.holes[0]",
+    ),
+    (
+        {
+            "polygon": SQUARE,
+            "sides": SIDES4,
+            "holes": [{"polygon": [[0.5, 0.5], [1.5, 1.5], [1.5, 0.5], [0.5, 1.5]], "sides": ["h"] * 4}],
+        },
+        "domain.holes[0].polygon",
+        "crosses itself",
+    ),
+    (
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"circle": [1, 1, 0.2], "side": "h?"}]},
+        "domain.holes[0].side",
+        "is not an identifier",
+    ),
+    (
+        {
+            "polygon": SQUARE,
+            "sides": SIDES4,
+            "holes": [{"polygon": [[0.5, 0.5], [1.5, 0.5], [1, 1.5]], "sides": ["h"]}],
+        },
+        "domain.holes[0].sides",
+        "has 1 names but the polygon has 3 edges",
+    ),
     ({"polygon": SQUARE}, "domain.sides", "domain.sides is missing"),
     ({"polygon": SQUARE, "sides": SIDES4, "hole": []}, "domain.hole", "unknown key"),
     ("unit_circle", "domain", "the only named domain is unit_square"),
@@ -206,8 +269,9 @@ def test_broken_domains_are_refused_with_one_line(spec, key, message):
 def test_holes_may_be_given_either_way_round():
     hole = [[0.5, 0.5], [1.5, 0.5], [1, 1.5]]
     ccw = domain_from_spec({"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": hole, "sides": ["p", "q", "r"]}]})
-    cw = domain_from_spec({"polygon": SQUARE, "sides": SIDES4,
-                           "holes": [{"polygon": hole[::-1], "sides": ["q", "p", "r"]}]})
+    cw = domain_from_spec(
+        {"polygon": SQUARE, "sides": SIDES4, "holes": [{"polygon": hole[::-1], "sides": ["q", "p", "r"]}]}
+    )
     assert ccw == cw  # the same edges carry the same names
     mesh = build_mesh("triangle", 8, domain=cw)
     validate_mesh(mesh)

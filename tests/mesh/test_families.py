@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 import shapely
 
+from vemkit.config.domain import UNIT_SQUARE_SIDES
+from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import FAMILIES, build_mesh
 from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
-from vemkit.config.domain import UNIT_SQUARE_SIDES
-from vemkit.mesh.checks import validate_mesh
 
 CASES = [
     ("square", 6, {}),
@@ -28,9 +28,13 @@ SIDE = {"left": (0, 0.0), "right": (0, 1.0), "bottom": (1, 0.0), "top": (1, 1.0)
 
 
 def same_mesh(a, b):
-    return (np.array_equal(a.vertices, b.vertices) and np.array_equal(a.cell_offsets, b.cell_offsets)
-            and np.array_equal(a.cell_vertices, b.cell_vertices) and a.meta == b.meta
-            and all(np.array_equal(a.boundary[k], b.boundary[k]) for k in a.boundary))
+    return (
+        np.array_equal(a.vertices, b.vertices)
+        and np.array_equal(a.cell_offsets, b.cell_offsets)
+        and np.array_equal(a.cell_vertices, b.cell_vertices)
+        and a.meta == b.meta
+        and all(np.array_equal(a.boundary[k], b.boundary[k]) for k in a.boundary)
+    )
 
 
 @pytest.mark.parametrize("family, n, options", CASES, ids=IDS)
@@ -130,8 +134,14 @@ def test_hanging_contact_layer():
     n, levels = 4, 3
     mesh = hanging(n, levels)
     assert mesh.n_cells == n * n + 3 * n * (2**levels - 1)
-    assert mesh.meta == {"family": "hanging", "n": n, "levels": levels, "rule": "contact", "seed": 0,
-                         "contact_side": "bottom"}
+    assert mesh.meta == {
+        "family": "hanging",
+        "n": n,
+        "levels": levels,
+        "rule": "contact",
+        "seed": 0,
+        "contact_side": "bottom",
+    }
     bottom = mesh.vertices[mesh.boundary["bottom"]]
     np.testing.assert_allclose(np.abs(bottom[:, 1, 0] - bottom[:, 0, 0]), 1 / (n * 2**levels))
     top = mesh.vertices[mesh.boundary["top"]]

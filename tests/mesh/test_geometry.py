@@ -53,7 +53,7 @@ def test_hanging_nodes_are_inserted_into_the_larger_cell():
     cells = [[0, 1, 2, 3], [1, 4, 5, 6], [6, 5, 7, 2]]
     mesh = from_polygons(v, cells)
     offsets, refs = insert_edge_vertices(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, 1e-12)
-    fixed = from_polygons(v, [refs[offsets[k]:offsets[k + 1]] for k in range(3)])
+    fixed = from_polygons(v, [refs[offsets[k] : offsets[k + 1]] for k in range(3)])
     assert fixed.cell(0).tolist() == [0, 1, 6, 2, 3]
     assert fixed.cell(1).tolist() == [1, 4, 5, 6] and fixed.cell(2).tolist() == [6, 5, 7, 2]
     validate_mesh(fixed)

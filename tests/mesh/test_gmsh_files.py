@@ -34,7 +34,9 @@ def gmsh_v2(cells: dict, names: bool = True, sides=SIDES) -> str:
     elements = [(GMSH_TYPE["line"], tag, line) for tag, (_, lines) in sides.items() for line in lines]
     elements += [(GMSH_TYPE[kind], 10, cell) for kind, group in cells.items() for cell in group]
     out += ["$Elements", str(len(elements))]
-    out += [f"{k + 1} {kind} 2 {tag} {tag} " + " ".join(map(str, nodes)) for k, (kind, tag, nodes) in enumerate(elements)]
+    out += [
+        f"{k + 1} {kind} 2 {tag} {tag} " + " ".join(map(str, nodes)) for k, (kind, tag, nodes) in enumerate(elements)
+    ]
     return "\n".join(out + ["$EndElements", ""])
 
 
@@ -132,8 +134,11 @@ def test_broken_gmsh_meshes_are_refused_naming_the_culprit(tmp_path, cells, mess
 
 def test_unreadable_and_wrong_files_are_refused(tmp_path):
     bad_node = gmsh_v2({"quad": QUADS[:5] + [(6, 7, 11, 99)]}, sides={})
-    with pytest.raises(MeshError, match=r"mesh.msh, line 30: the element uses node 99, which \$Nodes does not "
-                                        "declare; fix that line"):
+    with pytest.raises(
+        MeshError,
+        match=r"mesh.msh, line 30: the element uses node 99, which \$Nodes does not "
+        "declare; fix that line",
+    ):
         read_mesh(write(tmp_path, bad_node))
     with pytest.raises(MeshError, match="line element .* is not a boundary edge"):
         read_mesh(write(tmp_path, gmsh_v2({"quad": QUADS}, sides={7: ("inner", [(6, 7)])})))
@@ -144,9 +149,16 @@ def test_unreadable_and_wrong_files_are_refused(tmp_path):
 
 
 def test_read_mesh_reads_ugrid_with_its_sides(tmp_path):
-    mesh = build_mesh("voronoi", 4, seed=1, domain={"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
-                                                    "sides": ["bottom", "right-side", "top", "left"],
-                                                    "holes": [{"circle": [1, 0.5, 0.2], "side": "hole"}]})
+    mesh = build_mesh(
+        "voronoi",
+        4,
+        seed=1,
+        domain={
+            "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+            "sides": ["bottom", "right-side", "top", "left"],
+            "holes": [{"circle": [1, 0.5, 0.2], "side": "hole"}],
+        },
+    )
     write_ugrid(mesh, tmp_path / "mesh.nc")
     back = read_mesh(tmp_path / "mesh.nc")
     assert list(back.boundary) == list(mesh.boundary) and "right-side" in back.boundary
@@ -164,5 +176,7 @@ def test_broken_ugrid_and_3d_gmsh_are_refused(tmp_path):
     with pytest.raises(MeshError, match=re.escape("mesh.nc: cell 0 is clockwise")):
         read_mesh(tmp_path / "mesh.nc")
     lifted = gmsh_v2({"quad": QUADS}).replace("\n13 7.0 7.0 0\n", "\n13 7.0 7.0 0.5\n")
-    with pytest.raises(MeshError, match=re.escape("mesh.msh: node 12 (counting from 0) has z = 0.5; give a plane mesh")):
+    with pytest.raises(
+        MeshError, match=re.escape("mesh.msh: node 12 (counting from 0) has z = 0.5; give a plane mesh")
+    ):
         read_mesh(write(tmp_path, lifted))

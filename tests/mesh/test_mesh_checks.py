@@ -5,10 +5,11 @@ import time
 import numpy as np
 import pytest
 
+from vemkit.exceptions import MeshError
+from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families.square import square, structured_triangle
 from vemkit.mesh.mesh import Mesh, from_polygons
-from vemkit.mesh.checks import validate_mesh
-from vemkit.exceptions import MeshError
+
 # two unit squares side by side: vertices 0..5
 #   3---4---5
 #   | 0 | 1 |
@@ -106,8 +107,12 @@ def test_edge_traversed_twice_in_same_direction():
 def test_t_junction_is_named():
     # the big square does not list vertex 7, the corner of its two small neighbours
     v = [[0, 0], [2, 0], [2, 2], [0, 2], [3, 0], [3, 1], [3, 2], [2, 1]]
-    rejects(from_polygons(v, [[0, 1, 2, 3], [1, 4, 5, 7], [7, 5, 6, 2]]),
-            "vertex 7 lies inside edge (1, 2) of cell 0", "T-junction", "insert vertex 7 into cell 0")
+    rejects(
+        from_polygons(v, [[0, 1, 2, 3], [1, 4, 5, 7], [7, 5, 6, 2]]),
+        "vertex 7 lies inside edge (1, 2) of cell 0",
+        "T-junction",
+        "insert vertex 7 into cell 0",
+    )
 
 
 def test_double_cover_around_a_vertex():

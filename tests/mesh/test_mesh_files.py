@@ -46,7 +46,10 @@ def test_ugrid_file_layout(tmp_path):
         faces = ds["mesh2d_face_nodes"]
         assert faces.dims == ("mesh2d_nFaces", "mesh2d_nMax_face_nodes")
         assert faces.attrs["_FillValue"] == -1 and faces.attrs["start_index"] == 0
-        assert faces.shape == (mesh.n_cells, 5) and (faces.values == -1).sum() == mesh.n_cells * 5 - mesh.cell_vertices.size
+        assert (
+            faces.shape == (mesh.n_cells, 5)
+            and (faces.values == -1).sum() == mesh.n_cells * 5 - mesh.cell_vertices.size
+        )
         assert ds["mesh2d_node_x"].dims == ("mesh2d_nNodes",) and ds["mesh2d_node_x"].dtype == np.float64
         assert ds["boundary_bottom"].dims == ("boundary_bottom_nEdges", "two")
         assert "UGRID-1.0" in ds.attrs["Conventions"]
@@ -61,7 +64,7 @@ def test_padded_face_nodes_matches_a_loop():
     for k in range(mesh.n_cells):
         row = table[k]
         np.testing.assert_array_equal(row[row >= 0], mesh.cell(k))
-        assert (row[mesh.cell_sizes[k]:] == -1).all()
+        assert (row[mesh.cell_sizes[k] :] == -1).all()
 
 
 def test_dataset_takes_node_data_and_reads_back_as_a_mesh(tmp_path):

@@ -4,8 +4,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import FAMILY_CASES, family_mesh
+
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.mesh import from_polygons
@@ -27,7 +27,9 @@ def _adapted(case: str, steps: int = 3, fraction: float = 0.3, max_hanging=None)
 
 
 def _side_lengths(mesh):
-    return {k: float(np.linalg.norm(np.diff(mesh.vertices[e], axis=1), axis=-1).sum()) for k, e in mesh.boundary.items()}
+    return {
+        k: float(np.linalg.norm(np.diff(mesh.vertices[e], axis=1), axis=-1).sum()) for k, e in mesh.boundary.items()
+    }
 
 
 def test_a_square_is_quadrisected_and_its_neighbours_gain_hanging_nodes():
@@ -100,8 +102,12 @@ def test_new_vertices_on_a_circular_side_lie_on_the_circle():
     m = 16
     t = 2 * np.pi * np.arange(m) / m
     ring = np.stack([np.cos(t), np.sin(t)], axis=1)
-    mesh = from_polygons(np.r_[ring, [[0.0, 0.0]]], [[i, (i + 1) % m, m] for i in range(m)],
-                         {"rim": [[i, (i + 1) % m] for i in range(m)]}, {"circles": {"rim": [0.0, 0.0, 1.0]}})
+    mesh = from_polygons(
+        np.r_[ring, [[0.0, 0.0]]],
+        [[i, (i + 1) % m, m] for i in range(m)],
+        {"rim": [[i, (i + 1) % m] for i in range(m)]},
+        {"circles": {"rim": [0.0, 0.0, 1.0]}},
+    )
     refined = refine_cells(mesh, np.arange(m)).mesh
     validate_mesh(refined)
     rim = np.unique(refined.boundary["rim"])
@@ -145,8 +151,9 @@ def test_cut_cells_at_a_circular_hole_are_split_with_every_new_vertex_on_the_cir
     from vemkit.mesh.families import scene_mesh
     from vemkit.studies.adaptivity import curved_sides
 
-    scene = load_scene(Path(__file__).resolve().parents[2] / "config" / "scenes" / "lbracket.yaml",
-                       ["discretization.mesh.h=2.5"])
+    scene = load_scene(
+        Path(__file__).resolve().parents[2] / "config" / "scenes" / "lbracket.yaml", ["discretization.mesh.h=2.5"]
+    )
     mesh, circles = scene_mesh(scene), curved_sides(scene.domain)
     area = mesh.cell_areas.sum()
     for step in range(4):
@@ -169,8 +176,9 @@ def test_a_new_vertex_the_circle_would_push_out_of_its_cell_stays_on_the_chord()
     # a thin strip x + y in [1, 1.05] whose side on the unit circle is one chord: the circle's midpoint
     # (0.707, 0.707) lies beyond the strip, so that cell keeps its new vertex at the chord's midpoint
     v = [[1, 0], [1.05, 0], [0, 1.05], [0, 1]]
-    mesh = from_polygons(v, [[0, 1, 2, 3]], {"outer": [[0, 1], [1, 2], [2, 3]], "hole": [[3, 0]]},
-                         {"circles": {"hole": [0.0, 0.0, 1.0]}})
+    mesh = from_polygons(
+        v, [[0, 1, 2, 3]], {"outer": [[0, 1], [1, 2], [2, 3]], "hole": [[3, 0]]}, {"circles": {"hole": [0.0, 0.0, 1.0]}}
+    )
     refined = refine_cells(mesh, [0])
     assert refined.skipped.size == 0 and refined.mesh.n_cells == 4
     validate_mesh(refined.mesh)

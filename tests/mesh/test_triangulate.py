@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.mesh import from_polygons
-from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.triangulate import ear_clip_reference, triangulate_cells
 
 L_SHAPE = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
@@ -14,8 +14,7 @@ COMB = [(0, 0), (5, 0), (5, 3), (4, 3), (4, 1), (3, 1), (3, 3), (2, 3), (2, 1), 
 # a square with hanging nodes on every side, two on the bottom
 HANGING_SQUARE = [(0, 0), (0.25, 0), (0.5, 0), (1, 0), (1, 0.5), (1, 1), (0.5, 1), (0, 1), (0, 0.5)]
 # an L whose re-entrant corner has collinear neighbours, and collinear runs on the long sides
-COLLINEAR_L = [(0, 0), (1, 0), (2, 0), (2, 0.5), (2, 1), (1.5, 1), (1, 1), (1, 1.5), (1, 2), (0.5, 2), (0, 2),
-               (0, 1)]
+COLLINEAR_L = [(0, 0), (1, 0), (2, 0), (2, 0.5), (2, 1), (1.5, 1), (1, 1), (1, 1.5), (1, 2), (0.5, 2), (0, 2), (0, 1)]
 POLYGONS = {"L": L_SHAPE, "arrow": ARROW, "comb": COMB, "hanging": HANGING_SQUARE, "collinear L": COLLINEAR_L}
 
 
@@ -74,13 +73,16 @@ def test_random_star_polygons(seed):
     assert_proper(xy, tris)
 
 
-@pytest.mark.parametrize("family, options", [
-    ("square", {}),
-    ("triangle", {"seed": 1}),
-    ("voronoi", {"seed": 3}),
-    ("voronoi", {"seed": 4, "lloyd_iterations": 0}),
-    ("hanging", {"levels": 3, "rule": "random", "fraction": 0.4, "seed": 2}),
-])
+@pytest.mark.parametrize(
+    "family, options",
+    [
+        ("square", {}),
+        ("triangle", {"seed": 1}),
+        ("voronoi", {"seed": 3}),
+        ("voronoi", {"seed": 4, "lloyd_iterations": 0}),
+        ("hanging", {"levels": 3, "rule": "random", "fraction": 0.4, "seed": 2}),
+    ],
+)
 def test_family_meshes(family, options):
     mesh = build_mesh(family, 8, **options)
     tris, parent = triangulate_cells(mesh)

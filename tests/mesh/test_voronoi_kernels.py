@@ -17,8 +17,11 @@ from vemkit.mesh.geometry import areas_centroids, areas_centroids_numpy
 
 voronoi_module = sys.modules["vemkit.mesh.families.voronoi"]  # the package exports the function
 
-PLATE = {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-         "holes": [{"circle": [0.5, 0.5, 0.25], "side": "a"}, {"circle": [1.4, 0.45, 0.3], "side": "b"}]}
+PLATE = {
+    "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+    "sides": ["bottom", "right", "top", "left"],
+    "holes": [{"circle": [0.5, 0.5, 0.25], "side": "a"}, {"circle": [1.4, 0.45, 0.3], "side": "b"}],
+}
 L_SHAPE = shapely.Polygon([(0, 0), (1, 0), (1, 0.5), (0.5, 0.5), (0.5, 1), (0, 1)])
 
 
@@ -116,8 +119,21 @@ def test_green_centroids_of_clipped_cells_equal_shapelys():
         vertices, offsets, refs, area, _, lo, hi = diagram(points, anisotropy)
         inside, vertex_in = voronoi_module._inside(index, vertices, offsets, refs, lo, hi)
         cut = np.flatnonzero(~inside)
-        got, ok = voronoi_clip.clipped_centroids(vertices, offsets, refs, cut, points[cut], vertex_in, index.ends,
-                                                 index.ptr, index.items, index.origin, index.inv, index.g, area[cut])
+        got, ok = voronoi_clip.clipped_centroids(
+            vertices,
+            offsets,
+            refs,
+            cut,
+            points[cut],
+            vertex_in,
+            index.ends,
+            index.ptr,
+            index.items,
+            index.origin,
+            index.inv,
+            index.g,
+            area[cut],
+        )
         pieces = shapely.intersection(voronoi_module._polygons(vertices, offsets, refs, cut), shape)
         assert ok.all() and cut.size > 100
         np.testing.assert_allclose(got, shapely.get_coordinates(shapely.centroid(pieces)), rtol=0, atol=1e-11 * h)
@@ -131,11 +147,24 @@ def test_green_centroid_with_a_vertex_on_the_boundary():
     offsets, refs = np.array([0, 3, 6]), np.arange(6)
     vertex_in = shapely.contains_xy(square, vertices[:, 0], vertices[:, 1])
     area = areas_centroids(vertices, offsets)[0]
-    got, ok = voronoi_clip.clipped_centroids(vertices, offsets, refs, np.arange(2), np.array([[0.5, 0.2], [0.7, 0.3]]),
-                                             vertex_in, index.ends, index.ptr, index.items, index.origin, index.inv,
-                                             index.g, area)
-    want = shapely.get_coordinates(shapely.centroid(shapely.intersection(
-        [shapely.Polygon(vertices[:3]), shapely.Polygon(vertices[3:])], square)))
+    got, ok = voronoi_clip.clipped_centroids(
+        vertices,
+        offsets,
+        refs,
+        np.arange(2),
+        np.array([[0.5, 0.2], [0.7, 0.3]]),
+        vertex_in,
+        index.ends,
+        index.ptr,
+        index.items,
+        index.origin,
+        index.inv,
+        index.g,
+        area,
+    )
+    want = shapely.get_coordinates(
+        shapely.centroid(shapely.intersection([shapely.Polygon(vertices[:3]), shapely.Polygon(vertices[3:])], square))
+    )
     assert ok.all()
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-14)
 
@@ -144,8 +173,11 @@ def test_voronoi_on_a_plate_with_holes_is_valid_and_shapelys_up_to_round_off(mon
     mesh = build_mesh("voronoi", 40, domain=PLATE, seed=1, lloyd_iterations=10)
     validate_mesh(mesh)
     assert mesh.cell_areas.sum() == pytest.approx(2.0 - np.pi * (0.25**2 + 0.3**2), rel=2e-3)  # circles as polygons
-    monkeypatch.setattr(voronoi_module, "clipped_centroids",
-                        lambda *args: (np.zeros((len(args[3]), 2)), np.zeros(len(args[3]), dtype=bool)))
+    monkeypatch.setattr(
+        voronoi_module,
+        "clipped_centroids",
+        lambda *args: (np.zeros((len(args[3]), 2)), np.zeros(len(args[3]), dtype=bool)),
+    )
     by_shapely = build_mesh("voronoi", 40, domain=PLATE, seed=1, lloyd_iterations=10)
     np.testing.assert_array_equal(mesh.cell_vertices, by_shapely.cell_vertices)
     np.testing.assert_allclose(mesh.vertices, by_shapely.vertices, rtol=0, atol=1e-10)  # h = 0.025

@@ -17,8 +17,15 @@ def cube(vertices=CUBE, faces=CUBE_FACES, name=True):
 
 
 def rebuilt(mesh, **changes):
-    fields = dict(vertices=mesh.vertices, face_offsets=mesh.face_offsets, face_vertices=mesh.face_vertices,
-                  cell_offsets=mesh.cell_offsets, cell_faces=mesh.cell_faces, boundary=mesh.boundary, meta=mesh.meta)
+    fields = dict(
+        vertices=mesh.vertices,
+        face_offsets=mesh.face_offsets,
+        face_vertices=mesh.face_vertices,
+        cell_offsets=mesh.cell_offsets,
+        cell_faces=mesh.cell_faces,
+        boundary=mesh.boundary,
+        meta=mesh.meta,
+    )
     fields.update(changes)
     return PolyhedralMesh(**fields)
 
@@ -116,8 +123,10 @@ def test_a_face_of_three_cells():
     fv = np.concatenate([mesh.face_vertices, third.face_vertices + mesh.n_vertices])
     cf = np.concatenate([mesh.cell_faces, third.cell_faces[:-1] + mesh.n_faces, [shared]])
     co = np.concatenate([mesh.cell_offsets, mesh.cell_offsets[-1] + third.cell_offsets[1:]])
-    refused(rebuilt(mesh, vertices=v, face_offsets=fo, face_vertices=fv, cell_faces=cf, cell_offsets=co),
-            f"face {shared} belongs to 3 cells")
+    refused(
+        rebuilt(mesh, vertices=v, face_offsets=fo, face_vertices=fv, cell_faces=cf, cell_offsets=co),
+        f"face {shared} belongs to 3 cells",
+    )
 
 
 def test_vertex_defects():
@@ -141,7 +150,9 @@ def test_boundary_names():
     parts = dict(mesh.boundary, extra=mesh.boundary["top"][:1])
     refused(rebuilt(mesh, boundary=parts), "in both parts 'top' and 'extra'")
     inner = int(np.flatnonzero((mesh.face_cells >= 0).all(axis=1))[0])
-    refused(rebuilt(mesh, boundary=dict(mesh.boundary, top=np.r_[mesh.boundary["top"], inner])),
-            f"face {inner} is not a boundary face")
+    refused(
+        rebuilt(mesh, boundary=dict(mesh.boundary, top=np.r_[mesh.boundary["top"], inner])),
+        f"face {inner} is not a boundary face",
+    )
     refused(rebuilt(mesh, boundary=dict(mesh.boundary, top=[10**6])), "refers to face 1000000")
     refused(rebuilt(mesh, boundary={"top side": mesh.boundary_faces}), "not an identifier")

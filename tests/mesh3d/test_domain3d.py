@@ -10,8 +10,12 @@ from vemkit.mesh.families import build_mesh
 from vemkit.mesh.families3d import build_mesh3d
 
 BOX = {"box": [[0, 0, 0], [1, 1, 0.5]]}
-EXTRUDE = {"extrude": {"depth": 0.25}, "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
-           "sides": ["bottom", "right", "top", "left"], "holes": [{"circle": [0.5, 0.5, 0.2], "side": "bore"}]}
+EXTRUDE = {
+    "extrude": {"depth": 0.25},
+    "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+    "sides": ["bottom", "right", "top", "left"],
+    "holes": [{"circle": [0.5, 0.5, 0.2], "side": "bore"}],
+}
 
 
 def test_box_and_extrude_specs():
@@ -27,22 +31,25 @@ def test_box_and_extrude_specs():
     assert not is_3d_domain("unit_square")
 
 
-@pytest.mark.parametrize("spec, key, words", [
-    ({"box": [[0, 0], [1, 1]]}, "domain.box", "two corners"),
-    ({"box": [[0, 0, 1], [1, 1, 1]]}, "domain.box", "z1 = 1 is not above z0 = 1"),
-    ({"box": [[0, 0, 0], [1, 1, "x"]]}, "domain.box", "finite numbers"),
-    ({"box": [[0, 0, 0], [1, 1, 1]], "sides": ["a"] * 5}, "domain.sides", "has 5 names; give 6"),
-    ({"box": [[0, 0, 0], [1, 1, 1]], "sides": ["a b"] * 6}, "domain.sides", "not an identifier"),
-    ({"box": [[0, 0, 0], [1, 1, 1]], "holes": []}, "domain.holes", "unknown key"),
-    ({"box": [[0, 0, 0], [1, 1, 1]], "extrude": {"depth": 1}}, "domain", "not both"),
-    (dict(EXTRUDE, extrude={"depth": -1}), "domain.extrude.depth", "positive number"),
-    (dict(EXTRUDE, extrude={}), "domain.extrude.depth", "missing"),
-    (dict(EXTRUDE, extrude={"depth": 1, "layers": 3}), "domain.extrude.layers", "valid keys: depth, ends"),
-    (dict(EXTRUDE, extrude={"depth": 1, "ends": ["front"]}), "domain.extrude.ends", "give 2"),
-    (dict(EXTRUDE, extrude=3), "domain.extrude", "depth: D"),
-    (dict(EXTRUDE, sides=["a", "b"]), "domain.sides", "one name per edge"),
-    (dict(EXTRUDE, holes=[{"circle": [5, 5, 0.1], "side": "h"}]), "domain.holes[0]", "outside the body"),
-])
+@pytest.mark.parametrize(
+    "spec, key, words",
+    [
+        ({"box": [[0, 0], [1, 1]]}, "domain.box", "two corners"),
+        ({"box": [[0, 0, 1], [1, 1, 1]]}, "domain.box", "z1 = 1 is not above z0 = 1"),
+        ({"box": [[0, 0, 0], [1, 1, "x"]]}, "domain.box", "finite numbers"),
+        ({"box": [[0, 0, 0], [1, 1, 1]], "sides": ["a"] * 5}, "domain.sides", "has 5 names; give 6"),
+        ({"box": [[0, 0, 0], [1, 1, 1]], "sides": ["a b"] * 6}, "domain.sides", "not an identifier"),
+        ({"box": [[0, 0, 0], [1, 1, 1]], "holes": []}, "domain.holes", "unknown key"),
+        ({"box": [[0, 0, 0], [1, 1, 1]], "extrude": {"depth": 1}}, "domain", "not both"),
+        (dict(EXTRUDE, extrude={"depth": -1}), "domain.extrude.depth", "positive number"),
+        (dict(EXTRUDE, extrude={}), "domain.extrude.depth", "missing"),
+        (dict(EXTRUDE, extrude={"depth": 1, "layers": 3}), "domain.extrude.layers", "valid keys: depth, ends"),
+        (dict(EXTRUDE, extrude={"depth": 1, "ends": ["front"]}), "domain.extrude.ends", "give 2"),
+        (dict(EXTRUDE, extrude=3), "domain.extrude", "depth: D"),
+        (dict(EXTRUDE, sides=["a", "b"]), "domain.sides", "one name per edge"),
+        (dict(EXTRUDE, holes=[{"circle": [5, 5, 0.1], "side": "h"}]), "domain.holes[0]", "outside the body"),
+    ],
+)
 def test_broken_specs_are_refused(spec, key, words):
     with pytest.raises(SceneError) as info:
         domain3d_from_spec(spec)
@@ -59,8 +66,15 @@ def test_sizes():
         cells_per_length3d(box, h=0)
 
 
-@pytest.mark.parametrize("family, size, cells", [("hex", {"n": 4}, 32), ("tet", {"h": 0.5, "kind": "structured"}, 24),
-                                                 ("octree", {"n": 2}, 4 + 7 * 4), ("voronoi", {"cells": 40}, 40)])
+@pytest.mark.parametrize(
+    "family, size, cells",
+    [
+        ("hex", {"n": 4}, 32),
+        ("tet", {"h": 0.5, "kind": "structured"}, 24),
+        ("octree", {"n": 2}, 4 + 7 * 4),
+        ("voronoi", {"cells": 40}, 40),
+    ],
+)
 def test_box_meshes(family, size, cells):
     mesh = build_mesh3d(family, BOX, **size)
     validate_mesh3d(mesh)
@@ -75,7 +89,7 @@ def test_extruded_meshes_are_prisms_over_the_2d_mesh(family):
     base = build_mesh(family, 8, domain={k: v for k, v in EXTRUDE.items() if k != "extrude"})
     validate_mesh3d(mesh)
     assert mesh.meta["layers"] == 2 and mesh.n_cells == 2 * base.n_cells  # layers = round(depth n)
-    assert np.array_equal(mesh.vertices[:base.n_vertices, :2], base.vertices)
+    assert np.array_equal(mesh.vertices[: base.n_vertices, :2], base.vertices)
     assert abs(mesh.cell_volumes.sum() - 0.25 * base.cell_areas.sum()) <= 1e-12
     assert set(mesh.boundary) == {"bottom", "right", "top", "left", "bore", "front", "back"}
     assert build_mesh3d(family, EXTRUDE, n=8, layers=3).n_cells == 3 * base.n_cells

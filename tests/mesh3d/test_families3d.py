@@ -35,7 +35,10 @@ def assert_fills_box(mesh, box=BOX, sides=SIDES):
 
 
 def test_polyhedral_geometry_of_a_cube():
-    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float) * 2 + 7
+    v = (
+        np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float) * 2
+        + 7
+    )
     faces = [[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4], [3, 7, 6, 2], [0, 3, 2, 1], [4, 5, 6, 7]]
     mesh = from_polyhedra(v, [faces])
     assert mesh.cell_volumes[0] == pytest.approx(8.0, rel=1e-14)
@@ -50,7 +53,9 @@ def test_diameter_kernel_and_its_numpy_twin_agree():
 
     mesh = voronoi(3, seed=1)
     offsets, ids = mesh.cell_vertex_lists
-    assert np.allclose(_diameters(mesh.vertices, offsets, ids), diameters_numpy(mesh.vertices, offsets, ids), rtol=1e-15)
+    assert np.allclose(
+        _diameters(mesh.vertices, offsets, ids), diameters_numpy(mesh.vertices, offsets, ids), rtol=1e-15
+    )
     mesh = octree(shape=(2, 2, 2), rule="random", seed=2)
     offsets, ids = mesh.cell_vertex_lists
     assert np.array_equal(mesh.cell_diameters, diameters_numpy(mesh.vertices, offsets, ids))
@@ -70,8 +75,10 @@ def test_tet():
     assert np.allclose(mesh.cell_volumes, np.prod(np.subtract(BOX[1], BOX[0])) / 72)
 
 
-@pytest.mark.parametrize("options", [{}, {"contact_side": "left"}, {"rule": "random", "seed": 3},
-                                     {"rule": "random", "fraction": 0.7, "seed": 1}])
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"contact_side": "left"}, {"rule": "random", "seed": 3}, {"rule": "random", "fraction": 0.7, "seed": 1}],
+)
 def test_octree(options):
     mesh = octree(shape=(3, 4, 3), box=BOX, **options)
     assert_fills_box(mesh)
@@ -92,9 +99,16 @@ def test_octree_hanging_nodes_are_coarse_vertices():
     assert offsets[coarse + 1] - offsets[coarse] == 8 + 5  # its corners, 4 edge midpoints and the face centre
 
 
-@pytest.mark.parametrize("options", [{"n": 3}, {"cells": 150, "box": BOX, "seed": 4}, {"n": 4, "lloyd_iterations": 0},
-                                     {"n": 4, "jitter": 0.0, "lloyd_iterations": 0},
-                                     {"n": 3, "lloyd_samples": 0, "seed": 5}])
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"n": 3},
+        {"cells": 150, "box": BOX, "seed": 4},
+        {"n": 4, "lloyd_iterations": 0},
+        {"n": 4, "jitter": 0.0, "lloyd_iterations": 0},
+        {"n": 3, "lloyd_samples": 0, "seed": 5},
+    ],
+)
 def test_voronoi(options):
     mesh = voronoi(**options)
     box = options.get("box", ((0, 0, 0), (1, 1, 1)))
@@ -112,8 +126,11 @@ def test_voronoi_is_deterministic_and_lloyd_evens_the_cells():
 
 @pytest.mark.parametrize("family", ["square", "triangle", "voronoi", "hanging"])
 def test_extrude_any_2d_family(family):
-    domain = {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-              "holes": [{"circle": [1.0, 0.5, 0.25], "side": "bore"}]}
+    domain = {
+        "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+        "sides": ["bottom", "right", "top", "left"],
+        "holes": [{"circle": [1.0, 0.5, 0.25], "side": "bore"}],
+    }
     base = build_mesh(family, 6, domain=domain)
     mesh = extrude(base, 3, 0.25)
     validate_mesh3d(mesh)

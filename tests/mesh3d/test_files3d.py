@@ -4,6 +4,7 @@ import meshio
 import netCDF4
 import numpy as np
 import pytest
+from vtu_reading import canonical, outward_cycles, stream_cycles, vtu_arrays
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.families import build_mesh
@@ -11,7 +12,6 @@ from vemkit.mesh.families3d import extrude, hex, octree, tet, voronoi
 from vemkit.mesh.families3d.grid import lattice
 from vemkit.mesh.files3d import VOLUME_FILL, read_mesh3d, read_ugrid3d, write_ugrid3d, write_vtu3d
 from vemkit.mesh.polyhedral_build import csr_rows
-from vtu_reading import canonical, outward_cycles, stream_cycles, vtu_arrays
 
 
 def same_mesh(a, b):
@@ -22,8 +22,10 @@ def same_mesh(a, b):
         assert np.array_equal(a.boundary[name], b.boundary[name])
 
 
-@pytest.mark.parametrize("make", [lambda: octree(3, rule="random", seed=1), lambda: voronoi(3),
-                                  lambda: extrude(build_mesh("hanging", 3), 2, 0.5)])
+@pytest.mark.parametrize(
+    "make",
+    [lambda: octree(3, rule="random", seed=1), lambda: voronoi(3), lambda: extrude(build_mesh("hanging", 3), 2, 0.5)],
+)
 def test_netcdf_round_trip(tmp_path, make):
     mesh = make()
     write_ugrid3d(mesh, tmp_path / "m.nc")
@@ -67,7 +69,9 @@ def test_vtu_polyhedra_read_back(tmp_path):
     assert cycles == [outward_cycles(mesh, c) for c in range(mesh.n_cells)]  # outward, in mesh order
     offsets, ids = mesh.cell_vertex_lists
     assert np.array_equal(arrays["offsets"], offsets[1:]) and np.array_equal(arrays["connectivity"], ids)
-    assert np.array_equal(arrays["vol"], mesh.cell_volumes) and np.array_equal(arrays["u"].reshape(-1, 3), mesh.vertices)
+    assert np.array_equal(arrays["vol"], mesh.cell_volumes) and np.array_equal(
+        arrays["u"].reshape(-1, 3), mesh.vertices
+    )
 
 
 def test_meshio_reads_the_vtu_polyhedra(tmp_path):
@@ -146,8 +150,9 @@ def grid_cells(kind):
         return mesh, lattice((2, 2, 1), ((0, 0, 0), (1, 1, 1)))[1]
     if kind == "tetra":
         mesh = tet(shape=(1, 2, 1))
-        ids = lattice((1, 2, 1), ((0, 0, 0), (1, 1, 1)))[1][:, [[0, 1, 2, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 7, 6],
-                                                                [0, 4, 5, 6], [0, 1, 5, 6]]].reshape(-1, 4)
+        ids = lattice((1, 2, 1), ((0, 0, 0), (1, 1, 1)))[1][
+            :, [[0, 1, 2, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 7, 6], [0, 4, 5, 6], [0, 1, 5, 6]]
+        ].reshape(-1, 4)
         return mesh, ids  # half of them mirrored: the reader turns them outward
     base = build_mesh("triangle", 2, kind="structured")
     mesh = extrude(base, 2, 1.0)
@@ -182,9 +187,11 @@ def test_gmsh_3d_errors(tmp_path):
     sides = boundary_cycles(mesh)
     untagged = read_mesh3d(gmsh_file(tmp_path, mesh.vertices, "hexahedron", cells, {"left": sides["left"]}, "gmsh22"))
     assert len(untagged.boundary["untagged"]) == mesh.boundary_faces.size - len(sides["left"])
-    inner = mesh.face_vertices[mesh.face_offsets[0]:mesh.face_offsets[1]]
-    interior = [csr_rows(mesh.face_offsets, mesh.face_vertices)[f].tolist()
-                for f in np.flatnonzero((mesh.face_cells >= 0).all(axis=1))[:1]]
+    inner = mesh.face_vertices[mesh.face_offsets[0] : mesh.face_offsets[1]]
+    interior = [
+        csr_rows(mesh.face_offsets, mesh.face_vertices)[f].tolist()
+        for f in np.flatnonzero((mesh.face_cells >= 0).all(axis=1))[:1]
+    ]
     assert inner.size == 4
     with pytest.raises(MeshError, match="is not a boundary face of the mesh; tag boundary surfaces only"):
         read_mesh3d(gmsh_file(tmp_path, mesh.vertices, "hexahedron", cells, {"bad": interior}, "gmsh22"))

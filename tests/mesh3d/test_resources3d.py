@@ -9,7 +9,9 @@ from vemkit.mesh.families3d.resources import estimate_mesh3d
 BOX = {"box": [[0, 0, 0], [2, 1, 1]]}
 
 
-@pytest.mark.parametrize("family, size", [("hex", {"n": 3}), ("tet", {"h": 0.5, "kind": "structured"}), ("hex", {"cells": 250})])
+@pytest.mark.parametrize(
+    "family, size", [("hex", {"n": 3}), ("tet", {"h": 0.5, "kind": "structured"}), ("hex", {"cells": 250})]
+)
 def test_grids_are_predicted_exactly(family, size):
     est = estimate_mesh3d(family, BOX, **size)
     mesh = build_mesh3d(family, BOX, **size)
@@ -35,6 +37,8 @@ def test_voronoi_within_ten_percent(size):
 
 def test_errors():
     with pytest.raises(SceneError, match="give a box domain"):
-        estimate_mesh3d("square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2)
+        estimate_mesh3d(
+            "square", {"extrude": {"depth": 1}, "polygon": [[0, 0], [1, 0], [1, 1]], "sides": ["a"] * 3}, n=2
+        )
     with pytest.raises(SceneError, match="unknown box family 'square'"):
         estimate_mesh3d("square", BOX, n=2)

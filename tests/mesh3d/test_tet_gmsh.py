@@ -27,12 +27,23 @@ pytest.importorskip("gmsh")
 
 BOX = {"box": [[0, 0, 0], [1, 2, 0.5]]}
 SIDES = ("left", "right", "front", "back", "bottom", "top")
-PLATE = {"extrude": {"depth": 0.5, "ends": ["near", "far"]}, "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
-         "sides": ["bottom", "right", "top", "left"], "arcs": [None, [1.0, 0.5], None, None],
-         "holes": [{"circle": [0.7, 0.5, 0.25], "side": "bore"},
-                   {"polygon": [[1.3, 0.3], [1.5, 0.3], [1.4, 0.6]], "sides": ["h1", "h2", "h3"]}]}
-ANNULUS = {"extrude": {"depth": 0.5}, "polygon": [[1, 0], [0, 1], [-1, 0], [0, -1]], "sides": ["outer"] * 4,
-           "arcs": [[0, 0]] * 4, "holes": [{"circle": [0.0, 0.0, 0.5], "side": "bore"}]}
+PLATE = {
+    "extrude": {"depth": 0.5, "ends": ["near", "far"]},
+    "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+    "sides": ["bottom", "right", "top", "left"],
+    "arcs": [None, [1.0, 0.5], None, None],
+    "holes": [
+        {"circle": [0.7, 0.5, 0.25], "side": "bore"},
+        {"polygon": [[1.3, 0.3], [1.5, 0.3], [1.4, 0.6]], "sides": ["h1", "h2", "h3"]},
+    ],
+}
+ANNULUS = {
+    "extrude": {"depth": 0.5},
+    "polygon": [[1, 0], [0, 1], [-1, 0], [0, -1]],
+    "sides": ["outer"] * 4,
+    "arcs": [[0, 0]] * 4,
+    "holes": [{"circle": [0.0, 0.0, 0.5], "side": "bore"}],
+}
 MIN_RADIUS_RATIO, MIN_DIHEDRAL, MAX_DIHEDRAL = 0.2, 10.0, 165.0
 
 
@@ -53,8 +64,11 @@ def quality(mesh):
     dihedral = np.degrees(np.pi - np.arccos(np.clip(cosines, -1.0, 1.0)))
     a, b, c = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]
     volume = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
-    num = ((a * a).sum(1)[:, None] * np.cross(b, c) + (b * b).sum(1)[:, None] * np.cross(c, a)
-           + (c * c).sum(1)[:, None] * np.cross(a, b))
+    num = (
+        (a * a).sum(1)[:, None] * np.cross(b, c)
+        + (b * b).sum(1)[:, None] * np.cross(c, a)
+        + (c * c).sum(1)[:, None] * np.cross(a, b)
+    )
     r_circ = np.linalg.norm(num, axis=1) / (12.0 * volume)
     r_in = 3.0 * volume / areas.sum(axis=1)
     return float((3.0 * r_in / r_circ).min()), float(dihedral.min()), float(dihedral.max())
@@ -66,8 +80,11 @@ def non_delaunay_fraction(mesh):
     tets, p = tetrahedra(mesh), mesh.vertices
     a = p[tets[:, 0]]
     b, c, d = (p[tets[:, k]] - a for k in (1, 2, 3))
-    num = ((b * b).sum(1)[:, None] * np.cross(c, d) + (c * c).sum(1)[:, None] * np.cross(d, b)
-           + (d * d).sum(1)[:, None] * np.cross(b, c))
+    num = (
+        (b * b).sum(1)[:, None] * np.cross(c, d)
+        + (c * c).sum(1)[:, None] * np.cross(d, b)
+        + (d * d).sum(1)[:, None] * np.cross(b, c)
+    )
     vol6 = np.einsum("ij,ij->i", b, np.cross(c, d))
     centre, radius = a + num / (2.0 * vol6[:, None]), np.linalg.norm(num, axis=1) / np.abs(2.0 * vol6)
     inner = np.flatnonzero((mesh.face_cells >= 0).all(axis=1))
@@ -162,15 +179,17 @@ def test_extruded_plate_with_arc_and_holes():
     assert side_area(mesh, "h1") == pytest.approx(0.2 * 0.5, rel=1e-12)  # straight sides: exact
     assert side_area(mesh, "top") == pytest.approx(2.0 * 0.5, rel=1e-12)
     assert side_area(mesh, "near") == pytest.approx(side_area(mesh, "far"), rel=1e-12)
-    bound = sum(side_area(mesh, s) * longest_edge(mesh, s) ** 2 / (2 * r) for s, r in (("bore", 0.25),
-                                                                                       ("right", np.sqrt(1.25))))
+    bound = sum(
+        side_area(mesh, s) * longest_edge(mesh, s) ** 2 / (2 * r) for s, r in (("bore", 0.25), ("right", np.sqrt(1.25)))
+    )
     error = abs(mesh.cell_volumes.sum() - body.volume)
     assert error <= bound and error <= 0.005 * body.volume, (error, bound)
     assert build_mesh3d("tet", PLATE, n=16).cell_volumes.sum() == pytest.approx(body.volume, rel=0.001)
 
 
-@pytest.mark.parametrize("domain, size", [(BOX, {"n": 6}), (BOX, {"cells": 5000}), (PLATE, {"n": 8}),
-                                          (ANNULUS, {"h": 0.125})])
+@pytest.mark.parametrize(
+    "domain, size", [(BOX, {"n": 6}), (BOX, {"cells": 5000}), (PLATE, {"n": 8}), (ANNULUS, {"h": 0.125})]
+)
 def test_resources_predicted_within_the_stated_error(domain, size):
     est = estimate_mesh3d("tet", domain, **size)
     mesh = build_mesh3d("tet", domain, **size)
@@ -189,16 +208,34 @@ def test_surface_area():
 
 
 def test_errors_are_one_line_with_keys():
-    cases = [(dict(kind="kuhn"), "tet mesh kind 'kuhn' is unknown; valid kinds: delaunay, structured",
-              "discretization.mesh.kind", BOX),
-             (dict(kind="structured"), "meshes a box only", "discretization.mesh.kind", PLATE),
-             (dict(layers=2), "layers applies to the prism families", "discretization.mesh.layers", PLATE),
-             (dict(seed=2), "mesh option 'seed' is not valid for family tet \\(kind=delaunay\\); valid options: "
-              "optimize, kind", "discretization.mesh.seed", BOX),
-             (dict(optimize=False, kind="structured"), "'optimize' is not valid for family tet \\(kind=structured\\)",
-              "discretization.mesh.optimize", BOX),
-             (dict(lloyd_iterations=2, kind="structured"), "not valid for family tet \\(kind=structured\\)",
-              "discretization.mesh.lloyd_iterations", BOX)]
+    cases = [
+        (
+            dict(kind="kuhn"),
+            "tet mesh kind 'kuhn' is unknown; valid kinds: delaunay, structured",
+            "discretization.mesh.kind",
+            BOX,
+        ),
+        (dict(kind="structured"), "meshes a box only", "discretization.mesh.kind", PLATE),
+        (dict(layers=2), "layers applies to the prism families", "discretization.mesh.layers", PLATE),
+        (
+            dict(seed=2),
+            "mesh option 'seed' is not valid for family tet \\(kind=delaunay\\); valid options: optimize, kind",
+            "discretization.mesh.seed",
+            BOX,
+        ),
+        (
+            dict(optimize=False, kind="structured"),
+            "'optimize' is not valid for family tet \\(kind=structured\\)",
+            "discretization.mesh.optimize",
+            BOX,
+        ),
+        (
+            dict(lloyd_iterations=2, kind="structured"),
+            "not valid for family tet \\(kind=structured\\)",
+            "discretization.mesh.lloyd_iterations",
+            BOX,
+        ),
+    ]
     for options, match, key, domain in cases:
         with pytest.raises(SceneError, match=match) as info:
             build_mesh3d("tet", domain, n=2, **options)
@@ -270,8 +307,9 @@ def test_vem_on_gmsh_tets_of_an_extruded_annulus_equals_p1_finite_elements():
     validate_mesh3d(mesh)
     assert 200 < mesh.n_cells < 3000
     space = VirtualElementSpace(mesh, 1)
-    basis = skfem.Basis(skfem.MeshTet(mesh.vertices.T.copy(), tetrahedra(mesh).T.copy()),
-                        skfem.ElementVector(skfem.ElementTetP1()))
+    basis = skfem.Basis(
+        skfem.MeshTet(mesh.vertices.T.copy(), tetrahedra(mesh).T.copy()), skfem.ElementVector(skfem.ElementTetP1())
+    )
     K_fem = linear_elasticity(lam, mu).assemble(basis)
     order = basis.nodal_dofs.T.ravel()  # VEM dof 3 i + k is the finite element dof nodal_dofs[k, i]
     K_fem = K_fem[order][:, order].tocsr()

@@ -12,16 +12,49 @@ from vemkit.studies import verification as V
 def _dataset():
     records = []
     for level, h in enumerate((0.4, 0.2)):
-        records.append({"scene": "kirsch", "family": "triangle", "level": level, "h": h, "n_dofs": 900 * 4**level,
-                        "error_h1": 0.05 * h / 0.4, "error_h1_semi": 0.1 * h / 0.4, "error_l2": 0.01 * (h / 0.4) ** 2,
-                        "stress_concentration": 2.9 + 0.1 * level})
-    records.append({"scene": "cook", "family": "triangle", "level": 0, "h": 1.0, "n_dofs": 2986, "v_mid": 23.877,
-                    "v_mid_difference": 23.877 / 23.96 - 1, "v_corner": 24.89})
-    records.append({"scene": "hertz", "family": "triangle", "level": 0, "h": 0.01, "n_dofs": 32142,
-                    "contact_force": 0.0046777, "radius": 1.0, "normal_k": 1e4, "half_width": 0.07532,
-                    "half_width_hertz": 0.07717, "half_width_difference": 0.07532 / 0.07717 - 1,
-                    "peak_pressure": 0.03911, "peak_pressure_hertz": 0.03859,
-                    "peak_pressure_difference": 0.03911 / 0.03859 - 1})
+        records.append(
+            {
+                "scene": "kirsch",
+                "family": "triangle",
+                "level": level,
+                "h": h,
+                "n_dofs": 900 * 4**level,
+                "error_h1": 0.05 * h / 0.4,
+                "error_h1_semi": 0.1 * h / 0.4,
+                "error_l2": 0.01 * (h / 0.4) ** 2,
+                "stress_concentration": 2.9 + 0.1 * level,
+            }
+        )
+    records.append(
+        {
+            "scene": "cook",
+            "family": "triangle",
+            "level": 0,
+            "h": 1.0,
+            "n_dofs": 2986,
+            "v_mid": 23.877,
+            "v_mid_difference": 23.877 / 23.96 - 1,
+            "v_corner": 24.89,
+        }
+    )
+    records.append(
+        {
+            "scene": "hertz",
+            "family": "triangle",
+            "level": 0,
+            "h": 0.01,
+            "n_dofs": 32142,
+            "contact_force": 0.0046777,
+            "radius": 1.0,
+            "normal_k": 1e4,
+            "half_width": 0.07532,
+            "half_width_hertz": 0.07717,
+            "half_width_difference": 0.07532 / 0.07717 - 1,
+            "peak_pressure": 0.03911,
+            "peak_pressure_hertz": 0.03859,
+            "peak_pressure_difference": 0.03911 / 0.03859 - 1,
+        }
+    )
     return V.verification_dataset(records, commit="abc")
 
 
@@ -46,7 +79,9 @@ def test_scene_figures_draw_a_real_solution(name, family, h):
 
     kept = {}
     scene = Path(__file__).resolve().parents[2] / "config" / "scenes" / f"{name}.yaml"
-    (run,) = V.run_case(name, scene, family, sizes=(h,), on_solution=lambda _, problem, ds: kept.update(p=problem, ds=ds))
+    (run,) = V.run_case(
+        name, scene, family, sizes=(h,), on_solution=lambda _, problem, ds: kept.update(p=problem, ds=ds)
+    )
     hertz = (run["half_width_hertz"], run["peak_pressure_hertz"]) if name == "hertz" else None
     fig = scene_figure(name, kept["p"].mesh, kept["ds"], hertz=hertz)
     assert len(fig.axes) >= (6 if name == "hertz" else 3)

@@ -2,8 +2,8 @@
 definite) and agreement with pyamg's own cycle on the same hierarchy; AMG-CG meets its tolerance."""
 
 import numpy as np
-
 from conftest import family_mesh, paper_problem
+
 from vemkit.solvers.linear import AMGSolver, linear_solver
 
 

@@ -13,23 +13,35 @@ from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import SLIP, STICK, contact_state
 from vemkit.solvers.verification import verify_solution
 
-UZAWA = {"method": "uzawa", "tol": 1e-12, "linear": "direct", "stop": "both", "eps_u": 1e-13, "eps_lambda": 1e-13,
-         "max_iterations": 20000}
+UZAWA = {
+    "method": "uzawa",
+    "tol": 1e-12,
+    "linear": "direct",
+    "stop": "both",
+    "eps_u": 1e-13,
+    "eps_lambda": 1e-13,
+    "max_iterations": 20000,
+}
 SSN = {"method": "ssn", "tol": 1e-12, "linear": "direct"}
 
 
 def sheared_box(family: str, n: int, friction: float, m: float = 0.0):
     """A box on z = 0 across the gap 0.002 x, its top moved by (0.004, 0.002, -0.01): it slides along
     a diagonal where the friction bound is low enough, sticks elsewhere."""
-    data = {"model": "3d", "domain": {"box": [[0, 0, 0], [1, 1, 0.5]]}, "material": {"E": 1000.0, "nu": 0.3},
-            "boundary": {"dirichlet": {"top": [0.004, 0.002, -0.01]}, "contact": ["bottom"]},
-            "contact": {"gap": "0.002*x", "normal": {"k": 200.0, "m": 1.0}, "friction": {"k": friction, "m": m}},
-            "discretization": {"mesh": {"family": family, "n": n}}}
+    data = {
+        "model": "3d",
+        "domain": {"box": [[0, 0, 0], [1, 1, 0.5]]},
+        "material": {"E": 1000.0, "nu": 0.3},
+        "boundary": {"dirichlet": {"top": [0.004, 0.002, -0.01]}, "contact": ["bottom"]},
+        "contact": {"gap": "0.002*x", "normal": {"k": 200.0, "m": 1.0}, "friction": {"k": friction, "m": m}},
+        "discretization": {"mesh": {"family": family, "n": n}},
+    }
     return scene_problem(scene_from_dict(data))
 
 
-@pytest.mark.parametrize("family, n, friction, stick, slip", [("hex", 4, 3.0, 6, 19), ("voronoi", 3, 5.0, 19, 1),
-                                                               ("hex", 3, 2.0, 0, 16)])
+@pytest.mark.parametrize(
+    "family, n, friction, stick, slip", [("hex", 4, 3.0, 6, 19), ("voronoi", 3, 5.0, 19, 1), ("hex", 3, 2.0, 0, 16)]
+)
 def test_uzawa_and_ssn_agree_on_the_disk(family, n, friction, stick, slip):
     problem = sheared_box(family, n, friction)
     a, b = solve(problem, UZAWA), solve(problem, SSN)

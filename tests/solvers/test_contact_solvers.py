@@ -8,9 +8,13 @@ import itertools
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
-
 from conftest import FAMILY_CASES, family_mesh, paper_problem
+
 from vemkit.contact.laws import ContactLaw
+from vemkit.contact.problem import discrete_problem
+from vemkit.exceptions import ConvergenceError
+from vemkit.mesh.families.square import square
+from vemkit.mesh.mesh import Mesh
 from vemkit.solvers.solution import (
     SEPARATED,
     SLIP,
@@ -18,12 +22,8 @@ from vemkit.solvers.solution import (
     contact_residual,
     contact_state,
 )
-from vemkit.exceptions import ConvergenceError
 from vemkit.solvers.ssn import solve_ssn
 from vemkit.solvers.uzawa import solve_uzawa
-from vemkit.mesh.families.square import square
-from vemkit.mesh.mesh import Mesh
-from vemkit.contact.problem import discrete_problem
 
 PAPER_LAW = ContactLaw(10.0, 1.0, 450.0, 0.0)
 TIGHT_UZAWA = dict(stop="both", eps_u=1e-13, eps_lambda=1e-13)
@@ -40,8 +40,15 @@ def _paper_tractions(scale):
 def scene(n, law=PAPER_LAW, gap=0.1, E=2000.0, traction_scale=1.0):
     """The paper's scene (SPEC §2) on square(n), with optional changes of law, gap and E."""
     return discrete_problem(
-        square(n), E, 0.4, dirichlet=("right",), neumann=_paper_tractions(traction_scale),
-        contact=("bottom",), gap=lambda x, y: gap + 0 * x, law=law, stabilization="dofi-2mu",
+        square(n),
+        E,
+        0.4,
+        dirichlet=("right",),
+        neumann=_paper_tractions(traction_scale),
+        contact=("bottom",),
+        gap=lambda x, y: gap + 0 * x,
+        law=law,
+        stabilization="dofi-2mu",
     )
 
 
@@ -53,8 +60,15 @@ def contact_elsewhere(part):
     else:
         neumann = {"top": lambda x, y: (-2000 + 0 * x, -200 + 0 * x), "bottom": lambda x, y: (0 * x, 0 * x)}
     return discrete_problem(
-        square(16), 2000.0, 0.4, dirichlet=("right",), neumann=neumann, contact=(part,),
-        gap=lambda x, y: 0.1 + 0 * x, law=PAPER_LAW, stabilization="dofi-2mu",
+        square(16),
+        2000.0,
+        0.4,
+        dirichlet=("right",),
+        neumann=neumann,
+        contact=(part,),
+        gap=lambda x, y: 0.1 + 0 * x,
+        law=PAPER_LAW,
+        stabilization="dofi-2mu",
     )
 
 
@@ -228,9 +242,15 @@ def test_rotated_scene_gives_rotated_solution():
 
     law = ContactLaw(10.0, 1.0, 700.0, 0.0)  # stick and slip vertices
     pb = discrete_problem(
-        rotated_mesh, 2000.0, 0.4, dirichlet=("right",),
+        rotated_mesh,
+        2000.0,
+        0.4,
+        dirichlet=("right",),
         neumann={name: rotated(t) for name, t in _paper_tractions(1.0).items()},
-        contact=("bottom",), gap=lambda x, y: 0.1 + 0 * x, law=law, stabilization="dofi-2mu",
+        contact=("bottom",),
+        gap=lambda x, y: 0.1 + 0 * x,
+        law=law,
+        stabilization="dofi-2mu",
     )
     assert np.allclose(pb.contact.normal, [s, -c])
     reference = ssn(scene(8, law=law))
@@ -267,7 +287,9 @@ EXTREME_LAWS = [
 
 
 @pytest.mark.parametrize("gap", [0.0, 10.0])
-@pytest.mark.parametrize("law", EXTREME_LAWS, ids=lambda law: f"kn{law.k_normal:g}-kt{law.k_friction:g}-mn{law.m_normal:g}")
+@pytest.mark.parametrize(
+    "law", EXTREME_LAWS, ids=lambda law: f"kn{law.k_normal:g}-kt{law.k_friction:g}-mn{law.m_normal:g}"
+)
 def test_ssn_extreme_laws(law, gap):
     pb = scene(8, law=law, gap=gap)
     solution = ssn(pb, tol=1e-10)

@@ -14,9 +14,16 @@ OPTIONS = {"ssn": {"method": "ssn", "tol": 1e-10}, "uzawa": {"method": "uzawa", 
 
 def _paper(friction_k: float):
     """The paper's scene on square(8); friction k = 450 (the paper): every contact vertex slips; 1500: they stick."""
-    return discrete_problem(square(8), 2000.0, 0.4, dirichlet=("right",),
-                            neumann={"left": lambda x, y: (200 * (5 - y), -200 + 0 * y), "top": lambda x, y: (0 * x, 0 * x)},
-                            contact=("bottom",), gap=lambda x, y: 0.1 + 0 * x, law=ContactLaw(10.0, 1.0, friction_k, 0.0))
+    return discrete_problem(
+        square(8),
+        2000.0,
+        0.4,
+        dirichlet=("right",),
+        neumann={"left": lambda x, y: (200 * (5 - y), -200 + 0 * y), "top": lambda x, y: (0 * x, 0 * x)},
+        contact=("bottom",),
+        gap=lambda x, y: 0.1 + 0 * x,
+        law=ContactLaw(10.0, 1.0, friction_k, 0.0),
+    )
 
 
 @pytest.mark.parametrize("friction_k, state", [(450.0, SLIP), (1500.0, STICK)])

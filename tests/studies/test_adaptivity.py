@@ -1,15 +1,16 @@
 """The adaptive loop (vemkit.studies.adaptivity): stops as asked; the estimator tracks the true error."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
-
 from manufactured import elasticity_solution
+
 from vemkit.config.scene import load_scene, scene_from_dict
 from vemkit.mesh.checks import validate_mesh
 from vemkit.studies.adaptivity import AdaptivitySettings, adapt
 from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import exact_errors
-from pathlib import Path
 
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 SMOOTH = "x*(1-x)*y*(1-y)*(1-x)**4*(1-y)**4"  # steep near the corner (0, 0): adaptivity has work to do
@@ -17,10 +18,16 @@ SMOOTH = "x*(1-x)*y*(1-y)*(1-x)**4*(1-y)**4"  # steep near the corner (0, 0): ad
 
 def _manufactured_scene():
     solution = elasticity_solution(SMOOTH, "0.5*" + SMOOTH, 1.0, 0.3)
-    scene = scene_from_dict({
-        "name": "manufactured", "material": {"E": 1.0, "nu": 0.3}, "body_force": solution["body_force"],
-        "boundary": {"dirichlet": ["left", "right", "bottom", "top"], "neumann": {}, "contact": []},
-        "discretization": {"mesh": {"family": "square", "n": 4}}, "solver": {"method": "ssn", "tol": 1e-10}})
+    scene = scene_from_dict(
+        {
+            "name": "manufactured",
+            "material": {"E": 1.0, "nu": 0.3},
+            "body_force": solution["body_force"],
+            "boundary": {"dirichlet": ["left", "right", "bottom", "top"], "neumann": {}, "contact": []},
+            "discretization": {"mesh": {"family": "square", "n": 4}},
+            "solver": {"method": "ssn", "tol": 1e-10},
+        }
+    )
     return scene, solution
 
 
@@ -32,7 +39,10 @@ def test_the_estimator_tracks_the_exact_error_within_a_factor_3_over_the_steps()
         absolute = exact_errors(mesh, projected_solution(mesh, u), exact["u"], exact["grad"])
         norm = exact_errors(mesh, projected_solution(mesh, 0 * u), exact["u"], exact["grad"])
         semi = absolute["h1_semi"] / norm["h1_semi"]
-        return {"error_h1_semi": semi, "error_h1": np.hypot(absolute["h1_semi"], absolute["l2"]) / np.hypot(norm["h1_semi"], norm["l2"])}
+        return {
+            "error_h1_semi": semi,
+            "error_h1": np.hypot(absolute["h1_semi"], absolute["l2"]) / np.hypot(norm["h1_semi"], norm["l2"]),
+        }
 
     run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-3, max_steps=9), true_error=true_error)
     errors = np.array([r["true_error"] for r in run.history])
@@ -116,15 +126,25 @@ def test_the_warm_start_finds_the_same_solutions_with_far_fewer_uzawa_iterations
 def test_a_circular_hole_is_refined_on_the_circle_and_every_mesh_is_valid():
     from vemkit.mesh.families import scene_mesh
 
-    scene = scene_from_dict({
-        "name": "plate", "material": {"E": 1.0, "nu": 0.3},
-        "domain": {"polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"],
-                   "holes": [{"circle": [1.0, 0.5, 0.25], "side": "hole"}]},
-        "boundary": {"dirichlet": ["left"], "neumann": {"right": {"traction": [1.0, 0.0]}}},
-        "discretization": {"mesh": {"family": "triangle", "n": 4}}})
+    scene = scene_from_dict(
+        {
+            "name": "plate",
+            "material": {"E": 1.0, "nu": 0.3},
+            "domain": {
+                "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+                "sides": ["bottom", "right", "top", "left"],
+                "holes": [{"circle": [1.0, 0.5, 0.25], "side": "hole"}],
+            },
+            "boundary": {"dirichlet": ["left"], "neumann": {"right": {"traction": [1.0, 0.0]}}},
+            "discretization": {"mesh": {"family": "triangle", "n": 4}},
+        }
+    )
     meshes = []
-    run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-6, max_steps=5),
-                observe=lambda step, so_far: meshes.append(so_far.problem.mesh))
+    run = adapt(
+        scene,
+        AdaptivitySettings(theta=0.5, target=1e-6, max_steps=5),
+        observe=lambda step, so_far: meshes.append(so_far.problem.mesh),
+    )
     for mesh in meshes:
         validate_mesh(mesh)
     estimates = [r["estimate"] for r in run.history]
@@ -147,12 +167,21 @@ def test_the_reference_error_is_exact_on_meshes_finer_than_the_reference_in_plac
     from vemkit.vem.norms import projection_error, seminorm_squared
 
     scene = load_scene(PAPER, ["discretization.mesh.n=4"])
-    runs = [adapt(scene, AdaptivitySettings(theta=theta, target=1e-6, max_steps=steps)) for theta, steps in ((0.3, 6), (1.0, 3))]
+    runs = [
+        adapt(scene, AdaptivitySettings(theta=theta, target=1e-6, max_steps=steps))
+        for theta, steps in ((0.3, 6), (1.0, 3))
+    ]
     meshes = [run.problem.mesh for run in runs]
     fields = [run.problem.dofs.expand(run.solution.u) for run in runs]
-    refs = [ReferenceSolution("<memory>", solution=(m, solution_dataset(r.problem, r.solution))) for m, r in zip(meshes, runs)]
+    refs = [
+        ReferenceSolution("<memory>", solution=(m, solution_dataset(r.problem, r.solution)))
+        for m, r in zip(meshes, runs)
+    ]
     norms = [np.sqrt(seminorm_squared(m.cell_areas, projected_solution(m, u).gradient)) for m, u in zip(meshes, fields)]
-    assert meshes[0].cell_areas.min() < meshes[1].cell_areas.min() and meshes[0].cell_areas.max() > meshes[1].cell_areas.max()
+    assert (
+        meshes[0].cell_areas.min() < meshes[1].cell_areas.min()
+        and meshes[0].cell_areas.max() > meshes[1].cell_areas.max()
+    )
     a_vs_b = reference_errors(meshes[0], fields[0], refs[1])["error_h1_semi"] * norms[1]
     b_vs_a = reference_errors(meshes[1], fields[1], refs[0])["error_h1_semi"] * norms[0]
     assert 1e-3 < a_vs_b / norms[1] < 0.2 and np.isclose(a_vs_b, b_vs_a, rtol=1e-10)
@@ -160,8 +189,12 @@ def test_the_reference_error_is_exact_on_meshes_finer_than_the_reference_in_plac
     coarse_run = adapt(coarse, AdaptivitySettings(target=1e-6, max_steps=1))
     u = coarse_run.problem.dofs.expand(coarse_run.solution.u)
     mine = reference_errors(coarse_run.problem.mesh, u, refs[1])
-    spec5 = projection_error(build_mesh("square", 8), projected_solution(coarse_run.problem.mesh, u), meshes[1], refs[1].projected)
-    assert np.isclose(mine["error_h1"], spec5["h1"], rtol=1e-12) and np.isclose(mine["error_l2"], spec5["l2"], rtol=1e-12)
+    spec5 = projection_error(
+        build_mesh("square", 8), projected_solution(coarse_run.problem.mesh, u), meshes[1], refs[1].projected
+    )
+    assert np.isclose(mine["error_h1"], spec5["h1"], rtol=1e-12) and np.isclose(
+        mine["error_l2"], spec5["l2"], rtol=1e-12
+    )
 
 
 def test_the_reference_error_takes_the_slivers_at_a_circular_hole_finer_than_the_reference():
@@ -173,13 +206,17 @@ def test_the_reference_error_takes_the_slivers_at_a_circular_hole_finer_than_the
     from vemkit.studies.convergence import ReferenceSolution
     from vemkit.vem.norms import seminorm_squared
 
-    scene = load_scene(Path(__file__).resolve().parents[2] / "config" / "scenes" / "lbracket.yaml",
-                       ["discretization.mesh.h=2.5"])
+    scene = load_scene(
+        Path(__file__).resolve().parents[2] / "config" / "scenes" / "lbracket.yaml", ["discretization.mesh.h=2.5"]
+    )
     runs = [adapt(scene, AdaptivitySettings(theta=1.0, target=1e-9, max_steps=steps)) for steps in (1, 3)]
     meshes = [run.problem.mesh for run in runs]
     fields = [run.problem.dofs.expand(run.solution.u) for run in runs]
     assert np.unique(meshes[1].boundary["bore"]).size == 32 and meshes[1].cell_areas.sum() < meshes[0].cell_areas.sum()
-    refs = [ReferenceSolution("<memory>", solution=(m, solution_dataset(r.problem, r.solution))) for m, r in zip(meshes, runs)]
+    refs = [
+        ReferenceSolution("<memory>", solution=(m, solution_dataset(r.problem, r.solution)))
+        for m, r in zip(meshes, runs)
+    ]
     norms = [np.sqrt(seminorm_squared(m.cell_areas, projected_solution(m, u).gradient)) for m, u in zip(meshes, fields)]
     fine_vs_coarse = reference_errors(meshes[1], fields[1], refs[0])["error_h1_semi"] * norms[0]
     coarse_vs_fine = reference_errors(meshes[0], fields[0], refs[1])["error_h1_semi"] * norms[1]

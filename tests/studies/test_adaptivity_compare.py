@@ -9,8 +9,14 @@ from vemkit.studies.adaptivity_compare import compare, dofs_at_error, fitted_rat
 def _history(dofs, error, seconds_per_dof=1e-5):
     dofs = np.asarray(dofs, float)
     error = np.asarray(error, float)
-    return {"n_dofs": dofs, "true_error_h1": error, "estimate": 2.0 * error, "effectivity": np.full(dofs.size, 2.0),
-            "wall_time": seconds_per_dof * dofs, "solve_time": 0.5 * seconds_per_dof * dofs}
+    return {
+        "n_dofs": dofs,
+        "true_error_h1": error,
+        "estimate": 2.0 * error,
+        "effectivity": np.full(dofs.size, 2.0),
+        "wall_time": seconds_per_dof * dofs,
+        "solve_time": 0.5 * seconds_per_dof * dofs,
+    }
 
 
 def test_the_fitted_rate_of_a_power_law_is_its_exponent_after_the_coarse_steps():
@@ -36,7 +42,9 @@ def test_compare_finds_the_dofs_ratio_at_the_finest_uniform_error():
     steps = 2.0 ** np.arange(2, 13)
     adaptive = _history(steps, steps**-0.5)
     out = compare(adaptive, uniform, targets=(0.2,))
-    assert out["rates"]["adaptive"]["rate"] == pytest.approx(-0.5) and out["rates"]["uniform"]["rate"] == pytest.approx(-0.25)
+    assert out["rates"]["adaptive"]["rate"] == pytest.approx(-0.5) and out["rates"]["uniform"]["rate"] == pytest.approx(
+        -0.25
+    )
     finest = out["finest_uniform"]
     assert finest["adaptive_dofs"] == pytest.approx(64.0) and finest["dofs_ratio"] == pytest.approx(64.0)
     assert finest["adaptive_time"] == pytest.approx(1e-5 * sum(2.0 ** np.arange(2, 7)))  # every step up to N = 64
@@ -55,14 +63,21 @@ def test_the_adaptive_loop_enters_the_speed_accuracy_study_as_a_configuration():
     from vemkit.studies.adaptivity_compare import tradeoff_records
     from vemkit.studies.convergence import ReferenceSolution
     from vemkit.studies.scene_solve import solve_scene
-    from vemkit.studies.tradeoff import RECORD_FLOATS, RECORD_INTS, RECORD_STRINGS, cheapest_for_targets, tradeoff_dataset
+    from vemkit.studies.tradeoff import (
+        RECORD_FLOATS,
+        RECORD_INTS,
+        RECORD_STRINGS,
+        cheapest_for_targets,
+        tradeoff_dataset,
+    )
 
     paper = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
     problem, _, ds = solve_scene(load_scene(paper, ["discretization.mesh.n=32"]))
     reference = ReferenceSolution("<n = 32>", solution=(problem.mesh, ds))
     scene = load_scene(paper, ["discretization.mesh.n=4"])
-    records = tradeoff_records(scene, reference, theta=0.5, max_dofs=1500, solvers=["ssn"], tolerances=[1e-8],
-                               stabilization="dofi-2mu")
+    records = tradeoff_records(
+        scene, reference, theta=0.5, max_dofs=1500, solvers=["ssn"], tolerances=[1e-8], stabilization="dofi-2mu"
+    )
     assert all(set(RECORD_FLOATS + RECORD_INTS + RECORD_STRINGS) <= set(r) for r in records)
     dofs, cost, error = (np.array([r[k] for r in records]) for k in ("n_dofs", "cost_time", "error_h1"))
     assert len(records) >= 4 and np.all(np.diff(dofs) > 0) and np.all(np.diff(cost) > 0)

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from manufactured_contact import contact_scene as manufactured_scene
+
 from vemkit.config.scene import scene_from_dict
 from vemkit.mesh.checks import validate_mesh
 from vemkit.solvers.solution import SLIP, STICK, contact_state
@@ -38,8 +38,12 @@ def test_the_effectivity_stays_within_a_factor_3_on_manufactured_contact_solutio
         found = so_far.indicators  # the Γ_C term's share of η² (the residuals carry the factor 1/2μ)
         contact_shares.append(found["contact"].sum() / (2 * so_far.problem.mu) / np.sum(found["indicator"] ** 2))
 
-    run = adapt(scene, AdaptivitySettings(theta=0.5, target=1e-6, max_steps=10), true_error=scene_true_error(scene),
-                observe=observe)
+    run = adapt(
+        scene,
+        AdaptivitySettings(theta=0.5, target=1e-6, max_steps=10),
+        true_error=scene_true_error(scene),
+        observe=observe,
+    )
     estimates = np.array([r["estimate"] for r in run.history])
     errors = np.array([r["true_error"] for r in run.history])
     effectivity = np.array([r["effectivity"] for r in run.history])

@@ -52,8 +52,24 @@ def test_vemkit_adapt_writes_a_k2_solution_file(tmp_path):
     from vemkit.io.solution_file import read_solution
 
     out = tmp_path / "adapt.nc"
-    assert main(["adapt", str(SLIDING), "-o", str(out), "-q", "--set", "discretization.order=2", "--set",
-                 "discretization.mesh.n=4", "--set", "adaptivity.max_steps=3"]) == 0
+    assert (
+        main(
+            [
+                "adapt",
+                str(SLIDING),
+                "-o",
+                str(out),
+                "-q",
+                "--set",
+                "discretization.order=2",
+                "--set",
+                "discretization.mesh.n=4",
+                "--set",
+                "adaptivity.max_steps=3",
+            ]
+        )
+        == 0
+    )
     mesh, ds = read_solution(out)
     assert ds.attrs["order"] == 2 and ds["u1_edge_mean"].size == mesh.edges.shape[0]
     assert ds["error_indicator"].size == mesh.n_cells and ds.attrs["adapt_steps"] == 3

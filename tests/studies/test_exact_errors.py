@@ -27,15 +27,22 @@ def field(x, y):
 
 def field_gradient(x, y):
     """[component, derivative] of ``field``, differentiated by hand."""
-    return np.array([[0.4 * np.cos(40 * x) * np.cos(30 * y), -0.3 * np.sin(40 * x) * np.sin(30 * y)],
-                     [0.01 * y * np.exp(x * y) * np.sin(50 * y),
-                      0.01 * np.exp(x * y) * (x * np.sin(50 * y) + 50 * np.cos(50 * y))]])
+    return np.array(
+        [
+            [0.4 * np.cos(40 * x) * np.cos(30 * y), -0.3 * np.sin(40 * x) * np.sin(30 * y)],
+            [
+                0.01 * y * np.exp(x * y) * np.sin(50 * y),
+                0.01 * np.exp(x * y) * (x * np.sin(50 * y) + 50 * np.cos(50 * y)),
+            ],
+        ]
+    )
 
 
 @pytest.mark.parametrize("order", [1, 2])
 def test_the_exact_error_attributes_are_the_exact_integrals(order):
     scene = load_scene(ROOT / "config" / "scenes" / "paper.yaml").with_overrides(
-        ["discretization.mesh.n=8", f"discretization.order={order}", f"exact.displacement={TEXT}"])
+        ["discretization.mesh.n=8", f"discretization.order={order}", f"exact.displacement={TEXT}"]
+    )
     problem, solution, ds = solve_scene(scene)
     quadrature = points, weights, _ = reference_quadrature(problem.mesh, degree=5)
     absolute = exact_errors(problem.mesh, problem.projected(solution.u), field, field_gradient, quadrature)
@@ -43,5 +50,6 @@ def test_the_exact_error_attributes_are_the_exact_integrals(order):
     semi = np.sqrt(np.sum(weights * np.sum(np.square(field_gradient(*points.T)), axis=(0, 1))))
     assert ds.attrs["error_l2"] == pytest.approx(absolute["l2"] / l2, rel=1e-12)
     assert ds.attrs["error_h1_semi"] == pytest.approx(absolute["h1_semi"] / semi, rel=1e-12)
-    assert ds.attrs["error_h1"] == pytest.approx(np.hypot(absolute["l2"], absolute["h1_semi"]) / np.hypot(l2, semi),
-                                                 rel=1e-12)
+    assert ds.attrs["error_h1"] == pytest.approx(
+        np.hypot(absolute["l2"], absolute["h1_semi"]) / np.hypot(l2, semi), rel=1e-12
+    )

@@ -42,8 +42,15 @@ def test_the_convergence_measure_refuses_k2_solutions(solutions):
 def test_solved_error_records_refuse_order2_before_solving():
     meshes = [(4, build_mesh("square", 4))]
     with pytest.raises(SceneError, match="convergence study") as caught:
-        solved_error_records("square", {"family": "square"}, "dofi-2mu", meshes, (8, build_mesh("square", 8)), PAPER,
-                             overrides=["discretization.order=2"])
+        solved_error_records(
+            "square",
+            {"family": "square"},
+            "dofi-2mu",
+            meshes,
+            (8, build_mesh("square", 8)),
+            PAPER,
+            overrides=["discretization.order=2"],
+        )
     assert caught.value.key == "discretization.order"
     require_order1(load_scene(PAPER), "anything")  # k = 1 passes
 

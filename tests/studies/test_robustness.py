@@ -2,16 +2,22 @@
 
 from pathlib import Path
 
-from conftest import assert_no_nan_stored
-
 import numpy as np
 import pytest
+from conftest import assert_no_nan_stored
 
 from vemkit.config.scene import load_scene
 from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import ConvergenceError, LinearSolveError, SceneError, TimeBudgetExceeded
-from vemkit.solvers.verification import (FAILURE_CLASSES, STATUS_MEANINGS, failed, failure_class, guarded_solve,
-                                         verify_solution)
+from vemkit.report.study_figures import stability_figure
+from vemkit.solvers.verification import (
+    FAILURE_CLASSES,
+    STATUS_MEANINGS,
+    failed,
+    failure_class,
+    guarded_solve,
+    verify_solution,
+)
 from vemkit.studies.robustness import (
     CASES,
     case_overrides,
@@ -20,14 +26,25 @@ from vemkit.studies.robustness import (
     stability_dataset,
     stability_markdown,
 )
-from vemkit.report.study_figures import stability_figure
 from vemkit.studies.sweeps import write_dataset
 
 ROOT = Path(__file__).resolve().parents[2]
 SOLVERS = {"ssn": {"max_iterations": 100}, "uzawa": {"max_iterations": 3000, "stop": "both"}}
 # one case of each kind of extreme; the whole matrix is the workflow's results/stability
-REPRESENTATIVE = ["paper", "k_nu=1e+08", "k_tau=0", "k_tau=1e+06", "m_nu=3,k_nu=10000", "m_tau=1,k_tau=10000",
-                  "kappa=0.4999", "E=0.002", "E=2e+09", "g_a=10", "voronoi,tiny edges,anisotropy=10", "hanging,levels=3"]
+REPRESENTATIVE = [
+    "paper",
+    "k_nu=1e+08",
+    "k_tau=0",
+    "k_tau=1e+06",
+    "m_nu=3,k_nu=10000",
+    "m_tau=1,k_tau=10000",
+    "kappa=0.4999",
+    "E=0.002",
+    "E=2e+09",
+    "g_a=10",
+    "voronoi,tiny edges,anisotropy=10",
+    "hanging,levels=3",
+]
 
 
 @pytest.fixture(scope="module")
@@ -111,7 +128,9 @@ def test_failure_classes_come_from_types_and_attributes_not_messages():
     assert failure_class(TimeBudgetExceeded("diverged")) == "time_budget"
     wrapped = ConvergenceError("ssn: diverged", solver="ssn", reason="linear_solver_failed", iterations=2)
     assert failure_class(wrapped) == "linear_solver_failed"
-    assert failure_class(raised_from(ConvergenceError("ssn: diverged"), LinearSolveError("cg"))) == "linear_solver_failed"
+    assert (
+        failure_class(raised_from(ConvergenceError("ssn: diverged"), LinearSolveError("cg"))) == "linear_solver_failed"
+    )
     assert failure_class(LinearSolveError("diverged")) == "linear_solver_failed"
     assert failure_class(SceneError("contact.normal.k = -1: must be >= 0")) == "invalid_input"
     assert failure_class(ValueError("anything"), phase="setup") == "invalid_input"
@@ -123,11 +142,12 @@ def test_failure_classes_come_from_types_and_attributes_not_messages():
 
 def test_real_solver_failures_carry_their_class():
     """Each solver failure raised by the solvers names its reason, solver and iteration."""
+    from conftest import paper_problem
+
     from vemkit.contact.laws import ContactLaw
+    from vemkit.mesh.families.square import square
     from vemkit.solvers.ssn import solve_ssn
     from vemkit.solvers.uzawa import solve_uzawa
-    from conftest import paper_problem
-    from vemkit.mesh.families.square import square
 
     stick_slip = paper_problem(square(8), law=ContactLaw(10.0, 1.0, 700.0, 0.0))
     stiff = paper_problem(square(8), law=ContactLaw(1e6, 1.0, 450.0, 0.0))
@@ -135,8 +155,11 @@ def test_real_solver_failures_carry_their_class():
         (lambda: solve_ssn(stick_slip, linear="direct", max_iterations=1), "ssn", ("max_iterations",)),
         (lambda: solve_uzawa(stick_slip, linear="direct", max_iterations=5), "uzawa", ("max_iterations",)),
         (lambda: solve_uzawa(stiff, linear="direct"), "uzawa", ("diverged", "stagnated")),
-        (lambda: solve_uzawa(paper_problem(square(8)), linear="direct", rho=1.0, max_iterations=3), "uzawa",
-         ("inaccurate_stop",)),
+        (
+            lambda: solve_uzawa(paper_problem(square(8)), linear="direct", rho=1.0, max_iterations=3),
+            "uzawa",
+            ("inaccurate_stop",),
+        ),
     ]
     for run, solver, reasons in cases:
         with pytest.raises(ConvergenceError) as failure:

@@ -2,11 +2,10 @@
 
 from pathlib import Path
 
-from conftest import assert_no_nan_stored
-
 import netCDF4
 import numpy as np
 import pytest
+from conftest import assert_no_nan_stored
 
 from vemkit.config.scene import load_scene
 from vemkit.solvers.verification import STATUS_MEANINGS
@@ -56,15 +55,21 @@ def test_dimensions_coordinates_and_attributes(friction_grid, scene):
 def test_quantities_are_consistent(friction_grid):
     _, ds = friction_grid
     w = ds["contact_weight"].values
-    np.testing.assert_allclose(ds["normal_force"].values, (ds["profile_pressure"] * w).sum("contact_node").values,
-                               rtol=1e-12)
-    np.testing.assert_allclose(ds["tangential_force"].values,
-                               (ds["profile_tangential_stress"] * w).sum("contact_node").values, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        ds["normal_force"].values, (ds["profile_pressure"] * w).sum("contact_node").values, rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        ds["tangential_force"].values,
+        (ds["profile_tangential_stress"] * w).sum("contact_node").values,
+        rtol=1e-12,
+        atol=1e-12,
+    )
     in_contact = (ds["profile_penetration"] > 0).values
     np.testing.assert_allclose(ds["contact_length"].values, (in_contact * w).sum(-1), rtol=1e-12)
     np.testing.assert_allclose(ds["stick_length"] + ds["slip_length"], ds["contact_length"], rtol=1e-12)
-    np.testing.assert_allclose(ds["max_penetration"].values,
-                               np.maximum(ds["profile_penetration"].max("contact_node").values, 0.0))
+    np.testing.assert_allclose(
+        ds["max_penetration"].values, np.maximum(ds["profile_penetration"].max("contact_node").values, 0.0)
+    )
     frictionless = ds.sel(k_tau=0.0)
     np.testing.assert_array_equal(frictionless["tangential_force"].values, 0.0)
     assert np.all(np.abs(ds.sel(k_tau=450.0)["tangential_force"].values) > 0)
@@ -73,8 +78,9 @@ def test_quantities_are_consistent(friction_grid):
 
 
 def test_normal_force_grows_with_the_load_and_falls_with_the_gap(scene):
-    ds = run_sweep(scene, {"boundary.neumann.left.traction[1]": [-100.0, -200.0, -400.0],
-                           "contact.gap": [0.0, 0.05, 0.1, 0.2]})
+    ds = run_sweep(
+        scene, {"boundary.neumann.left.traction[1]": [-100.0, -200.0, -400.0], "contact.gap": [0.0, 0.05, 0.1, 0.2]}
+    )
     assert ds["status"].dims == ("boundary_neumann_left_traction_1", "g_a")
     force = ds["normal_force"].values
     assert np.all(np.diff(force, axis=0) > 0)
@@ -116,9 +122,17 @@ def test_reused_problem_equals_fresh_solves_with_gauss_quadrature(scene):
 def test_failures_are_classified_and_the_file_holds_no_nan(scene, tmp_path):
     grid = {"solver.method": ["ssn", "uzawa"], "contact.normal.k": [10.0, 1e5, -1.0]}
     ds = run_sweep(scene.with_overrides(["solver.stop=both"]), grid)
-    status = {(m, k): STATUS_MEANINGS[int(ds["status"].sel(solver=m, k_nu=k))] for m in ("ssn", "uzawa") for k in (10.0, 1e5, -1.0)}
+    status = {
+        (m, k): STATUS_MEANINGS[int(ds["status"].sel(solver=m, k_nu=k))]
+        for m in ("ssn", "uzawa")
+        for k in (10.0, 1e5, -1.0)
+    }
     assert status[("ssn", 10.0)] == status[("ssn", 1e5)] == status[("uzawa", 10.0)] == "converged"
-    assert status[("uzawa", 1e5)] in ("not_converged_diverged", "not_converged_stagnated", "not_converged_max_iterations")
+    assert status[("uzawa", 1e5)] in (
+        "not_converged_diverged",
+        "not_converged_stagnated",
+        "not_converged_max_iterations",
+    )
     assert "contact.normal.k" in str(ds["message"].sel(solver="uzawa", k_nu=1e5).values)
     assert status[("ssn", -1.0)] == status[("uzawa", -1.0)] == "error_invalid_input"
     assert np.isnan(float(ds["normal_force"].sel(solver="uzawa", k_nu=1e5)))
@@ -137,7 +151,9 @@ def test_failures_are_classified_and_the_file_holds_no_nan(scene, tmp_path):
 def test_the_paper_stop_rule_is_held_to_tol(scene):
     """The paper's rule (stop on |du| OR |dlambda|) fires one lagged step early at h = 1/8 (residual ~3e-6);
     uzawa refuses that stop and iterates on until the residual is what solver.tol asks for."""
-    ds = run_sweep(scene, {"solver.method": ["uzawa"], "solver.stop": ["either", "both"]}, check_tol=1e-6).squeeze("solver")
+    ds = run_sweep(scene, {"solver.method": ["uzawa"], "solver.stop": ["either", "both"]}, check_tol=1e-6).squeeze(
+        "solver"
+    )
     for stop in ("either", "both"):
         assert int(ds["status"].sel(solver_stop=stop)) == 0, stop
         assert float(ds["residual"].sel(solver_stop=stop)) <= 1e-8, stop

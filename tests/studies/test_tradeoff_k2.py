@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from vemkit.config.scene import load_scene
+from vemkit.exceptions import InputError
 from vemkit.io.solution_file import write_netcdf
 from vemkit.mesh.families import build_mesh
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.tradeoff import family_order, run_family, tradeoff_dataset, tradeoff_markdown
-from vemkit.exceptions import InputError
 from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import projection_error
 from vemkit.vem.quadrature import reference_quadrature
@@ -43,8 +43,13 @@ def test_a_k2_run_is_measured_with_pi2_on_its_own_reference(k2_reference):
     assert record["error_h1"] < 1e-8 and record["error_l2"] < 1e-8
     assert record["n_dofs"] == record["n_unknowns"] + 2 * record["n_cells"]  # the condensed cell means count
     vertex = ref.displacement  # the wrong measure: Pi_1 of the k = 2 solution's vertex values
-    wrong = projection_error(ref.mesh, projected_solution(ref.mesh, vertex), ref.mesh, ref.projected,
-                             reference_quadrature(ref.mesh, degree=5))
+    wrong = projection_error(
+        ref.mesh,
+        projected_solution(ref.mesh, vertex),
+        ref.mesh,
+        ref.projected,
+        reference_quadrature(ref.mesh, degree=5),
+    )
     assert wrong["h1"] > 1e-2
     (k1,) = run_family(scene, "square", {"family": "square"}, ref, levels=[8], reference_n=8, **RUN)
     assert k1["order"] == 1 and k1["error_h1"] > 1e-2
@@ -63,18 +68,46 @@ def test_k2_beats_k1_at_equal_mesh_against_the_k1_reference(k1_reference):
     assert k2[0]["error_h1"] > k2[1]["error_h1"]
     for one, two in zip(k1, k2, strict=True):
         assert two["error_h1"] < 0.6 * one["error_h1"], (one["error_h1"], two["error_h1"])
-    tri = run_family(scene, "tri-k2", {"family": "triangle", "options": {"kind": "structured"}, "order": 2}, ref,
-                     levels=[4], solvers=["ssn"], tolerances=[1e-10], stabilizations=["dofi-2mu", "trace"],
-                     reference_n=32)
+    tri = run_family(
+        scene,
+        "tri-k2",
+        {"family": "triangle", "options": {"kind": "structured"}, "order": 2},
+        ref,
+        levels=[4],
+        solvers=["ssn"],
+        tolerances=[1e-10],
+        stabilizations=["dofi-2mu", "trace"],
+        reference_n=32,
+    )
     assert len(tri) == 2  # k = 2 on triangles is not P2: every stabilization counts
 
 
 def _record(family, order, n, error, time):
     dofs = 2 * n * (n + 1) * order**2
-    return {"family": family, "family_name": "square", "solver": "ssn", "tol": 1e-10, "stabilization": "dofi-2mu",
-            "n": n, "order": order, "n_dofs": dofs, "n_unknowns": dofs, "n_cells": n * n, "h_min": 1.0 / n,
-            "iterations": 2, "status": 0, "message": "", "wall_time": time, "assembly_time": 0.0, "mesh_time": 0.0,
-            "cost_time": time, "residual": 0.0, "error_h1": error, "error_h1_semi": error, "error_l2": error / 10}
+    return {
+        "family": family,
+        "family_name": "square",
+        "solver": "ssn",
+        "tol": 1e-10,
+        "stabilization": "dofi-2mu",
+        "n": n,
+        "order": order,
+        "n_dofs": dofs,
+        "n_unknowns": dofs,
+        "n_cells": n * n,
+        "h_min": 1.0 / n,
+        "iterations": 2,
+        "status": 0,
+        "message": "",
+        "wall_time": time,
+        "assembly_time": 0.0,
+        "mesh_time": 0.0,
+        "cost_time": time,
+        "residual": 0.0,
+        "error_h1": error,
+        "error_h1_semi": error,
+        "error_l2": error / 10,
+    }
 
 
 def test_the_pareto_answer_includes_k2():

@@ -79,8 +79,19 @@ def _records():
     out = []
     for family, c in (("square", 1.0), ("voronoi", 2.0)):
         for level, h in enumerate((0.4, 0.2, 0.1)):
-            out.append({"scene": "kirsch", "family": family, "level": level, "h": h, "n_dofs": 100 * 4**level,
-                        "error_h1": c * h, "error_h1_semi": c * h, "error_l2": c * h * h, "stress_concentration": 3.0})
+            out.append(
+                {
+                    "scene": "kirsch",
+                    "family": family,
+                    "level": level,
+                    "h": h,
+                    "n_dofs": 100 * 4**level,
+                    "error_h1": c * h,
+                    "error_h1_semi": c * h,
+                    "error_l2": c * h * h,
+                    "stress_concentration": 3.0,
+                }
+            )
     out.append({"scene": "cook", "family": "square", "level": 0, "h": 2.0, "n_dofs": 50, "v_mid": 23.0})
     return out
 
@@ -90,7 +101,10 @@ def test_dataset_orders_and_fill_values(tmp_path):
     assert ds["order_h1"].sel(scene="kirsch").values[:, 1:] == pytest.approx(1.0)
     assert ds["order_l2"].sel(scene="kirsch").values[:, 1:] == pytest.approx(2.0)
     assert np.isnan(ds["order_h1"].sel(scene="kirsch", level=0)).all()
-    assert np.isnan(ds["v_mid"].sel(scene="kirsch")).all() and np.isnan(ds["n_dofs"].sel(scene="cook", family="voronoi")).all()
+    assert (
+        np.isnan(ds["v_mid"].sel(scene="kirsch")).all()
+        and np.isnan(ds["n_dofs"].sel(scene="cook", family="voronoi")).all()
+    )
     path = V.write_verification(ds, tmp_path / "v.nc")
     import netCDF4
 

@@ -2,13 +2,13 @@
 
 import numpy as np
 import pytest
-
 from conftest import FAMILY_CASES, family_mesh
+
 from vemkit.contact.problem import discrete_problem
 from vemkit.solvers.linear import linear_solver
 from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.estimator import dorfler_marking, error_indicators, local_energies
 from vemkit.vem.elements import stabilization_code
+from vemkit.vem.estimator import dorfler_marking, error_indicators, local_energies
 from vemkit.vem.space import VirtualElementSpace
 
 LAM, MU = lame_parameters(2000.0, 0.4)
@@ -19,8 +19,9 @@ LAM, MU = lame_parameters(2000.0, 0.4)
 def test_local_energies_add_up_to_the_assembled_energy(case, stab):
     mesh = family_mesh(case, 5)
     u = np.random.default_rng(3).normal(size=(mesh.n_vertices, 2))
-    total, consistency = local_energies(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, LAM, MU,
-                                        stabilization_code(stab))
+    total, consistency = local_energies(
+        mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, LAM, MU, stabilization_code(stab)
+    )
     K = VirtualElementSpace(mesh, 1).stiffness_matrix(LAM, MU, stab)
     assert np.isclose(total.sum(), u.ravel() @ (K @ u.ravel()), rtol=1e-12)
     assert np.all(consistency <= total * (1 + 1e-12))
@@ -34,8 +35,10 @@ def test_the_estimate_vanishes_for_the_exact_solution_of_the_patch_test(case):
     grad = np.outer(c, [1.0, 0.0])
     eps = 0.5 * (grad + grad.T)
     sig = LAM * np.trace(eps) * np.eye(2) + 2 * MU * eps
-    tractions = {side: (lambda x, y, t=sig @ np.array(n, float): (t[0] + 0 * x, t[1] + 0 * x))
-                 for side, n in {"left": [-1, 0], "top": [0, 1], "bottom": [0, -1]}.items()}
+    tractions = {
+        side: (lambda x, y, t=sig @ np.array(n, float): (t[0] + 0 * x, t[1] + 0 * x))
+        for side, n in {"left": [-1, 0], "top": [0, 1], "bottom": [0, -1]}.items()
+    }
     pb = discrete_problem(mesh, 2000.0, 0.4, dirichlet=("right",), neumann=tractions)
     u = pb.dofs.expand(linear_solver(pb.stiffness, "direct").solve(pb.load))
     found = error_indicators(mesh, u, pb.lam, pb.mu, pb.stabilization, neumann=tractions)
@@ -44,8 +47,12 @@ def test_the_estimate_vanishes_for_the_exact_solution_of_the_patch_test(case):
     wrong = dict(tractions, top=lambda x, y: (0 * x + sig[0, 1] + 1.0, 0 * x + sig[1, 1]))
     seen = error_indicators(mesh, u, pb.lam, pb.mu, pb.stabilization, neumann=wrong)
     flagged = np.flatnonzero(seen["neumann"] > 1e-12)
-    top = np.unique(np.searchsorted(mesh.cell_offsets, np.flatnonzero(
-        np.isin(mesh.cell_vertices, mesh.boundary["top"])), side="right") - 1)
+    top = np.unique(
+        np.searchsorted(
+            mesh.cell_offsets, np.flatnonzero(np.isin(mesh.cell_vertices, mesh.boundary["top"])), side="right"
+        )
+        - 1
+    )
     touching = [k for k in top if np.isin(mesh.boundary["top"], mesh.cell(k)).all(axis=1).any()]
     assert flagged.tolist() == sorted(touching)
     # |e| ∫_e |Δt|² summed over the top side = Σ |e|² with Δt = (1, 0): the side length squared / m

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
-
 from conftest import FAMILY_CASES, family_mesh
+
 from vemkit.mesh.families import build_mesh
-from vemkit.vem.interpolation import MEAN_VALUE, WACHSPRESS, cell_kinds, coordinates, interpolate
 from vemkit.mesh.locate import locate_points
 from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.interpolation import MEAN_VALUE, WACHSPRESS, cell_kinds, coordinates, interpolate
 from vemkit.vem.norms import paper_error, projection_error
 
 
@@ -77,8 +77,12 @@ def test_nested_squares_agree_with_the_tensor_bilinear_formula(rng):
     i0 = np.minimum(np.floor(s[:, 0]).astype(int), n - 1)
     j0 = np.minimum(np.floor(s[:, 1]).astype(int), n - 1)
     fx, fy = s[:, 0] - i0, s[:, 1] - j0
-    expected = ((1 - fx) * (1 - fy) * grid[i0, j0] + fx * (1 - fy) * grid[i0 + 1, j0]
-                + (1 - fx) * fy * grid[i0, j0 + 1] + fx * fy * grid[i0 + 1, j0 + 1])
+    expected = (
+        (1 - fx) * (1 - fy) * grid[i0, j0]
+        + fx * (1 - fy) * grid[i0 + 1, j0]
+        + (1 - fx) * fy * grid[i0, j0 + 1]
+        + fx * fy * grid[i0 + 1, j0 + 1]
+    )
     assert np.allclose(got, expected, atol=1e-13, rtol=0)
 
 
@@ -123,6 +127,7 @@ def test_paper_measure_of_a_linear_field_and_of_the_reference_itself_is_zero(cas
 def test_paper_measure_on_nested_squares_converges_at_order_one():
     """Nodal interpolants of a smooth field: e_h = O(h), and on one mesh the paper's measure and
     the seminorm of Pi_1 on each mesh coincide up to the interpolation inside the coarse cells."""
+
     def smooth(x):
         return np.stack([np.sin(2 * x[:, 0]) * np.cos(x[:, 1]), np.exp(x[:, 0] * x[:, 1])], axis=1)
 
@@ -134,8 +139,9 @@ def test_paper_measure_on_nested_squares_converges_at_order_one():
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert np.all(np.abs(orders - 1.0) < 0.1), orders
     mesh = build_mesh("square", 16)
-    semi = projection_error(mesh, projected_solution(mesh, smooth(mesh.vertices)), ref,
-                            projected_solution(ref, smooth(ref.vertices)))["h1_semi"]
+    semi = projection_error(
+        mesh, projected_solution(mesh, smooth(mesh.vertices)), ref, projected_solution(ref, smooth(ref.vertices))
+    )["h1_semi"]
     assert 0.5 < errors[-1] / semi < 2.0
 
 

@@ -8,8 +8,8 @@ a non-polynomial body force; the element-level kernel is pinned against a dense 
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
-
 from conftest import family_mesh
+
 from vemkit.vem.assembly import condense_interior
 from vemkit.vem.condensation import condense_load, interior_load, recover_interior
 from vemkit.vem.elasticity import lame_parameters
@@ -28,9 +28,13 @@ def _force(x, y):
 def test_condensed_solution_is_the_full_solution(case):
     mesh = family_mesh(case, 5)
     space = VirtualElementSpace(mesh, 2)
-    load = body_force_k2(mesh, _force) + traction_load_k2(mesh, mesh.boundary["left"], lambda x, y: (0 * x + 50, 20 * y))
+    load = body_force_k2(mesh, _force) + traction_load_k2(
+        mesh, mesh.boundary["left"], lambda x, y: (0 * x + 50, 20 * y)
+    )
     full = space.numbering(space.clamped_on(mesh.boundary["right"]))
-    u_full = full.node_values(spla.spsolve(space.stiffness_matrix(LAM, MU, "dofi-2mu", full).tocsc(), full.restrict(load)))
+    u_full = full.node_values(
+        spla.spsolve(space.stiffness_matrix(LAM, MU, "dofi-2mu", full).tocsc(), full.restrict(load))
+    )
     clamped = np.zeros(full.n_nodes, dtype=bool)
     clamped[full.clamped_nodes] = True
     nodes = space.numbering(clamped, condensed=True)

@@ -10,8 +10,8 @@ the dual solution z), the P_1 load gives the optimal L2 order 3.
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
-
 from conftest import FAMILY_CASES, family_mesh
+
 from vemkit.vem.assembly import dirichlet_lift
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.elements.k2_fields import body_force_k2, body_force_p1_k2, projected_solution_k2
@@ -73,4 +73,3 @@ def test_manufactured_solution_converges_at_second_order(case):
     # the paper's P_0 load: L2 order 2, not 3 (an O(h^2) consistency error, measured, not assumed)
     assert 1.8 <= rate["p0"][1] <= 2.3, (case, rate, errs)
     assert errs[-1]["p1"][1] < 0.1 * errs[-1]["p0"][1]
-

@@ -4,15 +4,14 @@ exact quadratic consistency, and the k = 2 patch test on whole meshes of every f
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
+from conftest import FAMILY_CASES, POLYGONS, family_mesh, nonconvex_mesh
 
-from conftest import FAMILY_CASES, family_mesh
-from conftest import POLYGONS, nonconvex_mesh
 from vemkit.vem.assembly import dirichlet_lift
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.elements import STABILIZATIONS
-from vemkit.vem.elements.k2_stiffness import element_stiffness_k2_matrix
-from vemkit.vem.elements.k2_reference import element_stiffness_k2_reference, field_dofs
 from vemkit.vem.elements.k2_fields import body_force_k2, traction_load_k2
+from vemkit.vem.elements.k2_reference import element_stiffness_k2_reference, field_dofs
+from vemkit.vem.elements.k2_stiffness import element_stiffness_k2_matrix
 from vemkit.vem.space import VirtualElementSpace
 
 LAM, MU = lame_parameters(2000.0, 0.4)
@@ -74,8 +73,11 @@ def test_kernel_null_space_is_exactly_the_rigid_motions(name, stab):
     K = element_stiffness_k2_matrix(coords, LAM, MU, stab)
     ev = np.linalg.eigvalsh(K)
     assert np.all(np.abs(ev[:3]) < 1e-12 * ev[-1]) and ev[3] > 1e-6 * ev[-1]
-    for rigid in (np.array([[1.0, 0, 0, 0, 0, 0], [0] * 6]), np.array([[0] * 6, [1.0, 0, 0, 0, 0, 0]]),
-                  np.array([[0, 0, -1.0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0]])):
+    for rigid in (
+        np.array([[1.0, 0, 0, 0, 0, 0], [0] * 6]),
+        np.array([[0] * 6, [1.0, 0, 0, 0, 0, 0]]),
+        np.array([[0, 0, -1.0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0]]),
+    ):
         assert np.abs(K @ field_dofs(coords, quadratic_stacked(rigid))).max() < 1e-11 * ev[-1]
 
 
@@ -138,6 +140,7 @@ def test_stiffness_times_quadratic_is_its_load(case):
     load = body_force_k2(mesh, lambda x, y: (f[0] + 0 * x, f[1] + 0 * x))
     normals = {"left": (-1, 0), "right": (1, 0), "bottom": (0, -1), "top": (0, 1)}
     for side, (n1, n2) in normals.items():
+
         def traction(x, y, n1=n1, n2=n2):
             s11, s22, s12 = quadratic_stress(x, y)
             return s11 * n1 + s12 * n2, s12 * n1 + s22 * n2
@@ -158,7 +161,9 @@ def test_eliminated_assembly_is_the_restriction_of_the_full_matrix():
     values = space.interpolate(quadratic)
     clamped = (2 * nodes.clamped_nodes[:, None] + np.arange(2)).ravel()
     expected = -full[np.ix_(free, clamped)] @ values.ravel()[clamped]
-    assert np.allclose(dirichlet_lift(space, LAM, MU, "trace", nodes, values), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    assert np.allclose(
+        dirichlet_lift(space, LAM, MU, "trace", nodes, values), expected, rtol=0, atol=1e-10 * np.abs(expected).max()
+    )
 
 
 @pytest.mark.parametrize("case", ["triangle-delaunay", "voronoi", "nonconvex"])

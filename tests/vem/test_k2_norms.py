@@ -34,10 +34,14 @@ def test_a_quadratic_has_no_error_at_k2_and_a_linear_field_none_at_k1():
     coarse = build_mesh("hanging", 4, levels=1, rule="contact")
     ref_values, ref = _k2(fine, _quadratic)
     coarse_values, coarse_proj = _k2(coarse, _quadratic)
-    err = projection_error_degree5(coarse, coarse_proj, fine, ref, regions={"everywhere": lambda p: np.ones(len(p), bool)})
+    err = projection_error_degree5(
+        coarse, coarse_proj, fine, ref, regions={"everywhere": lambda p: np.ones(len(p), bool)}
+    )
     assert max(err["h1"], err["h1_semi"], err["l2"]) < 1e-12
-    assert trace_error(VirtualElementSpace(coarse, 2), coarse_values, VirtualElementSpace(fine, 2), ref_values,
-                       "bottom") < 1e-12
+    assert (
+        trace_error(VirtualElementSpace(coarse, 2), coarse_values, VirtualElementSpace(fine, 2), ref_values, "bottom")
+        < 1e-12
+    )
 
     def linear(x, y):
         return 0.3 * x - 0.2 * y + 0.1, 0.5 * y + 0.4 * x
@@ -61,12 +65,14 @@ def test_known_errors_of_the_k1_interpolant_of_x_squared(n):
     ref_values, ref = _k2(fine, field)
     coarse = build_mesh("square", n)
     vertex_values = np.stack(field(*coarse.vertices.T), axis=1)
-    err = projection_error_degree5(coarse, projected_solution(coarse, vertex_values), fine, ref,
-                              regions={"left half": lambda p: p[:, 0] < 0.5})
+    err = projection_error_degree5(
+        coarse, projected_solution(coarse, vertex_values), fine, ref, regions={"left half": lambda p: p[:, 0] < 0.5}
+    )
     assert err["h1_semi"] == pytest.approx(h / 2, rel=1e-12)
     assert err["share_left half"] == pytest.approx(0.5, rel=1e-12)  # the error density is uniform
-    assert trace_error(VirtualElementSpace(coarse, 1), vertex_values, VirtualElementSpace(fine, 2), ref_values,
-                       ["bottom"]) == pytest.approx(h * h / np.sqrt(6), rel=1e-12)
+    assert trace_error(
+        VirtualElementSpace(coarse, 1), vertex_values, VirtualElementSpace(fine, 2), ref_values, ["bottom"]
+    ) == pytest.approx(h * h / np.sqrt(6), rel=1e-12)
 
 
 @pytest.mark.parametrize("order", [1, 2])
@@ -79,8 +85,11 @@ def test_trace_errors_of_the_interpolants_of_a_cubic(order):
 
     mesh = build_mesh("square", 4)
     space = VirtualElementSpace(mesh, order)
-    values = np.stack([mesh.vertices[:, 0] ** 3, 0 * mesh.vertices[:, 0]], axis=1) if order == 1 else \
-        space.interpolate(lambda x, y: (x**3, 0 * x))
+    values = (
+        np.stack([mesh.vertices[:, 0] ** 3, 0 * mesh.vertices[:, 0]], axis=1)
+        if order == 1
+        else space.interpolate(lambda x, y: (x**3, 0 * x))
+    )
     err = trace_errors(space, "bottom", values, lambda p: np.stack([p[:, 0] ** 3, 0 * p[:, 0]], axis=1))
     m, w = np.polynomial.legendre.leggauss(10)
     eta, squared = 0.125, 0.0
@@ -105,10 +114,12 @@ def test_trace_errors_against_a_nested_reference_trace_is_trace_error():
     ref_values, coarse_values = fine_space.interpolate(field), coarse_space.interpolate(field)
     m = nesting_subdivisions(coarse, fine, "bottom")
     assert m == 4  # coarse bottom edges 1/8, reference edges 1/32
-    err = trace_errors(coarse_space, "bottom", coarse_values,
-                       lambda p: boundary_trace(fine_space, "bottom", ref_values, p), m)
-    assert err["contact_l2"] == pytest.approx(trace_error(coarse_space, coarse_values, fine_space, ref_values, "bottom"),
-                                              rel=1e-10)
+    err = trace_errors(
+        coarse_space, "bottom", coarse_values, lambda p: boundary_trace(fine_space, "bottom", ref_values, p), m
+    )
+    assert err["contact_l2"] == pytest.approx(
+        trace_error(coarse_space, coarse_values, fine_space, ref_values, "bottom"), rel=1e-10
+    )
     # the coarse values are the interpolant of the field, the reference a 4x finer one: I_h u_ref is
     # I_h u up to the reference's own O(h^3 / 64) trace error
     assert err["interpolation_contact_l2"] == pytest.approx(err["contact_l2"], rel=0.05)

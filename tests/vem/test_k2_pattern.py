@@ -5,8 +5,8 @@ node-cell incidence B, each coupling a full 2 x 2 block of scalar dofs."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
-
 from conftest import family_mesh
+
 from vemkit.vem.dofs import DofMap
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.elements.k2_fields import cell_nodes

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import family_mesh
+
 from vemkit.contact.problem import discrete_problem
 from vemkit.vem.elasticity import lame_parameters
 from vemkit.vem.elements import ORDERS, element_for
@@ -22,10 +22,12 @@ CASES = ["square", "voronoi", "hanging-random", "triangle-delaunay"]
 
 def polynomial(order: int):
     """A vector field of degree ``order`` (every monomial present)."""
+
     def field(x, y):
         u1 = 0.1 + 0.2 * x - 0.3 * y + (order >= 2) * (0.05 * x * x - 0.07 * x * y + 0.02 * y * y)
         u2 = -0.2 + 0.1 * x + 0.4 * y + (order >= 2) * (0.03 * x * x + 0.06 * x * y - 0.04 * y * y)
         return u1, u2
+
     return field
 
 
@@ -39,8 +41,10 @@ def test_pi_reproduces_polynomials_of_the_elements_degree(order, case):
     cells = rng.integers(0, space.mesh.n_cells, 200)
     offsets = space.mesh.cell_offsets
     corner = space.mesh.vertices[space.mesh.cell_vertices[offsets[cells]]]
-    centre = np.add.reduceat(space.mesh.vertices[space.mesh.cell_vertices], offsets[:-1])[cells] / \
-        space.mesh.cell_sizes[cells, None]
+    centre = (
+        np.add.reduceat(space.mesh.vertices[space.mesh.cell_vertices], offsets[:-1])[cells]
+        / space.mesh.cell_sizes[cells, None]
+    )
     points = centre + rng.uniform(0, 0.5, (200, 1)) * (corner - centre)  # inside a star-shaped cell
     exact = np.stack(field(points[:, 0], points[:, 1]), axis=1)
     assert np.max(np.abs(projection.evaluate(cells, points) - exact)) < 1e-11
@@ -51,8 +55,7 @@ def test_the_stiffness_kernel_is_the_rigid_motions(order):
     space = VirtualElementSpace(family_mesh("voronoi", 5), order)
     dofs = space.numbering(natural=True)
     K = space.stiffness_matrix(LAM, MU, "dofi-2mu", dofs)
-    for motion in (lambda x, y: (np.ones_like(x), 0 * x), lambda x, y: (0 * x, np.ones_like(x)),
-                   lambda x, y: (-y, x)):
+    for motion in (lambda x, y: (np.ones_like(x), 0 * x), lambda x, y: (0 * x, np.ones_like(x)), lambda x, y: (-y, x)):
         u = dofs.restrict(space.interpolate(motion))
         assert np.max(np.abs(K @ u)) < 1e-9 * abs(K).max()
     eigenvalues = np.linalg.eigvalsh(K.toarray())
@@ -82,13 +85,20 @@ def test_the_numbering_numbers_every_free_node_once(order):
         assert np.array_equal(np.sort(dofs.free_nodes), np.flatnonzero(free))
         assert np.array_equal(dofs.free_index[dofs.free_nodes], np.arange(dofs.free_nodes.size))
         assert dofs.n_free == 2 * int(free.sum()) and dofs.condensed == (condensed and order > 1)
-    assert space.n_dofs == element_for(order).count_dofs(space.mesh.n_vertices, space.mesh.edges.shape[0],
-                                                         space.mesh.n_cells)
+    assert space.n_dofs == element_for(order).count_dofs(
+        space.mesh.n_vertices, space.mesh.edges.shape[0], space.mesh.n_cells
+    )
 
 
 def test_the_unknowns_invert_the_change_of_variables_of_the_contact_midpoints():
-    problem = discrete_problem(family_mesh("square", 4), 2000.0, 0.4, order=2, contact=["bottom"],
-                               neumann={"left": lambda x, y: (np.ones_like(x), 0 * x)})
+    problem = discrete_problem(
+        family_mesh("square", 4),
+        2000.0,
+        0.4,
+        order=2,
+        contact=["bottom"],
+        neumann={"left": lambda x, y: (np.ones_like(x), 0 * x)},
+    )
     assert problem.dofs.change is not None
     rng = np.random.default_rng(1)
     values = problem.dofs.node_values(rng.standard_normal(problem.n_dofs))

@@ -3,20 +3,21 @@
 import numpy as np
 import pytest
 import scipy.sparse as sp
-
 from conftest import FAMILY_CASES, POLYGONS, family_mesh, nonconvex_mesh
+
+from vemkit.contact.problem import discrete_problem
+from vemkit.solvers.linear import linear_solver
+from vemkit.vem.elasticity import lame_parameters
+from vemkit.vem.elements import STABILIZATIONS
 from vemkit.vem.elements.k1_fields import projected_solution
+from vemkit.vem.elements.k1_kernel import element_stiffness
+from vemkit.vem.elements.k1_reference import element_stiffness_reference
 from vemkit.vem.norms import exact_errors
 from vemkit.vem.projection import shear_energy_density, stress
 from vemkit.vem.space import VirtualElementSpace
-from vemkit.solvers.linear import linear_solver
-from vemkit.contact.problem import discrete_problem
-from vemkit.vem.elasticity import lame_parameters
-from vemkit.vem.elements import STABILIZATIONS
-from vemkit.vem.elements.k1_kernel import element_stiffness
-from vemkit.vem.elements.k1_reference import element_stiffness_reference
 
 LAM, MU = lame_parameters(2000.0, 0.4)
+
 
 def kernel(coords, stab):
     n = len(coords)
@@ -172,9 +173,13 @@ def manufactured_errors(mesh, stab="dofi-2mu"):
         return f
 
     pb = discrete_problem(
-        mesh, 2000.0, 0.4, dirichlet=("right",),
+        mesh,
+        2000.0,
+        0.4,
+        dirichlet=("right",),
         neumann={"left": traction((-1, 0)), "top": traction((0, 1)), "bottom": traction((0, -1))},
-        body_force=body_force, stabilization=stab,
+        body_force=body_force,
+        stabilization=stab,
     )
     u = pb.dofs.expand(linear_solver(pb.stiffness, "direct").solve(pb.load))
     return exact_errors(mesh, projected_solution(mesh, u), exact_u, exact_grad)

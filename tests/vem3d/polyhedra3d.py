@@ -22,8 +22,12 @@ def _rectangle_face(points, lo, hi, axis, outward):
         u, v = v, u
     tol = 1e-9
     inside = np.all((points >= lo - tol) & (points <= hi + tol), axis=1)
-    on_edge = inside & ((np.abs(points[:, u] - lo[u]) < tol) | (np.abs(points[:, u] - hi[u]) < tol)
-                        | (np.abs(points[:, v] - lo[v]) < tol) | (np.abs(points[:, v] - hi[v]) < tol))
+    on_edge = inside & (
+        (np.abs(points[:, u] - lo[u]) < tol)
+        | (np.abs(points[:, u] - hi[u]) < tol)
+        | (np.abs(points[:, v] - lo[v]) < tol)
+        | (np.abs(points[:, v] - hi[v]) < tol)
+    )
     ids = np.flatnonzero(on_edge)
     centre = 0.5 * (lo + hi)
     angle = np.arctan2(points[ids, v] - centre[v], points[ids, u] - centre[u])
@@ -56,8 +60,13 @@ def box_cell(points, lo, hi, split=()):
 
 
 def _unique_points(boxes):
-    corners = np.array([[(b[0] if s == 0 else b[1])[k] for k, s in enumerate(bits)]
-                        for b in boxes for bits in itertools.product((0, 1), repeat=3)])
+    corners = np.array(
+        [
+            [(b[0] if s == 0 else b[1])[k] for k, s in enumerate(bits)]
+            for b in boxes
+            for bits in itertools.product((0, 1), repeat=3)
+        ]
+    )
     return np.unique(np.round(corners, 12), axis=0)
 
 
@@ -77,8 +86,10 @@ def _boundary(points, cells, box):
 def boxes_mesh(boxes, splits=None):
     points = _unique_points(boxes)
     splits = splits or {}
-    cells = [box_cell(points, np.asarray(b[0], float), np.asarray(b[1], float), splits.get(i, ()))
-             for i, b in enumerate(boxes)]
+    cells = [
+        box_cell(points, np.asarray(b[0], float), np.asarray(b[1], float), splits.get(i, ()))
+        for i, b in enumerate(boxes)
+    ]
     lo, hi = np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
     return from_polyhedra(points, cells, _boundary(points, cells, (lo, hi)))
 
@@ -181,8 +192,15 @@ def mapped(mesh, A, b):
     """The image of a mesh under x -> A x + b (det A > 0): planar faces stay planar."""
     from vemkit.mesh.polyhedral import PolyhedralMesh
 
-    return PolyhedralMesh(mesh.vertices @ np.asarray(A).T + b, mesh.face_offsets, mesh.face_vertices,
-                          mesh.cell_offsets, mesh.cell_faces, mesh.boundary, mesh.meta)
+    return PolyhedralMesh(
+        mesh.vertices @ np.asarray(A).T + b,
+        mesh.face_offsets,
+        mesh.face_vertices,
+        mesh.cell_offsets,
+        mesh.cell_faces,
+        mesh.boundary,
+        mesh.meta,
+    )
 
 
 def random_affine(rng):

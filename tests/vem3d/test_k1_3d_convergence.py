@@ -93,9 +93,15 @@ FAMILY_MESHES = {  # every 3D family of SPEC §10 on the unit cube, as a scene w
     "tet": lambda n: build_mesh3d("tet", CUBE, n=n),
     "octree": lambda n: build_mesh3d("octree", CUBE, n=n, rule="random", fraction=0.3, seed=1),
     "voronoi": lambda n: build_mesh3d("voronoi", CUBE, n=n, seed=2),
-    "extruded-voronoi": lambda n: build_mesh3d("voronoi", {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
-                                                           "sides": ["bottom", "right", "top", "left"],
-                                                           "extrude": {"depth": 1.0}}, n=n),
+    "extruded-voronoi": lambda n: build_mesh3d(
+        "voronoi",
+        {
+            "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+            "sides": ["bottom", "right", "top", "left"],
+            "extrude": {"depth": 1.0},
+        },
+        n=n,
+    ),
 }
 
 

@@ -4,8 +4,7 @@ the Numba kernel equals its numpy twin (which solves (3.8) literally)."""
 
 import numpy as np
 import pytest
-from polyhedra3d import (hanging_mesh, hex_grid, l_prism, mapped, random_affine, random_hull, random_star_prism,
-                         tet_grid)
+from polyhedra3d import hanging_mesh, hex_grid, l_prism, mapped, random_affine, random_hull, random_star_prism, tet_grid
 
 from vemkit.vem.elasticity import rigid_body_modes
 from vemkit.vem.elements import element_for, stabilization_code
@@ -35,8 +34,8 @@ def local_matrices(mesh, stabilization="dofi-2mu"):
     for c in range(mesh.n_cells):
         n = offsets[c + 1] - offsets[c]
         K = ELEMENT.cell_matrix(c, geometry, offsets, ids, LAM, MU, stabilization_code(stabilization), work)
-        faces = [face_local[face_ptr[t]:face_ptr[t + 1]] for t in range(cell_face_ptr[c], cell_face_ptr[c + 1])]
-        yield mesh.vertices[ids[offsets[c]:offsets[c + 1]]], faces, K[:3 * n, :3 * n].copy()
+        faces = [face_local[face_ptr[t] : face_ptr[t + 1]] for t in range(cell_face_ptr[c], cell_face_ptr[c + 1])]
+        yield mesh.vertices[ids[offsets[c] : offsets[c + 1]]], faces, K[: 3 * n, : 3 * n].copy()
 
 
 def planar_polygon(rng, m):

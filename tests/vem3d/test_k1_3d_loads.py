@@ -24,9 +24,16 @@ def test_body_force_is_the_cell_mean_against_pi_v(make):
     rng = np.random.default_rng(4)
     base = make()
     offsets, ids = base.cell_vertex_lists
-    box_centres = np.array([0.5 * (base.vertices[ids[offsets[c]:offsets[c + 1]]].min(axis=0)
-                                   + base.vertices[ids[offsets[c]:offsets[c + 1]]].max(axis=0))
-                            for c in range(base.n_cells)])
+    box_centres = np.array(
+        [
+            0.5
+            * (
+                base.vertices[ids[offsets[c] : offsets[c + 1]]].min(axis=0)
+                + base.vertices[ids[offsets[c] : offsets[c + 1]]].max(axis=0)
+            )
+            for c in range(base.n_cells)
+        ]
+    )
     A, b = random_affine(rng)
     mesh = mapped(base, A, b)
     space = VirtualElementSpace(mesh, 1)

@@ -22,8 +22,7 @@ def test_tetrahedra_give_p1_finite_elements():
     mesh = mapped(mesh, *random_affine(np.random.default_rng(3)))
     space = VirtualElementSpace(mesh, 1)
     assert space.element.dimension == 3 and space.n_dofs == 3 * mesh.n_vertices
-    basis = skfem.Basis(skfem.MeshTet(mesh.vertices.T.copy(), tets.T.copy()),
-                        skfem.ElementVector(skfem.ElementTetP1()))
+    basis = skfem.Basis(skfem.MeshTet(mesh.vertices.T.copy(), tets.T.copy()), skfem.ElementVector(skfem.ElementTetP1()))
     K_fem = linear_elasticity(LAM, MU).assemble(basis)
     order = basis.nodal_dofs.T.ravel()  # VEM dof 3 i + k is the finite element dof nodal_dofs[k, i]
     K_fem = K_fem[order][:, order].toarray()
@@ -105,7 +104,7 @@ def test_numbering_carries_three_components_per_node():
     values = np.random.default_rng(0).standard_normal((space.n_nodes, 3))
     u = dofs.restrict(values)
     node = dofs.free_nodes[4]
-    assert np.array_equal(u[3 * dofs.free_index[node]:3 * dofs.free_index[node] + 3], values[node])
+    assert np.array_equal(u[3 * dofs.free_index[node] : 3 * dofs.free_index[node] + 3], values[node])
     back = dofs.node_values(u)
     assert np.array_equal(back[~clamped], values[~clamped]) and np.all(back[clamped] == 0)
     assert dofs.expand(u).shape == (mesh.n_vertices, 3)

@@ -21,15 +21,20 @@ def dry_run(*args) -> subprocess.CompletedProcess:
     exe = str(exe) if exe.exists() else shutil.which("snakemake")
     if exe is None:
         pytest.skip("snakemake is not installed")
-    return subprocess.run([exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 def planned(*args) -> dict:
     run = dry_run(*args)
     assert run.returncode == 0, run.stdout + run.stderr
-    stats = run.stdout[run.stdout.index("Job stats:"):]
-    stats = stats[:stats.index("total")]
+    stats = run.stdout[run.stdout.index("Job stats:") :]
+    stats = stats[: stats.index("total")]
     return {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)}
 
 
@@ -41,20 +46,28 @@ def _config(tmp_path, scenes: dict) -> str:
 
 def test_every_scene_gets_its_runs_figures_and_reference_and_scenes_are_added_by_name(tmp_path):
     """A --configfile merges its scenes with the shipped ones; a scene whose file is missing is skipped."""
-    added = {"mine": {"scene": "config/scenes/paper.yaml", "overrides": ["discretization.mesh.n=2"]},
-             "ghost": {"scene": "config/scenes/no-such-scene.yaml", "reference": {"uniform": 3}}}
+    added = {
+        "mine": {"scene": "config/scenes/paper.yaml", "overrides": ["discretization.mesh.n=2"]},
+        "ghost": {"scene": "config/scenes/no-such-scene.yaml", "reference": {"uniform": 3}},
+    }
     scenes = {label: case for label, case in {**STUDY["scenes"], **added}.items() if (ROOT / case["scene"]).is_file()}
     assert "mine" in scenes and "ghost" not in scenes
     jobs = planned("adaptivity", "--configfile", _config(tmp_path, added))
     assert jobs.pop("adaptivity") == 1 and jobs.pop("adaptivity_summary") == 1
-    assert jobs == {"adaptivity_run": 2 * len(scenes), "adaptivity_figures": len(scenes),
-                    "adaptivity_reference": sum(case.get("reference") is not None for case in scenes.values())}
+    assert jobs == {
+        "adaptivity_run": 2 * len(scenes),
+        "adaptivity_figures": len(scenes),
+        "adaptivity_reference": sum(case.get("reference") is not None for case in scenes.values()),
+    }
 
 
-@pytest.mark.parametrize("entry, key", [
-    ({"scene": "config/scenes/paper.yaml", "theta": 1.5}, "theta"),
-    ({"scene": "config/scenes/paper.yaml", "reference": {"uniform": 3, "adaptive": 10}}, "reference"),
-])
+@pytest.mark.parametrize(
+    "entry, key",
+    [
+        ({"scene": "config/scenes/paper.yaml", "theta": 1.5}, "theta"),
+        ({"scene": "config/scenes/paper.yaml", "reference": {"uniform": 3, "adaptive": 10}}, "reference"),
+    ],
+)
 def test_bad_settings_are_refused_naming_the_key(tmp_path, entry, key):
     run = dry_run("adaptivity", "--configfile", _config(tmp_path, {"mine": entry}))
     message = run.stdout + run.stderr

@@ -16,8 +16,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vemkit.studies.convergence import (ReferenceSolution, read_convergence, run_record, solved_error_records,
-                                        study_scene)
+from vemkit.studies.convergence import (
+    ReferenceSolution,
+    read_convergence,
+    run_record,
+    solved_error_records,
+    study_scene,
+)
 from vemkit.studies.paper import PAPER_TABLE1
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -56,8 +61,16 @@ def test_archive_is_complete(archive):
     assert json.loads(archive.attrs["package_versions"])["vemkit"]
     assert archive.attrs["git_commit"]
     assert int(archive["defined"].sum()) == archive["defined"].size
-    for name in ("error_h1", "error_h1_semi", "order", "error_paper", "order_paper", "n_dofs", "iterations",
-                 "wall_time"):
+    for name in (
+        "error_h1",
+        "error_h1_semi",
+        "order",
+        "error_paper",
+        "order_paper",
+        "n_dofs",
+        "iterations",
+        "wall_time",
+    ):
         assert name in archive
 
 
@@ -103,15 +116,24 @@ def test_coarse_rows_with_gauss_quadrature_recomputed(archive, tmp_path):
     gauss, ref = parameters["table1"]["gauss"], parameters["reference"]
     scene_file = tmp_path / "scene.yaml"
     scene_file.write_text(archive.attrs["scene"])
-    overrides = (parameters["overrides"] + [f"solver.{k}={v}" for k, v in parameters["solver"].items()]
-                 + ["discretization.contact_quadrature=gauss",
-                    f"discretization.contact_gauss_points={gauss['points']}"])
-    records = solved_error_records("square", {"family": "square"}, gauss["stabilization"],
-                                   [(n, build_mesh("square", n)) for n in COARSE],
-                                   (ref["n"], build_mesh("square", ref["n"])), scene_file, overrides)
+    overrides = (
+        parameters["overrides"]
+        + [f"solver.{k}={v}" for k, v in parameters["solver"].items()]
+        + ["discretization.contact_quadrature=gauss", f"discretization.contact_gauss_points={gauss['points']}"]
+    )
+    records = solved_error_records(
+        "square",
+        {"family": "square"},
+        gauss["stabilization"],
+        [(n, build_mesh("square", n)) for n in COARSE],
+        (ref["n"], build_mesh("square", ref["n"])),
+        scene_file,
+        overrides,
+    )
     for r in records:
-        archived = float(archive["error_paper_gauss"].sel(family="square", stabilization=gauss["stabilization"],
-                                                          h=1.0 / r["n"]))
+        archived = float(
+            archive["error_paper_gauss"].sel(family="square", stabilization=gauss["stabilization"], h=1.0 / r["n"])
+        )
         assert np.isclose(r["error_paper"], archived, rtol=RTOL, atol=0), (r["n"], r["error_paper"], archived)
 
 
@@ -128,8 +150,9 @@ def test_coarsest_row_of_every_family_recomputed(convergence_archive, tmp_path):
         record = run_record(family, stab, n, mesh, ds, reference)
         row = conv.sel(family=family, stabilization=stab, h=1.0 / n)
         for key in ("error_paper", "error_h1"):
-            assert np.isclose(record[key], float(row[key]), rtol=RTOL, atol=0), \
+            assert np.isclose(record[key], float(row[key]), rtol=RTOL, atol=0), (
                 f"{family} {key}: fresh {record[key]!r}, archived {float(row[key])!r}"
+            )
 
 
 def test_coarse_rows_of_table1_recomputed(archive, tmp_path):
@@ -148,6 +171,7 @@ def test_coarse_rows_of_table1_recomputed(archive, tmp_path):
             record = run_record(family, stab, n, mesh, ds, reference)
             row = archive.sel(family=family, stabilization=stab, h=1.0 / n)
             for key in ("error_h1", "error_h1_semi", "error_paper"):
-                assert np.isclose(record[key], float(row[key]), rtol=RTOL, atol=0), \
+                assert np.isclose(record[key], float(row[key]), rtol=RTOL, atol=0), (
                     f"{stab} n={n} {key}: fresh {record[key]!r}, archived {float(row[key])!r}"
+                )
             assert record["n_dofs"] == int(row["n_dofs"])

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _order2_settings():
     text = (ROOT / "workflow" / "rules" / "order2.smk").read_text(encoding="utf-8")
-    return ast.literal_eval(text[text.index("ORDER2 = {") + len("ORDER2 = "):text.index("ORDER2_CASES")])
+    return ast.literal_eval(text[text.index("ORDER2 = {") + len("ORDER2 = ") : text.index("ORDER2_CASES")])
 
 
 def test_order2_plans_every_case_and_level():
@@ -23,7 +23,8 @@ def test_order2_plans_every_case_and_level():
     assert jobs["order2_solve"] == levels
     extra = settings["manufactured_cases"]
     assert jobs["order2_manufactured_solve"] == (levels + sum(len(c["levels"]) for c in extra.values())) * len(
-        settings["manufactured"])
+        settings["manufactured"]
+    )
     assert jobs["order2_reference"] == 1 and jobs["order2_errors"] == len(settings["cases"])
     assert jobs["order2_manufactured_errors"] == (len(settings["cases"]) + len(extra)) * len(settings["manufactured"])
     assert jobs["order2_gather"] == 1 and jobs["order2_manufactured_gather"] == 1 and jobs["order2_figure"] == 2

@@ -50,8 +50,10 @@ def _cluster_or_skip() -> bool:
     conf = Path(os.environ.get("SLURM_CONF", "/etc/slurm/slurm.conf"))
     temporary = conf.exists() and local_cluster.MARKER in conf.read_text(errors="replace")
     if temporary and os.environ.get("VEMKIT_CLUSTER_TEST") != "1":
-        pytest.skip("the cluster answering is the temporary one of a running `make cluster-test` (it runs this "
-                    "test itself, then stops its daemons)")
+        pytest.skip(
+            "the cluster answering is the temporary one of a running `make cluster-test` (it runs this "
+            "test itself, then stops its daemons)"
+        )
     if not run_checks.SNAKEMAKE.exists():
         pytest.skip(f"{run_checks.SNAKEMAKE} not found: run make install")
     return _answers(["sacct", "-n", "-X", "--starttime=now"])

@@ -24,9 +24,8 @@ import pytest
 import xarray as xr
 import yaml
 
-from vemkit.report import tables
-from vemkit.studies.paper import PAPER_TABLE1
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL
+from vemkit.report import tables
 from vemkit.studies.convergence import (
     convergence_dataset,
     convergence_orders,
@@ -34,6 +33,7 @@ from vemkit.studies.convergence import (
     with_paper_variant,
     write_convergence,
 )
+from vemkit.studies.paper import PAPER_TABLE1
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -49,8 +49,13 @@ def dry_run(*args) -> subprocess.CompletedProcess:
     exe = _snakemake()
     if exe is None:
         pytest.skip("snakemake is not installed")
-    return subprocess.run([exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 def planned_jobs(*args) -> dict:
@@ -58,8 +63,8 @@ def planned_jobs(*args) -> dict:
     run = dry_run(*args)
     assert run.returncode == 0, run.stdout + run.stderr
     text = run.stdout + run.stderr
-    stats = text[text.index("Job stats:"):]
-    stats = stats[:stats.index("total")]
+    stats = text[text.index("Job stats:") :]
+    stats = stats[: stats.index("total")]
     return {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)}
 
 
@@ -72,8 +77,19 @@ def _families():
 # -- the DAG ----------------------------------------------------------------------------------
 def test_default_target_plans_the_whole_study():
     jobs = planned_jobs()
-    assert set(jobs) == {"all", "mesh", "mesh_levels", "solve", "solve_levels", "errors", "errors_gauss",
-                         "table1_dataset", "convergence_dataset", "table", *FIGURE_RULES}
+    assert set(jobs) == {
+        "all",
+        "mesh",
+        "mesh_levels",
+        "solve",
+        "solve_levels",
+        "errors",
+        "errors_gauss",
+        "table1_dataset",
+        "convergence_dataset",
+        "table",
+        *FIGURE_RULES,
+    }
     triangles, others = _families()
     stabs = len(CONFIG["stabilizations"])
     assert jobs["mesh_levels"] == len(set(CONFIG["convergence"]) | {CONFIG["table1"]["mesh"]})
@@ -102,8 +118,9 @@ def test_one_job_per_solve_without_batching():
     assert "solve_levels" not in jobs and "mesh_levels" not in jobs
     triangles, others = _families()
     stabs, levels = len(CONFIG["stabilizations"]), len(CONFIG["levels"])
-    extra = {(f["mesh"], f["n"]) for f in CONFIG["figures"]["fields"].values()} - \
-        {(f, n) for f in CONFIG["convergence"] for n in CONFIG["levels"]}
+    extra = {(f["mesh"], f["n"]) for f in CONFIG["figures"]["fields"].values()} - {
+        (f, n) for f in CONFIG["convergence"] for n in CONFIG["levels"]
+    }
     assert jobs["solve"] == levels * (stabs * len(others) + len(triangles)) + stabs + len(extra)
 
 
@@ -112,14 +129,17 @@ def test_figure_target_does_not_solve_the_reference():
     assert set(jobs) == {"mesh_levels", "solve_levels", "figure_deformed"}
 
 
-@pytest.mark.parametrize("bad, key", [
-    ({"bogus_key": 1}, "bogus_key"),
-    ({"levels": [4, "eight"]}, "levels[1]"),
-    ({"stabilizations": ["dofi", "dofi-3mu"]}, "stabilizations[1]"),
-    ({"meshes": {"square": {"family": "square", "colour": "red"}}}, "colour"),
-    ({"convergence": ["square", "no-such-family"]}, "no-such-family"),
-    ({"levels": [4, 512]}, "512"),
-])
+@pytest.mark.parametrize(
+    "bad, key",
+    [
+        ({"bogus_key": 1}, "bogus_key"),
+        ({"levels": [4, "eight"]}, "levels[1]"),
+        ({"stabilizations": ["dofi", "dofi-3mu"]}, "stabilizations[1]"),
+        ({"meshes": {"square": {"family": "square", "colour": "red"}}}, "colour"),
+        ({"convergence": ["square", "no-such-family"]}, "no-such-family"),
+        ({"levels": [4, 512]}, "512"),
+    ],
+)
 def test_bad_config_is_rejected_with_the_key(tmp_path, bad, key):
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(bad))
@@ -130,12 +150,18 @@ def test_bad_config_is_rejected_with_the_key(tmp_path, bad, key):
     assert "config" in message
 
 
-
 # -- the studies' configuration: Snakemake's config, merged with --configfile -----------------------
 def _sweep_config(tmp_path, figure_x):
-    spec = {"sweeps": {"mine": {"overrides": ["discretization.mesh.n=8"], "parts": 2,
-                                "grid": {"contact.normal.k": [1.0, 10.0], "contact.friction.k": [0.0, 450.0]},
-                                "figures": {"map": {"x": figure_x, "y": "k_tau", "quantities": ["normal_force"]}}}}}
+    spec = {
+        "sweeps": {
+            "mine": {
+                "overrides": ["discretization.mesh.n=8"],
+                "parts": 2,
+                "grid": {"contact.normal.k": [1.0, 10.0], "contact.friction.k": [0.0, 450.0]},
+                "figures": {"map": {"x": figure_x, "y": "k_tau", "quantities": ["normal_force"]}},
+            }
+        }
+    }
     path = tmp_path / "my-sweeps.yaml"
     path.write_text(yaml.safe_dump(spec))
     return str(path)
@@ -153,17 +179,21 @@ def test_a_sweep_figure_on_an_unknown_dimension_is_rejected(tmp_path):
     assert "sweeps.mine.figures.map" in message and "k_nu" in message and "Traceback" not in message
 
 
-@pytest.mark.parametrize("bad, key", [
-    ({"sweep_defaults": {"parts": 0}}, "sweep_defaults.parts"),
-    ({"stability": {"n": "sixteen"}}, "stability.n"),
-    ({"studies_bogus": 1}, "studies_bogus"),
-])
+@pytest.mark.parametrize(
+    "bad, key",
+    [
+        ({"sweep_defaults": {"parts": 0}}, "sweep_defaults.parts"),
+        ({"stability": {"n": "sixteen"}}, "stability.n"),
+        ({"studies_bogus": 1}, "studies_bogus"),
+    ],
+)
 def test_bad_studies_config_is_rejected_with_the_key(tmp_path, bad, key):
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(bad))
     run = dry_run("extras", "--configfile", str(path))
     assert run.returncode != 0
     assert key in run.stdout + run.stderr
+
 
 # -- vemkit.studies.convergence -----------------------------------------------------------------------
 def test_orders_of_a_power_law():
@@ -186,22 +216,44 @@ def _records(families=("square", "voronoi"), stabs=("dofi", "trace"), levels=(4,
         for j, s in enumerate(stabs):
             for n in levels:
                 e = (0.7 + 0.1 * i + 0.05 * j) * (4.0 / n) ** p
-                out.append({"family": f, "stabilization": s, "n": n, "h": 1 / n, "error_h1": e,
-                            "error_h1_semi": 1.1 * e, "error_l2": 0.1 * e, "error_paper": 1.2 * e,
-                            "n_dofs": 2 * (n + 1) ** 2,
-                            "n_cells": n * n, "iterations": 3, "wall_time": 0.01 * n, "assembly_time": 0.001,
-                            "h_max": math.sqrt(2) / n})
+                out.append(
+                    {
+                        "family": f,
+                        "stabilization": s,
+                        "n": n,
+                        "h": 1 / n,
+                        "error_h1": e,
+                        "error_h1_semi": 1.1 * e,
+                        "error_l2": 0.1 * e,
+                        "error_paper": 1.2 * e,
+                        "n_dofs": 2 * (n + 1) ** 2,
+                        "n_cells": n * n,
+                        "iterations": 3,
+                        "wall_time": 0.01 * n,
+                        "assembly_time": 0.001,
+                        "h_max": math.sqrt(2) / n,
+                    }
+                )
     return out
 
 
 def test_convergence_dataset_layout_and_attributes():
-    ds = convergence_dataset(_records(p=1.0), scene_yaml="name: paper\n", parameters={"levels": [4, 8]},
-                             commit="abc123")
+    ds = convergence_dataset(
+        _records(p=1.0), scene_yaml="name: paper\n", parameters={"levels": [4, 8]}, commit="abc123"
+    )
     assert ds["error_h1"].dims == ("family", "stabilization", "h")
     assert list(ds["h"].values) == [0.25, 0.125, 0.0625, 0.03125, 0.015625]  # coarse to fine
     assert list(ds["n"].values) == [4, 8, 16, 32, 64]
-    for name in ("error_h1", "error_h1_semi", "order", "error_paper", "order_paper", "n_dofs", "iterations",
-                 "wall_time"):
+    for name in (
+        "error_h1",
+        "error_h1_semi",
+        "order",
+        "error_paper",
+        "order_paper",
+        "n_dofs",
+        "iterations",
+        "wall_time",
+    ):
         assert name in ds
     assert np.isnan(ds["order"].isel(h=0)).all()
     assert np.allclose(ds["order"].isel(h=slice(1, None)), 1.0)
@@ -275,9 +327,19 @@ def _paper_like(scale):
     records = []
     for s, factor in scale.items():
         for n, e in zip(PAPER_TABLE1["n"], PAPER_TABLE1["error"]):
-            records.append({"family": "square", "stabilization": s, "n": n, "error_h1": factor * e,
-                            "error_h1_semi": 2.0 * factor * e, "error_paper": (1 + (factor - 1) / 100) * e,
-                            "n_dofs": 10, "iterations": 1, "wall_time": 0.1})
+            records.append(
+                {
+                    "family": "square",
+                    "stabilization": s,
+                    "n": n,
+                    "error_h1": factor * e,
+                    "error_h1_semi": 2.0 * factor * e,
+                    "error_paper": (1 + (factor - 1) / 100) * e,
+                    "n_dofs": 10,
+                    "iterations": 1,
+                    "wall_time": 0.1,
+                }
+            )
     return convergence_dataset(records, scene_yaml="x", commit="c")
 
 
@@ -308,8 +370,9 @@ def test_table1_shows_the_papers_measure_first_with_five_digits():
     lines = [line for line in tables.table1_markdown(ds).splitlines() if line.startswith("| ")]
     assert lines[1].startswith("| paper | Table 1 | error | 1.9114e-01 |")
     # the scene's stabilization first, the paper's measure first, ratios at 5 significant digits
-    assert lines[3] == ("| dofi-2mu | paper's measure | error | 1.9114e-01 | 1.0309e-01 | 5.4352e-02 | 2.8007e-02 "
-                        "| 1.3828e-02 |")
+    assert lines[3] == (
+        "| dofi-2mu | paper's measure | error | 1.9114e-01 | 1.0309e-01 | 5.4352e-02 | 2.8007e-02 | 1.3828e-02 |"
+    )
     assert lines[4].startswith("| dofi-2mu | paper's measure | ratio to paper | 1.0000 | 1.0000 |")
     assert re.fullmatch(r"\| dofi-2mu \| paper's measure \| order − paper \| – (\| [+-]0\.000\d\d ){4}\|", lines[6])
     assert "| dofi | paper's measure | ratio to paper | 1.0005 |" in "\n".join(lines)
@@ -317,17 +380,28 @@ def test_table1_shows_the_papers_measure_first_with_five_digits():
 
 def test_the_gauss_variant_sits_beside_the_papers_measure(tmp_path):
     ds = _paper_like({"dofi-2mu": 1.002, "trace": 0.9})
-    gauss = [{"family": "square", "stabilization": "dofi-2mu", "n": n, "error_paper": e * 1.00001}
-             for n, e in zip(PAPER_TABLE1["n"], PAPER_TABLE1["error"])]
+    gauss = [
+        {"family": "square", "stabilization": "dofi-2mu", "n": n, "error_paper": e * 1.00001}
+        for n, e in zip(PAPER_TABLE1["n"], PAPER_TABLE1["error"])
+    ]
     ds = with_paper_variant(ds, gauss, "gauss", "3 Gauss points")
     back = read_convergence(write_convergence(ds, tmp_path / "t.nc"))
     assert np.isnan(back["error_paper_gauss"].sel(stabilization="trace")).all()
-    assert np.allclose(back["order_paper_gauss"].sel(stabilization="dofi-2mu").isel(h=slice(1, None)),
-                       back["order_paper"].sel(stabilization="dofi-2mu").isel(h=slice(1, None)))
-    measures = [line.split(" | ")[:2] for line in tables.table1_markdown(back).splitlines()
-                if line.startswith("| ") and "| error |" in line]
-    assert measures[:4] == [["| paper", "Table 1"], ["| dofi-2mu", "paper's measure"],
-                            ["| dofi-2mu", "paper's measure, Gauss on Γ_C"], ["| trace", "paper's measure"]]
+    assert np.allclose(
+        back["order_paper_gauss"].sel(stabilization="dofi-2mu").isel(h=slice(1, None)),
+        back["order_paper"].sel(stabilization="dofi-2mu").isel(h=slice(1, None)),
+    )
+    measures = [
+        line.split(" | ")[:2]
+        for line in tables.table1_markdown(back).splitlines()
+        if line.startswith("| ") and "| error |" in line
+    ]
+    assert measures[:4] == [
+        ["| paper", "Table 1"],
+        ["| dofi-2mu", "paper's measure"],
+        ["| dofi-2mu", "paper's measure, Gauss on Γ_C"],
+        ["| trace", "paper's measure"],
+    ]
     summary = {(s["stabilization"], s["norm"]): s for s in tables.table1_summary(back)}
     assert summary[("dofi-2mu", "paper_gauss")]["meets_target"] and ("trace", "paper_gauss") not in summary
 
@@ -359,8 +433,8 @@ def test_table1_formats():
 
 # -- vemkit.report.figures (smoke) -------------------------------------------------------------------------
 def test_plots_draw(tmp_path):
-    from vemkit.report import figures as plots
     from vemkit.mesh.families import build_mesh
+    from vemkit.report import figures as plots
 
     ds = _paper_like({"dofi": 1.05, "trace": 0.8})
     out = plots.save(plots.convergence_figure(ds), tmp_path / "c.png", tmp_path / "c.pdf")

@@ -10,4 +10,13 @@ from vemkit.config.domain import Domain, domain_from_spec
 from vemkit.config.expressions import Expression, compile_expression
 from vemkit.config.scene import Scene, load_scene, scene_from_dict, scene_from_yaml
 
-__all__ = ["Domain", "Expression", "domain_from_spec", "Scene", "compile_expression", "load_scene", "scene_from_dict", "scene_from_yaml"]
+__all__ = [
+    "Domain",
+    "Expression",
+    "domain_from_spec",
+    "Scene",
+    "compile_expression",
+    "load_scene",
+    "scene_from_dict",
+    "scene_from_yaml",
+]

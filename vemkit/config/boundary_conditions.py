@@ -21,9 +21,20 @@ from vemkit.config.expressions import Expression, compile_expression
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import ExpressionError, SceneError
 
-__all__ = ["MAX_NORMAL_K_OVER_E", "PROBES", "boundary_expressions", "check_contact", "check_expressions_on_mesh",
-           "check_file_sides", "check_foundation", "check_mesh_size", "check_rigid_motions", "check_sides",
-           "free_rigid_motion", "side_points"]
+__all__ = [
+    "MAX_NORMAL_K_OVER_E",
+    "PROBES",
+    "boundary_expressions",
+    "check_contact",
+    "check_expressions_on_mesh",
+    "check_file_sides",
+    "check_foundation",
+    "check_mesh_size",
+    "check_rigid_motions",
+    "check_sides",
+    "free_rigid_motion",
+    "side_points",
+]
 
 #: contact.normal.k / material.E above this is refused (README "Input rules and limits"): measured,
 #: ssn's independent check is 5e-9 at k/E = 5e8 and fails at 5e11 (paper scene, n = 8)
@@ -31,8 +42,10 @@ MAX_NORMAL_K_OVER_E = 1e9
 PROBES = 16  # points per side (and per direction inside) where expressions are test-evaluated
 # points (x, y) of a side of the unit square at the curve parameters s in [0, 1]
 _UNIT_SQUARE_SIDE_POINTS = {
-    "left": lambda s: (0.0 * s, s), "right": lambda s: (0.0 * s + 1.0, s),
-    "bottom": lambda s: (s, 0.0 * s), "top": lambda s: (s, 0.0 * s + 1.0),
+    "left": lambda s: (0.0 * s, s),
+    "right": lambda s: (0.0 * s + 1.0, s),
+    "bottom": lambda s: (s, 0.0 * s),
+    "top": lambda s: (s, 0.0 * s + 1.0),
 }
 
 
@@ -67,8 +80,11 @@ def compile_checked(key: str, value, dimension: int = 2) -> Expression:
     except ExpressionError as error:
         raise SceneError(str(error), key=key) from None
     if dimension == 2 and "z" in expression.variables:
-        raise SceneError(f"{key} = {shorten(expression.text)!r}: uses z, but this scene is 2D (its expressions take "
-                         "x and y); remove z", key=key)
+        raise SceneError(
+            f"{key} = {shorten(expression.text)!r}: uses z, but this scene is 2D (its expressions take "
+            "x and y); remove z",
+            key=key,
+        )
     return expression
 
 
@@ -106,10 +122,13 @@ class PlaneProbes:
 def _components(key: str, value, dimension: int) -> list:
     """The list of a vector entry, which has one component per dimension (SPEC §10)."""
     if len(value) != dimension:
-        names = ", ".join(f"u{i + 1}" if "dirichlet" in key or "exact" in key else f"f_{'xyz'[i]}"
-                          for i in range(dimension))
-        raise SceneError(f"{key} has {len(value)} components; this {dimension}D scene needs {dimension} "
-                         f"([{names}]); fix the scene", key=key)
+        names = ", ".join(
+            f"u{i + 1}" if "dirichlet" in key or "exact" in key else f"f_{'xyz'[i]}" for i in range(dimension)
+        )
+        raise SceneError(
+            f"{key} has {len(value)} components; this {dimension}D scene needs {dimension} ([{names}]); fix the scene",
+            key=key,
+        )
     return list(value)
 
 
@@ -120,20 +139,32 @@ def _compiled_entries(data: dict, probes, dimension: int):
     inside = probes.inside() if probes is not None else None
     for side, components in _dirichlet(data["boundary"], dimension).items():
         key = f"boundary.dirichlet.{side}"
-        pair = tuple(None if value is None else compile_checked(f"{key}[{i}]", value, dimension)
-                     for i, value in enumerate(_components(key, components, dimension)))
+        pair = tuple(
+            None if value is None else compile_checked(f"{key}[{i}]", value, dimension)
+            for i, value in enumerate(_components(key, components, dimension))
+        )
         if pair == (None,) * dimension:
-            raise SceneError(f"{key} = [{', '.join(['null'] * dimension)}]: prescribes nothing; give a value for "
-                             "at least one component or move the side to neumann", key=key)
+            raise SceneError(
+                f"{key} = [{', '.join(['null'] * dimension)}]: prescribes nothing; give a value for "
+                "at least one component or move the side to neumann",
+                key=key,
+            )
         yield key, pair, at_side(side)
     for side, entry in data["boundary"]["neumann"].items():
         if len(entry) != 1:
-            raise SceneError(f"boundary.neumann.{side}: give exactly one of traction: [f_x, f_y] or "
-                             "pressure: p; fix the scene", key=f"boundary.neumann.{side}")
+            raise SceneError(
+                f"boundary.neumann.{side}: give exactly one of traction: [f_x, f_y] or pressure: p; fix the scene",
+                key=f"boundary.neumann.{side}",
+            )
         kind, value = next(iter(entry.items()))
         key = f"boundary.neumann.{side}.{kind}"
-        compiled = compile_checked(key, value, dimension) if kind == "pressure" else \
-            tuple(compile_checked(f"{key}[{i}]", v, dimension) for i, v in enumerate(_components(key, value, dimension)))
+        compiled = (
+            compile_checked(key, value, dimension)
+            if kind == "pressure"
+            else tuple(
+                compile_checked(f"{key}[{i}]", v, dimension) for i, v in enumerate(_components(key, value, dimension))
+            )
+        )
         yield key, compiled, at_side(side)
     if "exact" in data:
         key = "exact.displacement"
@@ -150,7 +181,7 @@ def boundary_expressions(data: dict, domain: Domain | None, probes=None, dimensi
     compiled = {}
     for key, value, points in _compiled_entries(data, probes, dimension):
         compiled[key] = value
-        for expression in (value if isinstance(value, tuple) else (value,)):
+        for expression in value if isinstance(value, tuple) else (value,):
             if expression is not None and points is not None:
                 evaluate_checked(expression, points)
     return compiled
@@ -160,12 +191,18 @@ def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
     """The foundation line's normal is not zero and every contact side lies on its body side."""
     for key in ("point", "normal"):
         if len(foundation[key]) != 2:
-            raise SceneError(f"contact.foundation.{key} has {len(foundation[key])} components; a 2D scene's "
-                             "foundation is a line: give 2", key=f"contact.foundation.{key}")
+            raise SceneError(
+                f"contact.foundation.{key} has {len(foundation[key])} components; a 2D scene's "
+                "foundation is a line: give 2",
+                key=f"contact.foundation.{key}",
+            )
     normal = np.asarray(foundation["normal"], dtype=float)
     if not np.hypot(*normal) > 0:
-        raise SceneError("contact.foundation.normal = [0, 0]: give the line's normal pointing towards "
-                         "the body, e.g. [0, 1] for a floor", key="contact.foundation.normal")
+        raise SceneError(
+            "contact.foundation.normal = [0, 0]: give the line's normal pointing towards "
+            "the body, e.g. [0, 1] for a floor",
+            key="contact.foundation.normal",
+        )
     if domain is None:
         return
     point = np.asarray(foundation["point"], dtype=float)
@@ -174,31 +211,42 @@ def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
         distance = ((x - point[0]) * normal[0] + (y - point[1]) * normal[1]) / np.hypot(*normal)
         if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
             i = int(np.argmin(distance))
-            raise SceneError(f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation line "
-                             f"at x={x[i]:.6g}, y={y[i]:.6g} (the body starts out penetrating it); move "
-                             "contact.foundation.point or flip contact.foundation.normal",
-                             key="contact.foundation")
+            raise SceneError(
+                f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation line "
+                f"at x={x[i]:.6g}, y={y[i]:.6g} (the body starts out penetrating it); move "
+                "contact.foundation.point or flip contact.foundation.normal",
+                key="contact.foundation",
+            )
 
 
 def check_mesh_size(mesh: dict) -> None:
     sizes = [key for key in ("n", "h", "cells") if key in mesh]
     if "\0" in mesh.get("file", ""):
-        raise SceneError("discretization.mesh.file: a file name cannot contain a NUL character; fix the scene",
-                         key="discretization.mesh.file")
+        raise SceneError(
+            "discretization.mesh.file: a file name cannot contain a NUL character; fix the scene",
+            key="discretization.mesh.file",
+        )
     if "file" in mesh:
         extra = sizes + [key for key in mesh if key not in ("file", *sizes)]
         if extra:
-            raise SceneError(f"discretization.mesh: file = {mesh['file']!r} is the whole mesh; drop "
-                             f"{', '.join(extra)}", key="discretization.mesh")
+            raise SceneError(
+                f"discretization.mesh: file = {mesh['file']!r} is the whole mesh; drop {', '.join(extra)}",
+                key="discretization.mesh",
+            )
         return
     if "family" not in mesh:
-        raise SceneError("discretization.mesh.family is missing (mesh family); add it to the scene or "
-                         "--set discretization.mesh.family=... (or give discretization.mesh.file)",
-                         key="discretization.mesh.family")
+        raise SceneError(
+            "discretization.mesh.family is missing (mesh family); add it to the scene or "
+            "--set discretization.mesh.family=... (or give discretization.mesh.file)",
+            key="discretization.mesh.family",
+        )
     if len(sizes) != 1:
         named = ", ".join(f"{k} = {mesh[k]}" for k in sizes) or "none given"
-        raise SceneError(f"discretization.mesh: give exactly one of n, h and cells ({named}); fix the "
-                         "scene or --set discretization.mesh.n=...", key="discretization.mesh")
+        raise SceneError(
+            f"discretization.mesh: give exactly one of n, h and cells ({named}); fix the "
+            "scene or --set discretization.mesh.n=...",
+            key="discretization.mesh",
+        )
 
 
 def check_sides(data: dict, sides) -> None:
@@ -207,30 +255,45 @@ def check_sides(data: dict, sides) -> None:
     for part in ("dirichlet", "neumann", "contact"):
         for index, side in enumerate(boundary[part]):
             if sides is not None and side not in sides:
-                where = f"boundary.{part}[{index}] = {side!r}" if isinstance(boundary[part], list) else \
-                    f"boundary.{part}.{side}"
-                raise SceneError(f"{where}: unknown boundary name {side!r}; the {_domain_name(data)} has "
-                                 f"sides {', '.join(sides)}; fix the scene", key=f"boundary.{part}")
+                where = (
+                    f"boundary.{part}[{index}] = {side!r}"
+                    if isinstance(boundary[part], list)
+                    else f"boundary.{part}.{side}"
+                )
+                raise SceneError(
+                    f"{where}: unknown boundary name {side!r}; the {_domain_name(data)} has "
+                    f"sides {', '.join(sides)}; fix the scene",
+                    key=f"boundary.{part}",
+                )
             if side in owner:
-                raise SceneError(f"boundary: side {side!r} is listed in both {owner[side]} and "
-                                 f"{part}; a side has one boundary condition")
+                raise SceneError(
+                    f"boundary: side {side!r} is listed in both {owner[side]} and "
+                    f"{part}; a side has one boundary condition"
+                )
             owner[side] = part
     if boundary["contact"] and "contact" not in data:
-        raise SceneError(f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
-                         "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}")
+        raise SceneError(
+            f"contact is missing: boundary.contact lists {', '.join(boundary['contact'])}; "
+            "add contact: {gap: ..., normal: {k: ..., m: ...}, friction: {k: ..., m: ...}}"
+        )
 
 
 def check_contact(data: dict, given_contact: dict, domain, compiled: dict) -> None:
     contact, sides = data["contact"], data["boundary"]["contact"]
     if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
-        raise SceneError(f"contact.normal.k = {contact['normal']['k']:g}: must be at most "
-                         f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "
-                         "(stiffer is rigid contact, beyond double precision); fix the scene or "
-                         "--set contact.normal.k=...", key="contact.normal.k")
+        raise SceneError(
+            f"contact.normal.k = {contact['normal']['k']:g}: must be at most "
+            f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "
+            "(stiffer is rigid contact, beyond double precision); fix the scene or "
+            "--set contact.normal.k=...",
+            key="contact.normal.k",
+        )
     if "foundation" in contact:
         if "gap" in given_contact:
-            raise SceneError("contact: give either gap or foundation, not both (the foundation "
-                             "line defines the gap)", key="contact.foundation")
+            raise SceneError(
+                "contact: give either gap or foundation, not both (the foundation line defines the gap)",
+                key="contact.foundation",
+            )
         check_foundation(contact["foundation"], sides, domain)
         return
     gap = compiled["contact.gap"] = compile_checked("contact.gap", contact["gap"])
@@ -239,9 +302,11 @@ def check_contact(data: dict, given_contact: dict, domain, compiled: dict) -> No
         values = evaluate_checked(gap, (x, y))
         if values.min() < 0:
             i = int(np.argmin(values))
-            raise SceneError(f"contact.gap = {repr(contact['gap'])}: is {values[i]:.6g} "
-                             f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
-                             "g_a must be >= 0); fix the scene or --set contact.gap=...")
+            raise SceneError(
+                f"contact.gap = {repr(contact['gap'])}: is {values[i]:.6g} "
+                f"< 0 at x={x[i]:.6g}, y={y[i]:.6g} on {side} (the initial gap "
+                "g_a must be >= 0); fix the scene or --set contact.gap=..."
+            )
 
 
 def _domain_name(data) -> str:
@@ -250,8 +315,11 @@ def _domain_name(data) -> str:
 
 # -- rigid motions (before assembly), mesh files' sides, expressions at the mesh's vertices ------
 def rigid_motion_error(motion: str) -> SceneError:
-    return SceneError(f"boundary.dirichlet leaves {motion} of the body free (the stiffness is singular); "
-                      "prescribe a component that stops it, e.g. clamp a side", key="boundary.dirichlet")
+    return SceneError(
+        f"boundary.dirichlet leaves {motion} of the body free (the stiffness is singular); "
+        "prescribe a component that stops it, e.g. clamp a side",
+        key="boundary.dirichlet",
+    )
 
 
 def check_rigid_motions(data: dict, domain: Domain | None) -> None:
@@ -282,9 +350,12 @@ def check_file_sides(scene, header) -> None:
             if side in header.sides or (not header.sides_complete and (side.isdigit() or side == "untagged")):
                 continue
             listed = ", ".join(header.sides) or "none"
-            raise SceneError(f"boundary.{part}: side {side!r} is not in the mesh file {scene.mesh_options['file']} "
-                             f"(its {'sides' if header.sides_complete else 'named sides'}: {listed}); fix the scene "
-                             "or the file", key=f"boundary.{part}")
+            raise SceneError(
+                f"boundary.{part}: side {side!r} is not in the mesh file {scene.mesh_options['file']} "
+                f"(its {'sides' if header.sides_complete else 'named sides'}: {listed}); fix the scene "
+                "or the file",
+                key=f"boundary.{part}",
+            )
 
 
 def check_expressions_on_mesh(scene, mesh) -> None:
@@ -297,8 +368,11 @@ def check_expressions_on_mesh(scene, mesh) -> None:
         if side not in mesh.boundary:
             continue  # the problem names the missing side
         parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
-        on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else
-                            np.concatenate([mesh.face(f) for f in parts] or [np.zeros(0, np.int64)]))
+        on_side = np.unique(
+            parts
+            if mesh.vertices.shape[1] == 2
+            else np.concatenate([mesh.face(f) for f in parts] or [np.zeros(0, np.int64)])
+        )
         pressure = scene.pressure(side)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))

@@ -40,8 +40,10 @@ UNIT_SQUARE_CORNERS = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
 def _edge_sides_on_lines(corners, lines) -> tuple:
     """The name of the line (axis, value) each edge corner i -> i+1 lies on."""
     k = len(corners)
-    return tuple(next(name for name, (axis, value) in lines.items()
-                      if corners[i][axis] == value == corners[(i + 1) % k][axis]) for i in range(k))
+    return tuple(
+        next(name for name, (axis, value) in lines.items() if corners[i][axis] == value == corners[(i + 1) % k][axis])
+        for i in range(k)
+    )
 
 
 UNIT_SQUARE_EDGE_SIDES = _edge_sides_on_lines(UNIT_SQUARE_CORNERS, UNIT_SQUARE_SIDE_LINES)  # bottom, right, top, left
@@ -164,8 +166,12 @@ class Domain:
         k = corners.shape[0]
         points, sides = [], []
         for i, centre in enumerate(self.arcs):
-            inner = np.zeros((0, 2)) if centre is None else arc_points(self.polygon[i], self.polygon[(i + 1) % k], centre, h)
-            points += [corners[i:i + 1], inner]
+            inner = (
+                np.zeros((0, 2))
+                if centre is None
+                else arc_points(self.polygon[i], self.polygon[(i + 1) % k], centre, h)
+            )
+            points += [corners[i : i + 1], inner]
             sides += [self.sides[i]] * (inner.shape[0] + 1)
         return np.concatenate(points), sides
 
@@ -208,7 +214,9 @@ class Domain:
             if centre is not None:
                 a, b = self.polygon[i], self.polygon[(i + 1) % k]
                 r, _, dt = arc_angles(a, b, centre)
-                out = (b[0] - a[0]) * (centre[1] - a[1]) - (b[1] - a[1]) * (centre[0] - a[0]) > 0  # centre on the body's side
+                out = (b[0] - a[0]) * (centre[1] - a[1]) - (b[1] - a[1]) * (
+                    centre[0] - a[0]
+                ) > 0  # centre on the body's side
                 area += (1.0 if out else -1.0) * 0.5 * r * r * (abs(dt) - math.sin(abs(dt)))
         for hole in self.holes:
             area -= math.pi * hole.r**2 if isinstance(hole, CircleHole) else shapely.Polygon(hole.polygon).area
@@ -218,8 +226,12 @@ class Domain:
         """The SPEC §7 mapping of this domain (``"unit_square"`` for the default): JSON-ready."""
         if self.is_unit_square:
             return "unit_square"
-        holes = [{"circle": [h.cx, h.cy, h.r], "side": h.side} if isinstance(h, CircleHole)
-                 else {"polygon": [list(p) for p in h.polygon], "sides": list(h.sides)} for h in self.holes]
+        holes = [
+            {"circle": [h.cx, h.cy, h.r], "side": h.side}
+            if isinstance(h, CircleHole)
+            else {"polygon": [list(p) for p in h.polygon], "sides": list(h.sides)}
+            for h in self.holes
+        ]
         spec = {"polygon": [list(p) for p in self.polygon], "sides": list(self.sides)}
         if self.arcs:
             spec["arcs"] = [None if c is None else list(c) for c in self.arcs]
@@ -264,39 +276,55 @@ def domain_from_spec(spec=None) -> Domain:
         return UNIT_SQUARE if spec is None else spec
     if isinstance(spec, str):
         if spec != "unit_square":
-            raise InputError(f"domain = {spec!r}: the only named domain is unit_square; "
-                             "give a mapping {polygon: ..., sides: ...}", key="domain")
+            raise InputError(
+                f"domain = {spec!r}: the only named domain is unit_square; give a mapping {{polygon: ..., sides: ...}}",
+                key="domain",
+            )
         return UNIT_SQUARE
     if not isinstance(spec, dict):
         raise InputError("domain: give unit_square or a mapping {polygon: [[x, y], ...], sides: [...]}", key="domain")
     unknown = sorted(set(spec) - {"polygon", "sides", "holes", "arcs"})
     if unknown:
-        raise InputError(f"domain.{unknown[0]}: unknown key; valid keys: polygon, sides, arcs, holes",
-                         key=f"domain.{unknown[0]}")
+        raise InputError(
+            f"domain.{unknown[0]}: unknown key; valid keys: polygon, sides, arcs, holes", key=f"domain.{unknown[0]}"
+        )
     for required in ("polygon", "sides"):
         if required not in spec:
-            raise InputError(f"domain.{required} is missing; give the outer polygon and one side name per edge",
-                             key=f"domain.{required}")
+            raise InputError(
+                f"domain.{required} is missing; give the outer polygon and one side name per edge",
+                key=f"domain.{required}",
+            )
     outer = _corners(spec["polygon"], "domain.polygon")
     sides = _side_list(spec["sides"], len(outer), "domain")
     ring = shapely.LinearRing(outer)
     _check_simple(ring, "domain.polygon", "the outer boundary")
     if not ring.is_ccw:
-        raise InputError("domain.polygon is clockwise; list its corners counter-clockwise (reverse the "
-                         "list, and its sides)", key="domain.polygon")
+        raise InputError(
+            "domain.polygon is clockwise; list its corners counter-clockwise (reverse the list, and its sides)",
+            key="domain.polygon",
+        )
     arcs = _arcs(spec.get("arcs"), outer)
     body = Domain(tuple(outer), tuple(sides), (), arcs)
     if arcs:
         curved = shapely.LinearRing(body.outer_ring(None)[0])
-        _check_simple(curved, "domain.arcs", "the outer boundary with its arcs",
-                      "move an arc's centre farther from its edge (flatter arc) or to its other side")
+        _check_simple(
+            curved,
+            "domain.arcs",
+            "the outer boundary with its arcs",
+            "move an arc's centre farther from its edge (flatter arc) or to its other side",
+        )
         if not curved.is_ccw:
-            raise InputError("domain.arcs: the outer boundary with its arcs is clockwise; move the arc centres "
-                             "to the other side of their edges", key="domain.arcs")
+            raise InputError(
+                "domain.arcs: the outer boundary with its arcs is clockwise; move the arc centres "
+                "to the other side of their edges",
+                key="domain.arcs",
+            )
     holes = spec.get("holes") or []
     if not isinstance(holes, list):
-        raise InputError("domain.holes: give a list of {circle: [cx, cy, r], side: NAME} or "
-                         "{polygon: [...], sides: [...]}", key="domain.holes")
+        raise InputError(
+            "domain.holes: give a list of {circle: [cx, cy, r], side: NAME} or {polygon: [...], sides: [...]}",
+            key="domain.holes",
+        )
     parsed = tuple(_hole(entry, f"domain.holes[{i}]") for i, entry in enumerate(holes))
     _check_placement(shapely.Polygon(body.outer_ring(None)[0]), parsed)
     return Domain(tuple(outer), tuple(sides), parsed, arcs)
@@ -309,10 +337,15 @@ def _arcs(value, corners: list) -> tuple:
     k = len(corners)
     if not isinstance(value, (list, tuple)) or len(value) != k:
         count = len(value) if isinstance(value, (list, tuple)) else "no list of"
-        raise InputError(f"domain.arcs has {count} entries but the polygon has {k} edges; give one per edge i -> "
-                         "i+1: null (straight) or the centre [cx, cy] of its arc", key="domain.arcs")
-    centres = [None if entry is None else _arc_centre(entry, corners[i], corners[(i + 1) % k], f"domain.arcs[{i}]")
-               for i, entry in enumerate(value)]
+        raise InputError(
+            f"domain.arcs has {count} entries but the polygon has {k} edges; give one per edge i -> "
+            "i+1: null (straight) or the centre [cx, cy] of its arc",
+            key="domain.arcs",
+        )
+    centres = [
+        None if entry is None else _arc_centre(entry, corners[i], corners[(i + 1) % k], f"domain.arcs[{i}]")
+        for i, entry in enumerate(value)
+    ]
     return tuple(centres) if any(c is not None for c in centres) else ()
 
 
@@ -325,12 +358,18 @@ def _arc_centre(entry, a, b, key: str) -> tuple:
         raise InputError(f"{key}: give null or the centre [cx, cy] (two finite numbers) of the edge's arc", key=key)
     ra, rb = math.hypot(a[0] - cx, a[1] - cy), math.hypot(b[0] - cx, b[1] - cy)
     if abs(ra - rb) > 1e-9 * max(ra, rb):
-        raise InputError(f"{key}: the corners {_pt(a)} and {_pt(b)} are at distances {ra:.12g} and {rb:.12g} from "
-                         f"the centre {_pt((cx, cy))}; give a centre equally far from both", key=key)
+        raise InputError(
+            f"{key}: the corners {_pt(a)} and {_pt(b)} are at distances {ra:.12g} and {rb:.12g} from "
+            f"the centre {_pt((cx, cy))}; give a centre equally far from both",
+            key=key,
+        )
     mid = math.hypot(0.5 * (a[0] + b[0]) - cx, 0.5 * (a[1] + b[1]) - cy)
     if mid <= 1e-9 * ra:
-        raise InputError(f"{key}: the centre {_pt((cx, cy))} is the middle of the edge, so the arc would be a half "
-                         "circle; split the edge at a corner on the circle (each arc less than a half circle)", key=key)
+        raise InputError(
+            f"{key}: the centre {_pt((cx, cy))} is the middle of the edge, so the arc would be a half "
+            "circle; split the edge at a corner on the circle (each arc less than a half circle)",
+            key=key,
+        )
     return (cx, cy)
 
 
@@ -342,23 +381,28 @@ def _corners(value, key: str) -> list:
     if points is None or points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 3:
         raise InputError(f"{key}: give a list of at least 3 corners [x, y]", key=key)
     if not np.isfinite(points).all():
-        raise InputError(f"{key}: corner {int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])} "
-                         "is not a finite number pair", key=key)
+        raise InputError(
+            f"{key}: corner {int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])} is not a finite number pair",
+            key=key,
+        )
     k = points.shape[0]
     for i in range(k):
         a, b = points[i], points[(i + 1) % k]
         if np.array_equal(a, b):
             hint = " (do not repeat the first corner at the end)" if i == k - 1 else ""
-            raise InputError(f"{key}: edge {i} from {_pt(a)} to {_pt(b)} has zero length; remove the repeated "
-                             f"corner{hint}", key=key)
+            raise InputError(
+                f"{key}: edge {i} from {_pt(a)} to {_pt(b)} has zero length; remove the repeated corner{hint}", key=key
+            )
     return [(float(x), float(y)) for x, y in points]
 
 
 def _side_list(names, edges: int, key: str) -> list:
     if not isinstance(names, (list, tuple)) or len(names) != edges:
         count = len(names) if isinstance(names, (list, tuple)) else "no list of"
-        raise InputError(f"{key}.sides has {count} names but the polygon has {edges} edges; give one name "
-                         "per edge i -> i+1", key=f"{key}.sides")
+        raise InputError(
+            f"{key}.sides has {count} names but the polygon has {edges} edges; give one name per edge i -> i+1",
+            key=f"{key}.sides",
+        )
     for name in names:
         _check_name(name, f"{key}.sides")
     return [str(n) for n in names]
@@ -366,8 +410,7 @@ def _side_list(names, edges: int, key: str) -> list:
 
 def _check_name(name, key: str) -> None:
     if not isinstance(name, str) or not SIDE_NAME.fullmatch(name):
-        raise InputError(f"{key}: side name {name!r} is not an identifier; use letters, digits, _ and - only",
-                         key=key)
+        raise InputError(f"{key}: side name {name!r} is not an identifier; use letters, digits, _ and - only", key=key)
 
 
 def _check_simple(ring, key: str, what: str, fix: str = "list the corners in order along the boundary") -> None:
@@ -379,8 +422,10 @@ def _check_simple(ring, key: str, what: str, fix: str = "list the corners in ord
 
 def _hole(entry, key: str):
     if not isinstance(entry, dict) or ("circle" in entry) == ("polygon" in entry):
-        raise InputError(f"{key}: give either {{circle: [cx, cy, r], side: NAME}} or "
-                         "{polygon: [[x, y], ...], sides: [...]}", key=key)
+        raise InputError(
+            f"{key}: give either {{circle: [cx, cy, r], side: NAME}} or {{polygon: [[x, y], ...], sides: [...]}}",
+            key=key,
+        )
     if "circle" in entry:
         unknown = sorted(set(entry) - {"circle", "side"})
         if unknown:
@@ -410,8 +455,10 @@ def _hole(entry, key: str):
 
 def _check_placement(outer: shapely.Polygon, holes: tuple) -> None:
     """Every hole strictly inside the body, clear of its boundary and of the other holes."""
-    shapes = [(shapely.Point(h.cx, h.cy), h.r) if isinstance(h, CircleHole) else (shapely.Polygon(h.polygon), 0.0)
-              for h in holes]
+    shapes = [
+        (shapely.Point(h.cx, h.cy), h.r) if isinstance(h, CircleHole) else (shapely.Polygon(h.polygon), 0.0)
+        for h in holes
+    ]
     for i, (shape, r) in enumerate(shapes):
         key = f"domain.holes[{i}]"
         if outer.distance(shape) > r:

@@ -79,8 +79,11 @@ def domain3d_from_spec(spec):
     if isinstance(spec, (Box, Extruded)):
         return spec
     if not is_3d_domain(spec):
-        raise SceneError("domain: give a 3D body {box: [[x0, y0, z0], [x1, y1, z1]]} or {extrude: {depth: ...}, "
-                         "polygon: ..., sides: ...}", key="domain")
+        raise SceneError(
+            "domain: give a 3D body {box: [[x0, y0, z0], [x1, y1, z1]]} or {extrude: {depth: ...}, "
+            "polygon: ..., sides: ...}",
+            key="domain",
+        )
     if "box" in spec and "extrude" in spec:
         raise SceneError("domain: give either box or extrude, not both", key="domain")
     return _box(spec) if "box" in spec else _extruded(spec)
@@ -92,16 +95,18 @@ def _names(value, count: int, key: str, what: str) -> tuple:
         raise SceneError(f"{key} has {given} names; give {count} ({what})", key=key)
     for name in value:
         if not isinstance(name, str) or not SIDE_NAME.fullmatch(name):
-            raise SceneError(f"{key}: side name {name!r} is not an identifier; use letters, digits, _ and - only",
-                             key=key)
+            raise SceneError(
+                f"{key}: side name {name!r} is not an identifier; use letters, digits, _ and - only", key=key
+            )
     return tuple(value)
 
 
 def _box(spec: dict) -> Box:
     unknown = sorted(set(spec) - {"box", "sides"})
     if unknown:
-        raise SceneError(f"domain.{unknown[0]}: unknown key; a box domain has box and sides",
-                         key=f"domain.{unknown[0]}")
+        raise SceneError(
+            f"domain.{unknown[0]}: unknown key; a box domain has box and sides", key=f"domain.{unknown[0]}"
+        )
     try:
         corners = np.asarray(spec["box"], dtype=float)
     except (TypeError, ValueError):
@@ -112,10 +117,14 @@ def _box(spec: dict) -> Box:
     if thin.size:
         axis = "xyz"[thin[0]]
         hi, lo = corners[1, thin[0]], corners[0, thin[0]]
-        raise SceneError(f"domain.box: {axis}1 = {hi:g} is not above {axis}0 = {lo:g}; "
-                         "give the lower corner first and a positive size along x, y and z", key="domain.box")
-    sides = _names(spec.get("sides", list(BOX_SIDES)), 6, "domain.sides",
-                   "the faces xmin, xmax, ymin, ymax, zmin, zmax")
+        raise SceneError(
+            f"domain.box: {axis}1 = {hi:g} is not above {axis}0 = {lo:g}; "
+            "give the lower corner first and a positive size along x, y and z",
+            key="domain.box",
+        )
+    sides = _names(
+        spec.get("sides", list(BOX_SIDES)), 6, "domain.sides", "the faces xmin, xmax, ymin, ymax, zmin, zmax"
+    )
     return Box(tuple(corners[0].tolist()), tuple(corners[1].tolist()), sides)
 
 
@@ -125,11 +134,13 @@ def _extruded(spec: dict) -> Extruded:
         raise SceneError("domain.extrude: give {depth: D, ends: [front, back]}", key="domain.extrude")
     unknown = sorted(set(ext) - {"depth", "ends"})
     if unknown:
-        raise SceneError(f"domain.extrude.{unknown[0]}: unknown key; valid keys: depth, ends",
-                         key=f"domain.extrude.{unknown[0]}")
+        raise SceneError(
+            f"domain.extrude.{unknown[0]}: unknown key; valid keys: depth, ends", key=f"domain.extrude.{unknown[0]}"
+        )
     if "depth" not in ext:
-        raise SceneError("domain.extrude.depth is missing; give the extrusion depth along z",
-                         key="domain.extrude.depth")
+        raise SceneError(
+            "domain.extrude.depth is missing; give the extrusion depth along z", key="domain.extrude.depth"
+        )
     try:
         depth = float(ext["depth"])
     except (TypeError, ValueError):
@@ -150,5 +161,11 @@ def _extruded(spec: dict) -> Extruded:
 def cells_per_length3d(domain, n=None, h=None, cells=None, cells_per_cube: float = 1.0):
     """n (cells per unit length) from exactly one of n, h = 1/n and cells (about n³ x volume x
     ``cells_per_cube`` of them); whole numbers come back as int."""
-    return mesh_density(n, h, cells, lambda count: (count / (cells_per_cube * domain.volume)) ** (1.0 / 3.0),
-                        SceneError, "discretization.mesh")
+    return mesh_density(
+        n,
+        h,
+        cells,
+        lambda count: (count / (cells_per_cube * domain.volume)) ** (1.0 / 3.0),
+        SceneError,
+        "discretization.mesh",
+    )

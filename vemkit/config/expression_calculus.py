@@ -86,18 +86,18 @@ def _square(a: Node) -> Node:
 _OUTER = {
     "sin": lambda a: call("cos", a),
     "cos": lambda a: neg(call("sin", a)),
-    "tan": lambda a: div(ONE, _square(call("cos", a))),             # 1 / cos^2 a
+    "tan": lambda a: div(ONE, _square(call("cos", a))),  # 1 / cos^2 a
     "asin": lambda a: div(ONE, call("sqrt", sub(ONE, _square(a)))),  # 1 / sqrt(1 - a^2)
     "acos": lambda a: neg(div(ONE, call("sqrt", sub(ONE, _square(a))))),
-    "atan": lambda a: div(ONE, add(ONE, _square(a))),               # 1 / (1 + a^2)
+    "atan": lambda a: div(ONE, add(ONE, _square(a))),  # 1 / (1 + a^2)
     "sinh": lambda a: call("cosh", a),
     "cosh": lambda a: call("sinh", a),
-    "tanh": lambda a: sub(ONE, _square(call("tanh", a))),           # 1 - tanh^2 a
+    "tanh": lambda a: sub(ONE, _square(call("tanh", a))),  # 1 - tanh^2 a
     "exp": lambda a: call("exp", a),
     "log": lambda a: div(ONE, a),
-    "sqrt": lambda a: div(ONE, mul(TWO, call("sqrt", a))),          # 1 / (2 sqrt a)
+    "sqrt": lambda a: div(ONE, mul(TWO, call("sqrt", a))),  # 1 / (2 sqrt a)
     "abs": lambda a: call("sign", a),
-    "sign": lambda a: ZERO,                                          # piecewise constant
+    "sign": lambda a: ZERO,  # piecewise constant
 }
 
 

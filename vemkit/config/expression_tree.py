@@ -23,50 +23,118 @@ import numpy as np
 
 from vemkit.exceptions import ExpressionError
 
-__all__ = ["ALLOWED", "CONDITIONS", "CONSTANTS", "FUNCTIONS", "MAX_NESTING_DEPTH", "Node", "VARIABLES",
-           "evaluator", "fail", "parse_tree", "shorten", "tree_variables"]
+__all__ = [
+    "ALLOWED",
+    "CONDITIONS",
+    "CONSTANTS",
+    "FUNCTIONS",
+    "MAX_NESTING_DEPTH",
+    "Node",
+    "VARIABLES",
+    "evaluator",
+    "fail",
+    "parse_tree",
+    "shorten",
+    "tree_variables",
+]
 
 MAX_NESTING_DEPTH = 100
 VARIABLES = ("x", "y", "z")
 CONSTANTS = {"pi": math.pi}
 # name -> (numpy function, least number of arguments, most number of arguments or None)
 FUNCTIONS = {
-    "sin": (np.sin, 1, 1), "cos": (np.cos, 1, 1), "tan": (np.tan, 1, 1),
-    "asin": (np.arcsin, 1, 1), "acos": (np.arccos, 1, 1), "atan": (np.arctan, 1, 1),
+    "sin": (np.sin, 1, 1),
+    "cos": (np.cos, 1, 1),
+    "tan": (np.tan, 1, 1),
+    "asin": (np.arcsin, 1, 1),
+    "acos": (np.arccos, 1, 1),
+    "atan": (np.arctan, 1, 1),
     "atan2": (np.arctan2, 2, 2),
-    "sinh": (np.sinh, 1, 1), "cosh": (np.cosh, 1, 1), "tanh": (np.tanh, 1, 1),
-    "exp": (np.exp, 1, 1), "log": (np.log, 1, 1), "sqrt": (np.sqrt, 1, 1),
-    "abs": (np.abs, 1, 1), "sign": (np.sign, 1, 1),
-    "min": (np.minimum, 2, None), "max": (np.maximum, 2, None),
+    "sinh": (np.sinh, 1, 1),
+    "cosh": (np.cosh, 1, 1),
+    "tanh": (np.tanh, 1, 1),
+    "exp": (np.exp, 1, 1),
+    "log": (np.log, 1, 1),
+    "sqrt": (np.sqrt, 1, 1),
+    "abs": (np.abs, 1, 1),
+    "sign": (np.sign, 1, 1),
+    "min": (np.minimum, 2, None),
+    "max": (np.maximum, 2, None),
     "where": (np.where, 3, 3),
 }
-ALLOWED = ("use x, y, pi, numbers, + - * / ** ( ) and " + " ".join(name for name in FUNCTIONS if name != "where")
-           + ", where(condition, a, b) with < <= > >= == != and or not")
-ARITHMETIC = {"add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.true_divide, "pow": np.power,
-              "neg": np.negative}
-CONDITIONS = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal,
-              "!=": np.not_equal, "and": np.logical_and, "or": np.logical_or, "not": np.logical_not}
+ALLOWED = (
+    "use x, y, pi, numbers, + - * / ** ( ) and "
+    + " ".join(name for name in FUNCTIONS if name != "where")
+    + ", where(condition, a, b) with < <= > >= == != and or not"
+)
+ARITHMETIC = {
+    "add": np.add,
+    "sub": np.subtract,
+    "mul": np.multiply,
+    "div": np.true_divide,
+    "pow": np.power,
+    "neg": np.negative,
+}
+CONDITIONS = {
+    "<": np.less,
+    "<=": np.less_equal,
+    ">": np.greater,
+    ">=": np.greater_equal,
+    "==": np.equal,
+    "!=": np.not_equal,
+    "and": np.logical_and,
+    "or": np.logical_or,
+    "not": np.logical_not,
+}
 
 _BINARY = {ast.Add: "add", ast.Sub: "sub", ast.Mult: "mul", ast.Div: "div", ast.Pow: "pow"}
 _COMPARISONS = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
-_SYMBOLS = {ast.Mod: "%", ast.FloorDiv: "//", ast.MatMult: "@", ast.LShift: "<<", ast.RShift: ">>",
-            ast.BitOr: "|", ast.BitXor: "^", ast.BitAnd: "&", ast.Not: "not", ast.Invert: "~",
-            ast.Is: "is", ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in"}
+_SYMBOLS = {
+    ast.Mod: "%",
+    ast.FloorDiv: "//",
+    ast.MatMult: "@",
+    ast.LShift: "<<",
+    ast.RShift: ">>",
+    ast.BitOr: "|",
+    ast.BitXor: "^",
+    ast.BitAnd: "&",
+    ast.Not: "not",
+    ast.Invert: "~",
+    ast.Is: "is",
+    ast.IsNot: "is not",
+    ast.In: "in",
+    ast.NotIn: "not in",
+}
 _DESCRIPTIONS = {
-    ast.Attribute: "attribute access", ast.Subscript: "indexing", ast.Slice: "a slice",
-    ast.Lambda: "a lambda", ast.IfExp: "a conditional expression", ast.Compare: "a comparison",
-    ast.BoolOp: "and/or", ast.List: "a list", ast.Tuple: "a tuple", ast.Dict: "a dict",
-    ast.Set: "a set", ast.ListComp: "a comprehension", ast.SetComp: "a comprehension",
-    ast.DictComp: "a comprehension", ast.GeneratorExp: "a generator",
-    ast.NamedExpr: "an assignment", ast.Starred: "a starred argument",
-    ast.JoinedStr: "an f-string", ast.FormattedValue: "an f-string", ast.Await: "await",
-    ast.Yield: "yield", ast.YieldFrom: "yield",
+    ast.Attribute: "attribute access",
+    ast.Subscript: "indexing",
+    ast.Slice: "a slice",
+    ast.Lambda: "a lambda",
+    ast.IfExp: "a conditional expression",
+    ast.Compare: "a comparison",
+    ast.BoolOp: "and/or",
+    ast.List: "a list",
+    ast.Tuple: "a tuple",
+    ast.Dict: "a dict",
+    ast.Set: "a set",
+    ast.ListComp: "a comprehension",
+    ast.SetComp: "a comprehension",
+    ast.DictComp: "a comprehension",
+    ast.GeneratorExp: "a generator",
+    ast.NamedExpr: "an assignment",
+    ast.Starred: "a starred argument",
+    ast.JoinedStr: "an f-string",
+    ast.FormattedValue: "an f-string",
+    ast.Await: "await",
+    ast.Yield: "yield",
+    ast.YieldFrom: "yield",
 }
 _WHERE_HINT = "write where(condition, a, b), e.g. where(x < 0.5, 1, 0)"
 
 
 class Node(NamedTuple):
     """One operation of an expression tree (module docstring); ``args`` are Nodes."""
+
     op: str
     args: tuple = ()
     value: object = None
@@ -111,8 +179,11 @@ class _Parser:
         """The depth limit: truly nested, or a long flat chain a + b + c + ... (which is not nested)."""
         if nesting_depth(self.text) > MAX_NESTING_DEPTH:
             return self.fail(f"nested more than {MAX_NESTING_DEPTH} levels deep", hint=False)
-        return self.fail(f"more than {MAX_NESTING_DEPTH} operations in one chain (a sum or product of that many "
-                         "terms); group the terms in parentheses, e.g. (a + b + ...) + (c + ...)", hint=False)
+        return self.fail(
+            f"more than {MAX_NESTING_DEPTH} operations in one chain (a sum or product of that many "
+            "terms); group the terms in parentheses, e.g. (a + b + ...) + (c + ...)",
+            hint=False,
+        )
 
     def segment(self, node: ast.AST) -> str:
         try:
@@ -140,8 +211,13 @@ class _Parser:
             return Node("neg", (operand,)) if isinstance(node.op, ast.USub) else operand
         if isinstance(node, (ast.BinOp, ast.UnaryOp)):
             symbol = _SYMBOLS.get(type(node.op), "?")
-            where = (f" (it joins conditions in where(...): write (x < 1) {symbol} (y < 1))" if symbol in ("&", "|")
-                     else " (it negates a condition in where(...))" if symbol == "not" else "")
+            where = (
+                f" (it joins conditions in where(...): write (x < 1) {symbol} (y < 1))"
+                if symbol in ("&", "|")
+                else " (it negates a condition in where(...))"
+                if symbol == "not"
+                else ""
+            )
             raise self.fail(f"operator {symbol!r} is not allowed in an expression{where}")
         if isinstance(node, ast.Call):
             return self.call(node, depth)
@@ -171,8 +247,10 @@ class _Parser:
             return Node(op, (self.condition(node.left, depth + 1), self.condition(node.right, depth + 1)))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
             return Node("not", (self.condition(node.operand, depth + 1),))
-        raise self.fail(f"the condition {self.segment(node)!r} of where(...) must be a comparison such as "
-                        "x < 0.5 (joined by and, or, not)")
+        raise self.fail(
+            f"the condition {self.segment(node)!r} of where(...) must be a comparison such as "
+            "x < 0.5 (joined by and, or, not)"
+        )
 
     def constant(self, node: ast.Constant) -> Node:
         value = node.value
@@ -200,8 +278,9 @@ class _Parser:
             raise self.fail(f"function {function!r} is not allowed in an expression")
         if node.keywords:
             keyword = node.keywords[0].arg
-            raise self.fail(f"keyword argument {(keyword or '**') + '='!r} in "
-                            f"{function}(...) is not allowed in an expression")
+            raise self.fail(
+                f"keyword argument {(keyword or '**') + '='!r} in {function}(...) is not allowed in an expression"
+            )
         _, least, most = FUNCTIONS[function]
         count = len(node.args)
         if count < least or (most is not None and count > most):
@@ -279,9 +358,14 @@ def evaluator(node: Node):
         for a in arguments:
             if not isinstance(a, np.float64):
                 last_use[a] = index
-    plan = [(operator, arguments, {a for a in arguments if not isinstance(a, np.float64)
-                                   and a >= len(VARIABLES) and last_use[a] == index})
-            for index, (operator, arguments) in enumerate(steps)]
+    plan = [
+        (
+            operator,
+            arguments,
+            {a for a in arguments if not isinstance(a, np.float64) and a >= len(VARIABLES) and last_use[a] == index},
+        )
+        for index, (operator, arguments) in enumerate(steps)
+    ]
 
     def run(x, y, z):
         values = [x, y, z] + [None] * len(plan)

@@ -25,12 +25,33 @@ from numbers import Real
 import numpy as np
 
 from vemkit.config.expression_calculus import derivative
-from vemkit.config.expression_tree import (ALLOWED, CONSTANTS, FUNCTIONS, MAX_NESTING_DEPTH, VARIABLES, Node,
-                                           evaluator, fail, parse_tree, shorten, tree_variables)
+from vemkit.config.expression_tree import (
+    ALLOWED,
+    CONSTANTS,
+    FUNCTIONS,
+    MAX_NESTING_DEPTH,
+    VARIABLES,
+    Node,
+    evaluator,
+    fail,
+    parse_tree,
+    shorten,
+    tree_variables,
+)
 from vemkit.exceptions import ExpressionError
 
-__all__ = ["ALLOWED", "CONSTANTS", "FUNCTIONS", "MAX_NESTING_DEPTH", "VARIABLES", "Expression", "ExpressionError",
-           "VectorField", "compile_expression", "vector_field"]
+__all__ = [
+    "ALLOWED",
+    "CONSTANTS",
+    "FUNCTIONS",
+    "MAX_NESTING_DEPTH",
+    "VARIABLES",
+    "Expression",
+    "ExpressionError",
+    "VectorField",
+    "compile_expression",
+    "vector_field",
+]
 
 MAX_EXPRESSION_LENGTH = 2000
 
@@ -63,8 +84,12 @@ class Expression:
 
     def __call__(self, x, y, z=None) -> np.ndarray:
         if z is None and "z" in self.variables:
-            raise ExpressionError(f"{self.name} = {shorten(self.text)!r}: uses z, but it is evaluated in the "
-                                  "plane (x, y); z is for 3D scenes", name=self.name, text=self.text)
+            raise ExpressionError(
+                f"{self.name} = {shorten(self.text)!r}: uses z, but it is evaluated in the "
+                "plane (x, y); z is for 3D scenes",
+                name=self.name,
+                text=self.text,
+            )
         points = [np.asarray(v, dtype=np.float64) for v in ((x, y) if z is None else (x, y, z))]
         shape = np.broadcast_shapes(*(p.shape for p in points))
         if self.constant_value is not None:
@@ -78,7 +103,10 @@ class Expression:
             at = ", ".join(f"{label}={np.broadcast_to(p, shape)[where]:.6g}" for label, p in zip("xyz", points))
             raise ExpressionError(
                 f"{self.name} = {shorten(self.text)!r}: evaluates to {result[where]} at "
-                f"{at}; the expression must be finite on the domain", name=self.name, text=self.text)
+                f"{at}; the expression must be finite on the domain",
+                name=self.name,
+                text=self.text,
+            )
         return result
 
     def derivative(self, variable: str) -> Expression:
@@ -86,8 +114,9 @@ class Expression:
         name ``d/dx of <key>`` and the original text."""
         if variable not in VARIABLES:
             raise ValueError(f"variable {variable!r}: expected one of {', '.join(VARIABLES)}")
-        return Expression(self.text, f"d/d{variable} of {self.name}", derivative(self._tree, variable),
-                          origin=(self, variable))
+        return Expression(
+            self.text, f"d/d{variable} of {self.name}", derivative(self._tree, variable), origin=(self, variable)
+        )
 
     def __reduce__(self):
         if self._origin is not None:
@@ -107,12 +136,12 @@ def compile_expression(value, *, name: str = "expression") -> Expression:
     if isinstance(value, Real) and not isinstance(value, bool):
         constant = float(value)
         if not math.isfinite(constant):
-            raise ExpressionError(f"{name} = {constant}: must be a finite number",
-                                  name=name, text=repr(constant))
+            raise ExpressionError(f"{name} = {constant}: must be a finite number", name=name, text=repr(constant))
         return Expression(repr(constant), name, Node("num", value=constant))
     if not isinstance(value, str):
-        raise ExpressionError(f"{name} = {shorten(repr(value))}: expected a number or an "
-                              f"expression string; {ALLOWED}", name=name)
+        raise ExpressionError(
+            f"{name} = {shorten(repr(value))}: expected a number or an expression string; {ALLOWED}", name=name
+        )
     text = value.strip()
     if not text:
         raise fail(name, text, "empty expression")
@@ -120,8 +149,7 @@ def compile_expression(value, *, name: str = "expression") -> Expression:
         raise fail(name, text, f"longer than {MAX_EXPRESSION_LENGTH} characters", hint=False)
     expression = Expression(text, name, parse_tree(text, name))
     if expression.is_constant and not math.isfinite(expression.constant_value):
-        raise fail(name, text, f"evaluates to {expression.constant_value}; the expression must be finite",
-                   hint=False)
+        raise fail(name, text, f"evaluates to {expression.constant_value}; the expression must be finite", hint=False)
     return expression
 
 

@@ -30,9 +30,22 @@ from vemkit.config.mesh_file_header import mesh_file_header
 from vemkit.config.mesh_resolution import scene_cells_per_length, thin_part_triangles
 from vemkit.exceptions import ResourceLimitError
 
-__all__ = ["BASE_BYTES", "BYTES_PER_DOF", "DEFAULT_MAX_DOFS", "MEMORY_FRACTION", "Resources",
-           "available_memory", "check_resources", "check_scene_resources", "domain_area", "estimate_mesh",
-           "estimate_resources", "estimate_resources3d", "memory_budget", "scene_resources"]
+__all__ = [
+    "BASE_BYTES",
+    "BYTES_PER_DOF",
+    "DEFAULT_MAX_DOFS",
+    "MEMORY_FRACTION",
+    "Resources",
+    "available_memory",
+    "check_resources",
+    "check_scene_resources",
+    "domain_area",
+    "estimate_mesh",
+    "estimate_resources",
+    "estimate_resources3d",
+    "memory_budget",
+    "scene_resources",
+]
 
 DEFAULT_MAX_DOFS = 4_000_000  # the paper's finest level (n = 1024) has 2.1 million on squares
 BASE_BYTES = 400 * 2**20  # Python with numpy, scipy, numba, xarray, netCDF4 loaded
@@ -50,8 +63,7 @@ class Resources(NamedTuple):
     peak_bytes: int
 
     def describe(self) -> str:
-        return (f"about {self.cells:,} cells, {self.dofs:,} DOFs and "
-                f"{_gib(self.peak_bytes)} of memory")
+        return f"about {self.cells:,} cells, {self.dofs:,} DOFs and {_gib(self.peak_bytes)} of memory"
 
 
 def _gib(count: float) -> str:
@@ -158,20 +170,28 @@ def available_memory() -> int | None:
     return max(min(candidates), 0) if candidates else None
 
 
-def check_resources(estimate: Resources, max_dofs: int | None = DEFAULT_MAX_DOFS,
-                    what: str = "the scene", fix: str = "a smaller discretization.mesh.n") -> None:
+def check_resources(
+    estimate: Resources,
+    max_dofs: int | None = DEFAULT_MAX_DOFS,
+    what: str = "the scene",
+    fix: str = "a smaller discretization.mesh.n",
+) -> None:
     """ResourceLimitError if ``estimate`` exceeds ``max_dofs`` or the machine (message: the
     estimate, the limit and the fix)."""
     if max_dofs is not None and estimate.dofs > max_dofs:
         raise ResourceLimitError(
             f"{what} needs {estimate.describe()}, more than the limit of {max_dofs:,} DOFs; "
-            f"use {fix}, or raise the limit with --max-dofs", key="max_dofs",
-            estimate=estimate._asdict())
+            f"use {fix}, or raise the limit with --max-dofs",
+            key="max_dofs",
+            estimate=estimate._asdict(),
+        )
     free = available_memory()
     if free is not None and estimate.peak_bytes > MEMORY_FRACTION * free:
         raise ResourceLimitError(
-            f"{what} needs {estimate.describe()}, more than this machine has available "
-            f"({_gib(free)}); use {fix}", key="memory", estimate=estimate._asdict())
+            f"{what} needs {estimate.describe()}, more than this machine has available ({_gib(free)}); use {fix}",
+            key="memory",
+            estimate=estimate._asdict(),
+        )
 
 
 def scene_resources(scene, layout: dict | None = None) -> Resources | None:
@@ -191,12 +211,16 @@ def scene_resources(scene, layout: dict | None = None) -> Resources | None:
     # nodes on vertices, edges (Euler: about V + C) and cells; measured peak memory per DOF of k = 2 as
     # for k = 1 (benchmarks/order2.py: 0.80 GiB at 525 312 DOFs, k = 1 0.74 GiB)
     layout = layout or {"vertex": 1}
-    nodes = sum(layout.get(entity, 0) * count
-                for entity, count in (("vertex", vertices), ("edge", vertices + cells), ("cell", cells)))
+    nodes = sum(
+        layout.get(entity, 0) * count
+        for entity, count in (("vertex", vertices), ("edge", vertices + cells), ("cell", cells))
+    )
     return estimate_resources(cells, nodes)._replace(vertices=vertices)
 
 
-def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout: dict | None = None) -> Resources | None:
+def check_scene_resources(
+    scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout: dict | None = None
+) -> Resources | None:
     """The prediction of :func:`scene_resources` (``layout``: the element's nodes per entity);
     ResourceLimitError beyond ``max_dofs`` or the machine's memory."""
     estimate = scene_resources(scene, layout)
@@ -204,13 +228,18 @@ def check_scene_resources(scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout
         return None
     options = scene.mesh_options
     if "file" in options:
-        check_resources(estimate, max_dofs, what=f"the mesh file {options['file']} ({estimate.vertices:,} "
-                        "vertices)", fix="a coarser mesh")
+        check_resources(
+            estimate,
+            max_dofs,
+            what=f"the mesh file {options['file']} ({estimate.vertices:,} vertices)",
+            fix="a coarser mesh",
+        )
         check_file_sides(scene, mesh_file_header(scene.mesh_file))
         return estimate
     size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells"))
-    check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
-                    fix="a coarser discretization.mesh")
+    check_resources(
+        estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})", fix="a coarser discretization.mesh"
+    )
     return estimate
 
 

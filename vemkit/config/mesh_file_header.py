@@ -81,8 +81,9 @@ def mesh_file_header(path) -> MeshFileHeader:
     the file cannot be a mesh vemkit reads."""
     path = Path(path)
     if path.suffix not in MESH_SUFFIXES:
-        raise MeshError(f"{path}: unknown mesh file type {path.suffix!r}; give a gmsh .msh or a UGRID .nc file",
-                        key=str(path))
+        raise MeshError(
+            f"{path}: unknown mesh file type {path.suffix!r}; give a gmsh .msh or a UGRID .nc file", key=str(path)
+        )
     fd = open_regular_file(path)
     try:
         size = os.fstat(fd).st_size
@@ -90,8 +91,11 @@ def mesh_file_header(path) -> MeshFileHeader:
     finally:
         os.close(fd)
     if header.cells > 2 * header.vertices + 2:
-        raise _fail(path, f"declares {header.cells:,} cells on {header.vertices:,} vertices, more than a plane mesh "
-                          "can have (2 per vertex); the file is broken")
+        raise _fail(
+            path,
+            f"declares {header.cells:,} cells on {header.vertices:,} vertices, more than a plane mesh "
+            "can have (2 per vertex); the file is broken",
+        )
     return header
 
 
@@ -119,13 +123,17 @@ def _gmsh_header(fd: int, path: Path, size: int) -> MeshFileHeader:
     start = _read_at(fd, 0, 4096).lstrip()
     while start.startswith(b"$Comments"):  # gmsh allows comment blocks before $MeshFormat
         end = start.find(b"$EndComments")
-        start = start[end + len(b"$EndComments"):].lstrip() if end >= 0 else b""
+        start = start[end + len(b"$EndComments") :].lstrip() if end >= 0 else b""
     lines = start.split(b"\n", 2)
     if len(lines) < 2 or lines[0].strip() != b"$MeshFormat":
         raise _fail(path, "cannot be read as gmsh: the file does not start with $MeshFormat; give a gmsh .msh file")
     fields = lines[1].split()
-    if len(fields) != 3 or fields[0][:2] not in (b"2.", b"4.") or fields[1] not in (b"0", b"1") \
-            or fields[2] not in (b"4", b"8"):
+    if (
+        len(fields) != 3
+        or fields[0][:2] not in (b"2.", b"4.")
+        or fields[1] not in (b"0", b"1")
+        or fields[2] not in (b"4", b"8")
+    ):
         raise _fail(path, f"cannot be read as gmsh: format line {_show(lines[1])}; vemkit reads gmsh 2 and 4")
     version, binary, word = int(fields[0][:1]), fields[1] == b"1", int(fields[2])
     at_nodes = _find_section(fd, "Nodes", 0, min(size, _MAX_BEFORE_NODES))
@@ -141,8 +149,9 @@ def _gmsh_header(fd: int, path: Path, size: int) -> MeshFileHeader:
         raise _fail(path, "cannot be read as gmsh: no $Elements section")
     elements = _gmsh_count(fd, at_elements, version, binary, word, path, "$Elements")
     if elements > 6 * nodes + 16:
-        raise _fail(path, f"declares {elements:,} elements on {nodes:,} nodes, more than a plane mesh has; "
-                          "the file is broken")
+        raise _fail(
+            path, f"declares {elements:,} elements on {nodes:,} nodes, more than a plane mesh has; the file is broken"
+        )
     names = _physical_line_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path)
     return MeshFileHeader(nodes, min(elements, 2 * nodes + 2), names, False, size)
 
@@ -152,7 +161,7 @@ def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
     head = _read_at(fd, offset, 256)
     try:
         if version == 4 and binary:
-            count = struct.unpack(f"<{'Q' if word == 8 else 'I'}", head[word:2 * word])[0]
+            count = struct.unpack(f"<{'Q' if word == 8 else 'I'}", head[word : 2 * word])[0]
         else:
             values = head.split(b"\n", 1)[0].split()
             count = int(values[1 if version == 4 else 0])
@@ -172,7 +181,7 @@ def _physical_line_names(fd, offset, path) -> tuple:
     except ValueError:
         raise _fail(path, "cannot be read as gmsh: the $PhysicalNames header is broken") from None
     names = []
-    for line in text[1:1 + count]:
+    for line in text[1 : 1 + count]:
         parts = line.split(None, 2)
         if len(parts) == 3 and parts[0] == "1":
             names.append(parts[2].strip().strip('"'))
@@ -204,16 +213,20 @@ def _ugrid_variable(nc, name, path, role: str, rank: int):
         raise _fail(path, f"cannot be read as UGRID netCDF: the {role} variable {str(name)[:60]!r} is missing")
     variable = nc.variables[name]
     if variable.ndim != rank or getattr(variable.dtype, "kind", "O") not in "iuf":
-        raise _fail(path, f"cannot be read as UGRID netCDF: {name[:60]} ({role}) must be a numeric "
-                          f"{'vector' if rank == 1 else 'table'}")
+        raise _fail(
+            path,
+            f"cannot be read as UGRID netCDF: {name[:60]} ({role}) must be a numeric "
+            f"{'vector' if rank == 1 else 'table'}",
+        )
     return variable
 
 
 def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
     if len(topologies) != 1:
-        raise _fail(path, f"cannot be read as UGRID netCDF: expected one mesh topology variable, found "
-                          f"{len(topologies)}")
+        raise _fail(
+            path, f"cannot be read as UGRID netCDF: expected one mesh topology variable, found {len(topologies)}"
+        )
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
     if str(getattr(topology, "topology_dimension", "2")) == "3":
@@ -228,8 +241,10 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     if y.shape[0] != vertices:
         raise _fail(path, f"cannot be read as UGRID netCDF: {x.shape[0]} x but {y.shape[0]} y node coordinates")
     if cells * corners > 64 * vertices + (1 << 20):
-        raise _fail(path, f"declares a face table of {cells:,} x {corners:,} entries for {vertices:,} vertices; "
-                          "the file is broken")
+        raise _fail(
+            path,
+            f"declares a face table of {cells:,} x {corners:,} entries for {vertices:,} vertices; the file is broken",
+        )
     sides = _ugrid_sides(nc, getattr(topology, "vemkit_boundary_parts", "[]"), vertices, path)
     return MeshFileHeader(vertices, cells, sides, True, size)
 
@@ -240,11 +255,16 @@ def _ugrid_sides(nc, text, vertices: int, path: Path) -> tuple:
     except ValueError:
         names = None
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-        raise _fail(path, "cannot be read as UGRID netCDF: the attribute vemkit_boundary_parts must be a JSON "
-                          "list of side names")
+        raise _fail(
+            path,
+            "cannot be read as UGRID netCDF: the attribute vemkit_boundary_parts must be a JSON list of side names",
+        )
     for name in names:
         part = _ugrid_variable(nc, f"boundary_{name}", path, f"boundary part {name[:40]!r}", 2)
         if part.shape[1] != 2 or part.shape[0] > 3 * vertices + 3 or getattr(part.dtype, "kind", "O") not in "iu":
-            raise _fail(path, f"cannot be read as UGRID netCDF: boundary_{name[:40]} must be an integer table of "
-                              "edges (vertex pairs)")
+            raise _fail(
+                path,
+                f"cannot be read as UGRID netCDF: boundary_{name[:40]} must be an integer table of "
+                "edges (vertex pairs)",
+            )
     return tuple(names)

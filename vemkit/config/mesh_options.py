@@ -57,11 +57,12 @@ def mesh_request(family: str, n, options=()) -> dict:
         key, separator, value = str(text).partition("=")
         key = key.strip()
         if not separator or not key:
-            raise SceneError(f"--option {text}: write it as key=value, e.g. --option seed=3",
-                             key="--option")
+            raise SceneError(f"--option {text}: write it as key=value, e.g. --option seed=3", key="--option")
         if key in ("family", "n"):
-            raise SceneError(f"--option {text}: give the {key} as the "
-                             f"{'FAMILY' if key == 'family' else 'N'} argument", key="--option")
+            raise SceneError(
+                f"--option {text}: give the {key} as the {'FAMILY' if key == 'family' else 'N'} argument",
+                key="--option",
+            )
         if key in data:
             raise SceneError(f"--option {key} is given twice; give it once", key="--option")
         data[key] = parse_yaml(value, f"--option {text}")

@@ -33,8 +33,15 @@ import shapely
 from vemkit.config.domain import CircleHole, Domain, cells_per_length, domain_from_spec
 from vemkit.exceptions import SceneError
 
-__all__ = ["MAX_CELL_OVER_BODY", "MAX_COORDINATE_OVER_CELL", "MIN_FEATURE", "VORONOI_MIN_HOLE",
-           "check_mesh_resolution", "scene_cells_per_length", "thin_part_triangles"]
+__all__ = [
+    "MAX_CELL_OVER_BODY",
+    "MAX_COORDINATE_OVER_CELL",
+    "MIN_FEATURE",
+    "VORONOI_MIN_HOLE",
+    "check_mesh_resolution",
+    "scene_cells_per_length",
+    "thin_part_triangles",
+]
 
 MAX_CELL_OVER_BODY = 10.0
 MAX_COORDINATE_OVER_CELL = {"voronoi": 5e4, "other": 1e6}
@@ -46,8 +53,9 @@ _FIX = "fix the scene or --set discretization.mesh.h=..."
 def cell_size(mesh: dict, domain: Domain) -> float:
     """The cell size h of ``discretization.mesh`` (1/n, h, or from cells) on ``domain``."""
     sizes = {key: mesh[key] for key in ("n", "h", "cells") if key in mesh}
-    return 1.0 / float(cells_per_length(domain, **sizes, cells_per_square=2.0 if mesh.get("family") == "triangle"
-                                        else 1.0))
+    return 1.0 / float(
+        cells_per_length(domain, **sizes, cells_per_square=2.0 if mesh.get("family") == "triangle" else 1.0)
+    )
 
 
 def scene_cells_per_length(scene) -> float:
@@ -68,29 +76,39 @@ def check_mesh_resolution(mesh: dict, domain: Domain) -> None:
     size, reach, (width, height) = _extent(domain)
     given = ", ".join(f"{k} = {mesh[k]:g}" for k in ("n", "h", "cells") if k in mesh)
     if h > MAX_CELL_OVER_BODY * size:
-        raise SceneError(f"discretization.mesh ({given}): cells of size {h:.3g} on a body of {width:.3g} x {height:.3g}; "
-                         f"give h <= {size:.3g} (the body's larger side) or a larger n; {_FIX}", key="discretization.mesh")
+        raise SceneError(
+            f"discretization.mesh ({given}): cells of size {h:.3g} on a body of {width:.3g} x {height:.3g}; "
+            f"give h <= {size:.3g} (the body's larger side) or a larger n; {_FIX}",
+            key="discretization.mesh",
+        )
     ratio = MAX_COORDINATE_OVER_CELL.get(family, MAX_COORDINATE_OVER_CELL["other"])
     if size > ratio * h:
-        raise SceneError(f"discretization.mesh ({given}): about {size / h:.2g} cells of size {h:.3g} across a body of "
-                         f"{width:.3g} x {height:.3g}, far beyond any memory; give a larger h or a smaller n (at most "
-                         f"{ratio:.0e} cells across); {_FIX}", key="discretization.mesh")
+        raise SceneError(
+            f"discretization.mesh ({given}): about {size / h:.2g} cells of size {h:.3g} across a body of "
+            f"{width:.3g} x {height:.3g}, far beyond any memory; give a larger h or a smaller n (at most "
+            f"{ratio:.0e} cells across); {_FIX}",
+            key="discretization.mesh",
+        )
     structured = domain.is_unit_square and family in ("square", "hanging") and float(1.0 / h).is_integer()
     finest = h / 2 ** int(mesh.get("levels", 1)) if family == "hanging" else h
     if reach > ratio * finest and not structured:
-        raise SceneError(f"discretization.mesh ({given}): cells of size {finest:.3g} at |x|, |y| up to {reach:.3g}, more "
-                         f"than {ratio:.0e} cells from the origin: too fine for double precision there; move the body "
-                         "near the origin (shift domain.polygon and the holes), or use coarser cells (fewer levels)",
-                         key="discretization.mesh")
+        raise SceneError(
+            f"discretization.mesh ({given}): cells of size {finest:.3g} at |x|, |y| up to {reach:.3g}, more "
+            f"than {ratio:.0e} cells from the origin: too fine for double precision there; move the body "
+            "near the origin (shift domain.polygon and the holes), or use coarser cells (fewer levels)",
+            key="discretization.mesh",
+        )
     _check_features(domain, max(h, size / 4096), size)
     if family == "voronoi":
         _check_voronoi_holes(domain, h)
     if family == "hanging" and mesh.get("rule", "contact") == "contact":
         side = mesh.get("contact_side", "bottom")
         if side not in domain.side_names:
-            raise SceneError(f"discretization.mesh.contact_side = {side!r}: the hanging family refines towards a side "
-                             f"of the body; give one of {', '.join(domain.side_names)} (or rule: random)",
-                             key="discretization.mesh.contact_side")
+            raise SceneError(
+                f"discretization.mesh.contact_side = {side!r}: the hanging family refines towards a side "
+                f"of the body; give one of {', '.join(domain.side_names)} (or rule: random)",
+                key="discretization.mesh.contact_side",
+            )
 
 
 def _circle_gaps(domain: Domain):
@@ -103,7 +121,7 @@ def _circle_gaps(domain: Domain):
     for i, c in enumerate(circles):
         centre = shapely.Point(c.cx, c.cy)
         gaps = [outer.distance(centre) - c.r] + [p.distance(centre) - c.r for p in others]
-        gaps += [math.hypot(c.cx - d.cx, c.cy - d.cy) - c.r - d.r for d in circles[i + 1:]]
+        gaps += [math.hypot(c.cx - d.cx, c.cy - d.cy) - c.r - d.r for d in circles[i + 1 :]]
         best = min(best, (min(gaps), c.cx, c.cy))
     return best
 
@@ -117,9 +135,12 @@ def _check_features(domain: Domain, h: float, size: float) -> None:
     x, y = shapely.get_coordinates(shapely.minimum_clearance_line(shape))[0] if clearance < math.inf else (0, 0)
     clearance, x, y = min((clearance, x, y), _circle_gaps(domain))
     if clearance < MIN_FEATURE * size:
-        raise SceneError(f"domain: the body has a feature of {clearance:.3g} near ({x:.6g}, {y:.6g}) (a hole, a gap or "
-                         f"an edge), {clearance / size:.1e} of its size {size:.3g}: below what a mesh resolves in double "
-                         "precision; remove it or merge the corners", key="domain")
+        raise SceneError(
+            f"domain: the body has a feature of {clearance:.3g} near ({x:.6g}, {y:.6g}) (a hole, a gap or "
+            f"an edge), {clearance / size:.1e} of its size {size:.3g}: below what a mesh resolves in double "
+            "precision; remove it or merge the corners",
+            key="domain",
+        )
 
 
 def _check_voronoi_holes(domain: Domain, h: float) -> None:
@@ -131,9 +152,11 @@ def _check_voronoi_holes(domain: Domain, h: float) -> None:
             corners = shapely.get_coordinates(box)
             radius = 0.5 * min(np.hypot(*(corners[1] - corners[0])), np.hypot(*(corners[2] - corners[1])))
         if radius < VORONOI_MIN_HOLE * h:
-            raise SceneError(f"domain.holes[{i}] (about {2 * radius:.3g} across) is too small for voronoi cells of size "
-                             f"{h:.3g}: give h <= {radius / VORONOI_MIN_HOLE:.3g} or the triangle family; {_FIX}",
-                             key="discretization.mesh")
+            raise SceneError(
+                f"domain.holes[{i}] (about {2 * radius:.3g} across) is too small for voronoi cells of size "
+                f"{h:.3g}: give h <= {radius / VORONOI_MIN_HOLE:.3g} or the triangle family; {_FIX}",
+                key="discretization.mesh",
+            )
 
 
 def _sharp_corners(shape) -> tuple:
@@ -168,8 +191,9 @@ def thin_part_triangles(domain: Domain, h: float) -> int:
     while r > MIN_FEATURE * size * 0.25:
         thin = shape.difference(shape.buffer(-r).buffer(r))
         if points.size:  # the tips of sharp corners, narrower than 2 r within r / sin(angle / 2)
-            thin = thin.difference(shapely.union_all(shapely.buffer(shapely.points(points),
-                                                                    1.01 * r / np.sin(0.5 * angles))))
+            thin = thin.difference(
+                shapely.union_all(shapely.buffer(shapely.points(points), 1.01 * r / np.sin(0.5 * angles)))
+            )
         bands.append((r, thin.area))
         if thin.area <= 1e-12 * shape.area:
             break

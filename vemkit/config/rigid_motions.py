@@ -66,8 +66,10 @@ def _rotation_words(points, omega: np.ndarray, means: np.ndarray) -> str:
     omega = omega / np.linalg.norm(omega)
     a = np.array([-np.cross(omega, means[i])[i] for i in range(3)])  # u_i = 0 at the mean of X_i
     through = np.cross(omega, a)
-    return (f"a rotation about the axis along ({omega[0]:.3g}, {omega[1]:.3g}, {omega[2]:.3g}) through "
-            f"({through[0]:.6g}, {through[1]:.6g}, {through[2]:.6g})")
+    return (
+        f"a rotation about the axis along ({omega[0]:.3g}, {omega[1]:.3g}, {omega[2]:.3g}) through "
+        f"({through[0]:.6g}, {through[1]:.6g}, {through[2]:.6g})"
+    )
 
 
 def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | None:

@@ -23,16 +23,17 @@ import yaml
 
 from vemkit.exceptions import SceneError
 
-__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "MAX_INTEGER_DIGITS", "SceneDumper", "parse_yaml",
-           "read_user_file"]
+__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "MAX_INTEGER_DIGITS", "SceneDumper", "parse_yaml", "read_user_file"]
 
 MAX_FILE_BYTES = 256 << 10  # 256 KiB: a scene is a few hundred bytes; 1 MiB of YAML takes ~8 s to read
 MAX_DEPTH = 32  # nested mappings/lists; a scene nests 4 deep
 MAX_INTEGER_DIGITS = 30  # longer integers are refused (no scene value needs them)
 
 _INT = re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$")
-_FLOAT = re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-                    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$")
+_FLOAT = re.compile(
+    r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+)
 _BOOL = re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$")
 _NULL = re.compile(r"^(?:~|null|Null|NULL|)$")
 _TAG = "tag:yaml.org,2002:"
@@ -42,8 +43,11 @@ def _core_schema_resolvers() -> dict:
     """The YAML 1.2 core schema as PyYAML implicit resolvers: {first character: [(tag, regexp)]}."""
     table: dict = {}
     for tag, regexp, first in (
-            ("bool", _BOOL, "tTfF"), ("int", _INT, "-+0123456789"),
-            ("float", _FLOAT, "-+.0123456789"), ("null", _NULL, ["~", "n", "N", ""])):
+        ("bool", _BOOL, "tTfF"),
+        ("int", _INT, "-+0123456789"),
+        ("float", _FLOAT, "-+.0123456789"),
+        ("null", _NULL, ["~", "n", "N", ""]),
+    ):
         for character in first:
             table.setdefault(character, []).append((_TAG + tag, regexp))
     return table
@@ -58,19 +62,22 @@ class _Composer:
         event = self.peek_event()
         if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
             raise yaml.composer.ComposerError(
-                None, None, "anchors and aliases (&name, *name) are not allowed; write the values "
-                "out", event.start_mark)
+                None, None, "anchors and aliases (&name, *name) are not allowed; write the values out", event.start_mark
+            )
         tag = getattr(event, "tag", None)
         if tag not in (None, "!"):
             raise yaml.composer.ComposerError(
-                None, None, f"explicit tags ({tag}) are not allowed; write plain values",
-                event.start_mark)
+                None, None, f"explicit tags ({tag}) are not allowed; write plain values", event.start_mark
+            )
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
                 raise yaml.composer.ComposerError(
-                    None, None, f"nested more than {MAX_DEPTH} levels deep; a scene nests a few "
-                    "levels", event.start_mark)
+                    None,
+                    None,
+                    f"nested more than {MAX_DEPTH} levels deep; a scene nests a few levels",
+                    event.start_mark,
+                )
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -90,8 +97,7 @@ class UserLoader(_Composer, yaml.SafeLoader):
             except TypeError:  # unhashable (a list as a key): let SafeLoader report it
                 break
             if duplicate:
-                raise yaml.constructor.ConstructorError(
-                    None, None, f"duplicate key {key!r}", key_node.start_mark)
+                raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r}", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
 
@@ -99,8 +105,8 @@ class UserLoader(_Composer, yaml.SafeLoader):
         text = self.construct_scalar(node)
         if len(text.lstrip("+-")) > MAX_INTEGER_DIGITS:
             raise yaml.constructor.ConstructorError(
-                None, None, f"integer with {len(text)} digits; give at most {MAX_INTEGER_DIGITS}",
-                node.start_mark)
+                None, None, f"integer with {len(text)} digits; give at most {MAX_INTEGER_DIGITS}", node.start_mark
+            )
         return int(text, 0) if text.startswith(("0o", "0x")) else int(text, 10)
 
     def construct_core_float(self, node):
@@ -131,22 +137,30 @@ def parse_yaml(text: str, source: str):
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = f"{source}:{mark.line + 1}" if mark is not None else source
-        context = f" ({error.context} at line {error.context_mark.line + 1})" \
-            if error.context and error.context_mark is not None and error.problem else ""
-        kind = "" if isinstance(error, (yaml.composer.ComposerError,
-                                        yaml.constructor.ConstructorError)) else "YAML syntax error: "
-        raise SceneError(f"{where}: {kind}{error.problem or error.context}{context}",
-                         key=source) from None
+        context = (
+            f" ({error.context} at line {error.context_mark.line + 1})"
+            if error.context and error.context_mark is not None and error.problem
+            else ""
+        )
+        kind = (
+            ""
+            if isinstance(error, (yaml.composer.ComposerError, yaml.constructor.ConstructorError))
+            else "YAML syntax error: "
+        )
+        raise SceneError(f"{where}: {kind}{error.problem or error.context}{context}", key=source) from None
     except yaml.YAMLError as error:
         raise SceneError(f"{source}: YAML syntax error: {error}", key=source) from None
     except RecursionError:
-        raise SceneError(f"{source}: nested too deeply; a scene nests a few levels",
-                         key=source) from None
+        raise SceneError(f"{source}: nested too deeply; a scene nests a few levels", key=source) from None
 
 
-_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-          (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"))
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+)
 
 
 def file_kind(mode: int) -> str:
@@ -161,24 +175,24 @@ def read_user_file(path, what: str = "scene file", max_bytes: int = MAX_FILE_BYT
     except FileNotFoundError:
         raise SceneError(f"{path}: {what} not found", key=str(path)) from None
     except OSError as error:
-        raise SceneError(f"{path}: cannot read the {what} ({error.strerror or error})",
-                         key=str(path)) from None
+        raise SceneError(f"{path}: cannot read the {what} ({error.strerror or error})", key=str(path)) from None
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            raise SceneError(f"{path}: cannot read the {what}: it is {file_kind(mode)}, not a "
-                             "regular file", key=str(path))
+            raise SceneError(
+                f"{path}: cannot read the {what}: it is {file_kind(mode)}, not a regular file", key=str(path)
+            )
         data = os.read(fd, max_bytes + 1)
         while len(data) <= max_bytes and (chunk := os.read(fd, max_bytes + 1 - len(data))):
             data += chunk
     except OSError as error:
-        raise SceneError(f"{path}: cannot read the {what} ({error.strerror or error})",
-                         key=str(path)) from None
+        raise SceneError(f"{path}: cannot read the {what} ({error.strerror or error})", key=str(path)) from None
     finally:
         os.close(fd)
     if len(data) > max_bytes:
-        raise SceneError(f"{path}: the {what} is larger than {max_bytes // 1024} KiB; a scene is "
-                         "a few hundred bytes", key=str(path))
+        raise SceneError(
+            f"{path}: the {what} is larger than {max_bytes // 1024} KiB; a scene is a few hundred bytes", key=str(path)
+        )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:

@@ -21,25 +21,39 @@ from typing import NamedTuple
 import jsonschema
 import yaml
 
-from vemkit.config.boundary_conditions import (boundary_expressions, check_contact,
-                                               check_mesh_size, check_rigid_motions, check_sides,
-                                               compile_checked, evaluate_checked, inside_points)
-from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
-from vemkit.config.material import lame_parameters
+from vemkit.config.boundary_conditions import (
+    boundary_expressions,
+    check_contact,
+    check_mesh_size,
+    check_rigid_motions,
+    check_sides,
+    compile_checked,
+    evaluate_checked,
+    inside_points,
+)
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
 from vemkit.config.domain3d import domain3d_from_spec
 from vemkit.config.expressions import Expression
+from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
+from vemkit.config.material import lame_parameters
 from vemkit.config.mesh_resolution import check_mesh_resolution
-from vemkit.config.safe_yaml import SceneDumper, parse_yaml as _parse_yaml, read_user_file
+from vemkit.config.safe_yaml import SceneDumper, read_user_file
+from vemkit.config.safe_yaml import parse_yaml as _parse_yaml
 from vemkit.config.scene3d import check_model_domain, semantic_checks_3d
 from vemkit.exceptions import SceneError
 
-__all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml",
-           "scene_schema"]
+__all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml", "scene_schema"]
 
 NO_DIRICHLET = "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]"
-_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
-               "object": "a mapping", "array": "a list", "null": "null", "boolean": "true/false"}
+_TYPE_NAMES = {
+    "number": "a number",
+    "integer": "an integer",
+    "string": "a string",
+    "object": "a mapping",
+    "array": "a list",
+    "null": "null",
+    "boolean": "true/false",
+}
 
 
 class PowerLaw(NamedTuple):
@@ -77,16 +91,19 @@ def _key(path) -> str:
 
 def _show(value) -> str:
     try:
-        text = repr(value) if isinstance(value, str) else json.dumps(value, default=str,
-                                                                      ensure_ascii=False)
+        text = repr(value) if isinstance(value, str) else json.dumps(value, default=str, ensure_ascii=False)
     except (TypeError, ValueError):
         text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
 #: an override of discretization.mesh.KEY removes these keys: one size (SPEC §7), or a file
-_MESH_SIZE_KEYS = {"n": ("h", "cells", "file"), "h": ("n", "cells", "file"), "cells": ("n", "h", "file"),
-                   "file": ("n", "h", "cells", "family")}
+_MESH_SIZE_KEYS = {
+    "n": ("h", "cells", "file"),
+    "h": ("n", "cells", "file"),
+    "cells": ("n", "h", "file"),
+    "file": ("n", "h", "cells", "family"),
+}
 
 
 # -- overrides -----------------------------------------------------------------------------------
@@ -108,13 +125,17 @@ def _key_segments(override: str, key_text: str) -> list:
         return [int(m[2]) if m[2] is not None else m[1] for m in _KEY_SEGMENT.finditer(key_text)]
     if re.search(r"\.\.|^\.|\.$|\.\[", key_text):
         problem = "a key component is empty (two dots, or a dot at an end)"
-    elif re.search(r"\[[^\]]*\]", key_text) and not re.search(r"\[\d+\]", key_text) or \
-            re.search(r"\[(?!\d+\])", key_text):
+    elif (
+        re.search(r"\[[^\]]*\]", key_text)
+        and not re.search(r"\[\d+\]", key_text)
+        or re.search(r"\[(?!\d+\])", key_text)
+    ):
         problem = "a list index is a whole number from 0 in brackets, e.g. boundary.dirichlet[0]"
     else:
         problem = "a key is letters, digits, _ and -, joined by dots"
-    raise SceneError(f"--set {override}: {problem}; expected key.path=value, e.g. --set solver.method=uzawa",
-                     key=key_text)
+    raise SceneError(
+        f"--set {override}: {problem}; expected key.path=value, e.g. --set solver.method=uzawa", key=key_text
+    )
 
 
 def _schema_step(node: dict, segment, container, override: str, path: list) -> dict:
@@ -122,26 +143,35 @@ def _schema_step(node: dict, segment, container, override: str, path: list) -> d
     node = _branch_for(node, str(segment))
     if isinstance(segment, int):
         if not isinstance(container, list) or "items" not in node:
-            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} is not a list; "
-                             f"drop [{segment}]", key=_key(path))
+            raise SceneError(
+                f"--set {override}: {_key(path)} = {_show(container)} is not a list; drop [{segment}]", key=_key(path)
+            )
         if segment >= len(container):
             count = len(container)
             indices = {0: "no index", 1: "the index 0"}.get(count, f"an index 0 ... {count - 1}")
-            raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has {count} "
-                             f"entr{'y' if count == 1 else 'ies'}: give {indices}, or set the whole list, "
-                             f"e.g. --set '{_key(path)}=[...]'", key=_key(path))
+            raise SceneError(
+                f"--set {override}: {_key(path)} = {_show(container)} has {count} "
+                f"entr{'y' if count == 1 else 'ies'}: give {indices}, or set the whole list, "
+                f"e.g. --set '{_key(path)}=[...]'",
+                key=_key(path),
+            )
         return _resolve(node["items"])
     if isinstance(container, list):
-        raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} is a list: index it "
-                         f"({_key(path)}[0]) or set the whole value, e.g. --set '{_key(path)}={{{segment}: ...}}'",
-                         key=_key(path))
+        raise SceneError(
+            f"--set {override}: {_key(path)} = {_show(container)} is a list: index it "
+            f"({_key(path)}[0]) or set the whole value, e.g. --set '{_key(path)}={{{segment}: ...}}'",
+            key=_key(path),
+        )
     if not isinstance(container, dict):
-        raise SceneError(f"--set {override}: {_key(path)} = {_show(container)} has no entry {segment!r}",
-                         key=_key(path))
+        raise SceneError(
+            f"--set {override}: {_key(path)} = {_show(container)} has no entry {segment!r}", key=_key(path)
+        )
     if "properties" in node:
         if segment not in node["properties"]:
-            raise SceneError(f"--set {override}: unknown key {_key([*path, segment])!r}"
-                             f"{_suggest(segment, node['properties'])}", key=_key([*path, segment]))
+            raise SceneError(
+                f"--set {override}: unknown key {_key([*path, segment])!r}{_suggest(segment, node['properties'])}",
+                key=_key([*path, segment]),
+            )
         return _resolve(node["properties"][segment])
     if isinstance(node.get("additionalProperties"), dict):  # a map: side name -> entry
         return _resolve(node["additionalProperties"])
@@ -176,8 +206,7 @@ def _apply_override(data: dict, override: str) -> None:
 def _suggest(word, choices) -> str:
     close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1)
     allowed = ", ".join(str(c) for c in choices)
-    return f" (did you mean {close[0]!r}?); allowed here: {allowed}" if close else \
-        f"; allowed here: {allowed}"
+    return f" (did you mean {close[0]!r}?); allowed here: {allowed}" if close else f"; allowed here: {allowed}"
 
 
 def _scene_fix(key: str | None) -> str:
@@ -186,12 +215,11 @@ def _scene_fix(key: str | None) -> str:
 
 
 def _check_finite(value, path, fix=_scene_fix) -> None:
-    if isinstance(value, (int, float)) and not isinstance(value, bool) and \
-            not abs(value) <= sys.float_info.max:  # nan, inf, ints beyond the float range
-        raise SceneError(f"{_key(path)} = {value}: must be a finite number; {fix(_key(path))}",
-                         key=_key(path))
-    children = value.items() if isinstance(value, dict) else \
-        enumerate(value) if isinstance(value, list) else ()
+    if (
+        isinstance(value, (int, float)) and not isinstance(value, bool) and not abs(value) <= sys.float_info.max
+    ):  # nan, inf, ints beyond the float range
+        raise SceneError(f"{_key(path)} = {value}: must be a finite number; {fix(_key(path))}", key=_key(path))
+    children = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
     for key, child in children:
         _check_finite(child, [*path, key], fix)
 
@@ -237,8 +265,11 @@ def _schema_error_message(error, fix=_scene_fix) -> str:
     if "propertyNames" in error.absolute_schema_path:
         return f"{key}: {_show(value)} is not a side name (letters, digits, _ and -); fix the scene"
     if keyword == "minProperties":
-        return f"{key} = {{}}: {NO_DIRICHLET}" if key == "boundary.dirichlet" else \
-            f"{key} = {{}}: must have at least {error.validator_value} entries; {fix(key)}"
+        return (
+            f"{key} = {{}}: {NO_DIRICHLET}"
+            if key == "boundary.dirichlet"
+            else f"{key} = {{}}: must have at least {error.validator_value} entries; {fix(key)}"
+        )
     if keyword == "additionalProperties":
         allowed = list(schema.get("properties", {}))
         extra = next(k for k in value if k not in allowed)
@@ -248,8 +279,9 @@ def _schema_error_message(error, fix=_scene_fix) -> str:
         title = _resolve(schema["properties"][missing]).get("title", "")
         if _key([*path, missing]) == "boundary.dirichlet":
             return f"boundary.dirichlet is missing: {NO_DIRICHLET}"
-        return f"{_key([*path, missing])} is missing ({title}); add it to the scene or " \
-               f"--set {_key([*path, missing])}=..."
+        return (
+            f"{_key([*path, missing])} is missing ({title}); add it to the scene or --set {_key([*path, missing])}=..."
+        )
     if keyword == "minItems" and key == "boundary.dirichlet":
         return f"boundary.dirichlet = []: {NO_DIRICHLET}"
     if keyword == "pattern" and schema == _validator().schema["$defs"]["side"]:
@@ -261,20 +293,24 @@ def _schema_error_message(error, fix=_scene_fix) -> str:
     elif keyword in ("enum", "const"):
         need = "must be one of " + ", ".join(map(str, bound if keyword == "enum" else [bound]))
     else:
-        need = {"exclusiveMinimum": f"must be > {bound}", "minimum": f"must be >= {bound}",
-                "exclusiveMaximum": f"must be < {bound}", "maximum": f"must be <= {bound}",
-                "minItems": f"must have at least {bound} entries",
-                "maxItems": f"must have at most {bound} entries",
-                "uniqueItems": "lists an entry twice", "minLength": "must not be empty",
-                "maxLength": f"must be at most {bound} characters"}.get(keyword, error.message)
+        need = {
+            "exclusiveMinimum": f"must be > {bound}",
+            "minimum": f"must be >= {bound}",
+            "exclusiveMaximum": f"must be < {bound}",
+            "maximum": f"must be <= {bound}",
+            "minItems": f"must have at least {bound} entries",
+            "maxItems": f"must have at most {bound} entries",
+            "uniqueItems": "lists an entry twice",
+            "minLength": "must not be empty",
+            "maxLength": f"must be at most {bound} characters",
+        }.get(keyword, error.message)
     title = f" ({schema['title']})" if "title" in schema else ""
     return f"{key} = {_show(value)}: {need}{title}; {fix(key)}"
 
 
 def _validate(data) -> None:
     if not isinstance(data, dict):
-        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), "
-                         f"got {_show(data)}")
+        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {_show(data)}")
     _check_finite(data, [])
     errors = list(_validator().iter_errors(data))
     if errors:
@@ -302,16 +338,17 @@ def _normalized(value, node: dict):
     return value
 
 
-
-
 def _check_order_options(discretization: dict) -> None:
     """Options that exist for one order k only are refused at the other; the k = 2 load's default."""
     if discretization["order"] >= 2:  # the cell moments of k >= 2 carry the body force
         discretization.setdefault("body_force_projection", DEFAULT_BODY_FORCE_PROJECTION_K2)
     elif discretization.get("body_force_projection", "p0") != "p0":
-        raise SceneError(f"discretization.body_force_projection = {discretization['body_force_projection']!r} "
-                         "needs discretization.order = 2 (k = 1 loads the cell mean of f1); drop it or set "
-                         "discretization.order=2", key="discretization.body_force_projection")
+        raise SceneError(
+            f"discretization.body_force_projection = {discretization['body_force_projection']!r} "
+            "needs discretization.order = 2 (k = 1 loads the cell mean of f1); drop it or set "
+            "discretization.order=2",
+            key="discretization.body_force_projection",
+        )
 
 
 def _semantic_checks(data: dict, given: dict) -> dict:
@@ -324,8 +361,7 @@ def _semantic_checks(data: dict, given: dict) -> dict:
     _check_order_options(data["discretization"])
     domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
     from_file = "file" in data["discretization"]["mesh"]
-    check_sides(data, None if from_file else
-                 (UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names))
+    check_sides(data, None if from_file else (UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names))
     probed = None if from_file else domain
     check_mesh_resolution(data["discretization"]["mesh"], domain)
     compiled = boundary_expressions(data, probed)
@@ -341,11 +377,13 @@ def _semantic_checks(data: dict, given: dict) -> dict:
 # -- the scene -----------------------------------------------------------------------------------
 def _field(*path, doc: str = "", convert=None):
     """A read-only property for ``scene.data[path[0]][path[1]]...``."""
+
     def get(self):
         value = self._data
         for part in path:
             value = value[part]
         return convert(value) if convert else value
+
     return property(get, doc=doc)
 
 
@@ -392,24 +430,38 @@ class Scene:
     has_contact = _field("boundary", "contact", convert=bool, doc="True if a side is in contact")
     stabilization = _field("discretization", "stabilization")
     contact_quadrature = _field("discretization", "contact_quadrature")
-    contact_gauss_points = _field("discretization", "contact_gauss_points",
-                                  doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)")
+    contact_gauss_points = _field(
+        "discretization",
+        "contact_gauss_points",
+        doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)",
+    )
     order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
     body_force_projection = property(
         lambda self: self._data["discretization"].get("body_force_projection", "p0"),
         doc="the k = 2 load: p1 (the default at order 2: P_1 f1 against Pi_2 v) or p0 (the paper's "
-            "P_0 f1); p0 at order 1, where it is irrelevant")
-    mesh_options = _field("discretization", "mesh", convert=dict,
-                          doc="discretization.mesh: family, n / h / cells (or file) and the family "
-                              "options given (a copy)")
-    solver_options = _field("solver", convert=dict,
-                            doc="solver, defaults filled; rho/eps_u/eps_lambda may be None (a copy)")
-    adaptivity_options = _field("adaptivity", convert=copy.deepcopy,
-                                doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)")
-    body_force = property(lambda self: self._expressions["body_force"],
-                          doc="(Expression, Expression) (3D: three): the volume force f1")
-    gap_expression = property(lambda self: self._expressions.get("contact.gap"),
-                              doc="Expression of the initial gap g_a; None without contact section")
+        "P_0 f1); p0 at order 1, where it is irrelevant",
+    )
+    mesh_options = _field(
+        "discretization",
+        "mesh",
+        convert=dict,
+        doc="discretization.mesh: family, n / h / cells (or file) and the family options given (a copy)",
+    )
+    solver_options = _field(
+        "solver", convert=dict, doc="solver, defaults filled; rho/eps_u/eps_lambda may be None (a copy)"
+    )
+    adaptivity_options = _field(
+        "adaptivity",
+        convert=copy.deepcopy,
+        doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)",
+    )
+    body_force = property(
+        lambda self: self._expressions["body_force"], doc="(Expression, Expression) (3D: three): the volume force f1"
+    )
+    gap_expression = property(
+        lambda self: self._expressions.get("contact.gap"),
+        doc="Expression of the initial gap g_a; None without contact section",
+    )
 
     @property
     def dimension(self) -> int:
@@ -433,8 +485,10 @@ class Scene:
         """The prescribed traction f2 on a Neumann side; KeyError for other sides (and pressure sides)."""
         key = f"boundary.neumann.{side}.traction"
         if key not in self._expressions:
-            raise KeyError(f"{side!r} is not a Neumann side with a traction in this scene "
-                           f"(neumann sides: {', '.join(self.neumann_sides) or 'none'})")
+            raise KeyError(
+                f"{side!r} is not a Neumann side with a traction in this scene "
+                f"(neumann sides: {', '.join(self.neumann_sides) or 'none'})"
+            )
         return self._expressions[key]
 
     def pressure(self, side: str) -> Expression | None:
@@ -468,11 +522,13 @@ class Scene:
         folder = Path(self.source).parent if self.source and not self.source.startswith("<") else Path(".")
         return folder / name
 
-    normal_compliance = property(lambda self: self._contact_law("normal"),
-                                 doc="PowerLaw p_nu(t) = k (t)_+^m; None without contact section")
-    friction_bound = property(lambda self: self._contact_law("friction"),
-                              doc="PowerLaw p_tau(t) = k (t)_+^m (m = 0: the paper's reduced law); "
-                                  "None without contact section")
+    normal_compliance = property(
+        lambda self: self._contact_law("normal"), doc="PowerLaw p_nu(t) = k (t)_+^m; None without contact section"
+    )
+    friction_bound = property(
+        lambda self: self._contact_law("friction"),
+        doc="PowerLaw p_tau(t) = k (t)_+^m (m = 0: the paper's reduced law); None without contact section",
+    )
 
     def _contact_law(self, kind: str) -> PowerLaw | None:
         contact = self._data.get("contact")
@@ -480,8 +536,7 @@ class Scene:
 
     def to_yaml(self) -> str:
         """The full, defaults-filled scene as YAML; loads back to an equal scene."""
-        return yaml.dump(self._data, Dumper=SceneDumper, sort_keys=False,
-                         default_flow_style=None, allow_unicode=True)
+        return yaml.dump(self._data, Dumper=SceneDumper, sort_keys=False, default_flow_style=None, allow_unicode=True)
 
     def with_overrides(self, overrides) -> Scene:
         """A new scene with ``key.path=value`` overrides applied (as ``--set``)."""
@@ -493,8 +548,7 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
     if isinstance(overrides, str):
         overrides = [overrides]
     if not isinstance(data, dict):
-        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), "
-                         f"got {_show(data)}")
+        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {_show(data)}")
     data = copy.deepcopy(data)
     for override in overrides:
         _apply_override(data, override)

@@ -14,9 +14,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.config.boundary_conditions import (MAX_NORMAL_K_OVER_E, PROBES, PlaneProbes, _dirichlet,
-                                               boundary_expressions, check_mesh_size, check_sides, compile_checked,
-                                               evaluate_checked, rigid_motion_error)
+from vemkit.config.boundary_conditions import (
+    MAX_NORMAL_K_OVER_E,
+    PROBES,
+    PlaneProbes,
+    _dirichlet,
+    boundary_expressions,
+    check_mesh_size,
+    check_sides,
+    compile_checked,
+    evaluate_checked,
+    rigid_motion_error,
+)
 from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
@@ -84,37 +93,54 @@ def check_model_domain(data: dict) -> None:
     three_d = is_3d_domain(data["domain"])
     if three_d and data["model"] != "3d":
         kind = "box" if "box" in data["domain"] else "extrude"
-        raise SceneError(f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d "
-                         "(or give a 2D domain)", key="model")
+        raise SceneError(
+            f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d (or give a 2D domain)",
+            key="model",
+        )
     if data["model"] == "3d" and not three_d and "file" not in data["discretization"]["mesh"]:
-        raise SceneError("model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
-                         "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model", key="domain")
+        raise SceneError(
+            "model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
+            "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model",
+            key="domain",
+        )
 
 
 def _refuse_2d_only(data: dict, given: dict) -> None:
     discretization = data["discretization"]
     if discretization["order"] != 1:
-        raise SceneError(f"discretization.order = {discretization['order']}: 3D bodies have the k = 1 element "
-                         "only; set discretization.order=1", key="discretization.order")
+        raise SceneError(
+            f"discretization.order = {discretization['order']}: 3D bodies have the k = 1 element "
+            "only; set discretization.order=1",
+            key="discretization.order",
+        )
     if "body_force_projection" in given.get("discretization", {}):
-        raise SceneError("discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean "
-                         "of f1; drop it", key="discretization.body_force_projection")
+        raise SceneError(
+            "discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean of f1; drop it",
+            key="discretization.body_force_projection",
+        )
     if discretization.get("contact_quadrature", "nodal") != "nodal":
-        raise SceneError(f"discretization.contact_quadrature = {discretization['contact_quadrature']!r}: 3D bodies "
-                         "have the nodal rule at the Gamma_C vertices only; set contact_quadrature: nodal",
-                         key="discretization.contact_quadrature")
+        raise SceneError(
+            f"discretization.contact_quadrature = {discretization['contact_quadrature']!r}: 3D bodies "
+            "have the nodal rule at the Gamma_C vertices only; set contact_quadrature: nodal",
+            key="discretization.contact_quadrature",
+        )
 
 
 def _check_family(mesh: dict, body) -> None:
     family = mesh.get("family")
     valid = BOX_FAMILIES if isinstance(body, Box) else FAMILIES_2D + EXTRUDE_FAMILIES_3D
     if family is not None and family not in valid:
-        what = "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
-        raise SceneError(f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: "
-                         f"{', '.join(valid)}", key="discretization.mesh.family")
+        what = (
+            "a box" if isinstance(body, Box) else "an extrude domain (a 2D family: prisms over the 2D mesh of the base)"
+        )
+        raise SceneError(
+            f"discretization.mesh.family = {family!r} does not mesh {what}; valid families: {', '.join(valid)}",
+            key="discretization.mesh.family",
+        )
     if "layers" in mesh and isinstance(body, Box):
-        raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
-                         key="discretization.mesh.layers")
+        raise SceneError(
+            "discretization.mesh.layers applies to an extrude domain only; remove it", key="discretization.mesh.layers"
+        )
 
 
 def _check_rigid_motions(data: dict, probes: BodyProbes) -> None:
@@ -148,8 +174,10 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
         _check_rigid_motions(data, probes)
     force = data["body_force"]
     if len(force) != DIMENSION:
-        raise SceneError(f"body_force has {len(force)} components; this 3D scene needs 3 ([f1_x, f1_y, f1_z]); "
-                         "fix the scene", key="body_force")
+        raise SceneError(
+            f"body_force has {len(force)} components; this 3D scene needs 3 ([f1_x, f1_y, f1_z]); fix the scene",
+            key="body_force",
+        )
     compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", force[i], DIMENSION) for i in range(3))
     if "contact" in data:
         check_contact_3d(data, given.get("contact", {}), probes, compiled)
@@ -162,14 +190,18 @@ def check_contact_3d(data: dict, given_contact: dict, probes: BodyProbes | None,
     """The contact section of a 3D scene (module docstring); ``probes`` None: a mesh file's body."""
     contact, sides = data["contact"], data["boundary"]["contact"]
     if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
-        raise SceneError(f"contact.normal.k = {contact['normal']['k']:g}: must be at most {MAX_NORMAL_K_OVER_E:g} "
-                         "material.E (stiffer is rigid contact, beyond double precision); fix the scene",
-                         key="contact.normal.k")
+        raise SceneError(
+            f"contact.normal.k = {contact['normal']['k']:g}: must be at most {MAX_NORMAL_K_OVER_E:g} "
+            "material.E (stiffer is rigid contact, beyond double precision); fix the scene",
+            key="contact.normal.k",
+        )
     s = np.linspace(0.0, 1.0, PROBES + 1)
     if "foundation" in contact:
         if "gap" in given_contact:
-            raise SceneError("contact: give either gap or foundation, not both (the foundation plane defines the "
-                             "gap)", key="contact.foundation")
+            raise SceneError(
+                "contact: give either gap or foundation, not both (the foundation plane defines the gap)",
+                key="contact.foundation",
+            )
         _check_plane(contact["foundation"], sides, probes, s)
         return
     gap = compiled["contact.gap"] = compile_checked("contact.gap", contact["gap"], DIMENSION)
@@ -178,27 +210,38 @@ def check_contact_3d(data: dict, given_contact: dict, probes: BodyProbes | None,
         values = np.broadcast_to(evaluate_checked(gap, points), points[0].shape)
         if not values.min() >= 0:
             i = int(np.argmin(np.where(np.isnan(values), -np.inf, values)))
-            raise SceneError(f"contact.gap = {contact['gap']!r}: is {values[i]:.6g} < 0 at x={points[0][i]:.6g}, "
-                             f"y={points[1][i]:.6g}, z={points[2][i]:.6g} on {side} (the initial gap g_a must be "
-                             ">= 0); fix the scene", key="contact.gap")
+            raise SceneError(
+                f"contact.gap = {contact['gap']!r}: is {values[i]:.6g} < 0 at x={points[0][i]:.6g}, "
+                f"y={points[1][i]:.6g}, z={points[2][i]:.6g} on {side} (the initial gap g_a must be "
+                ">= 0); fix the scene",
+                key="contact.gap",
+            )
 
 
 def _check_plane(foundation: dict, sides, probes, s) -> None:
     for key in ("point", "normal"):
         if len(foundation[key]) != DIMENSION:
-            raise SceneError(f"contact.foundation.{key} has {len(foundation[key])} components; a 3D scene's "
-                             "foundation is a plane: give 3", key=f"contact.foundation.{key}")
+            raise SceneError(
+                f"contact.foundation.{key} has {len(foundation[key])} components; a 3D scene's "
+                "foundation is a plane: give 3",
+                key=f"contact.foundation.{key}",
+            )
     normal = np.asarray(foundation["normal"], dtype=float)
     if not np.linalg.norm(normal) > 0:
-        raise SceneError("contact.foundation.normal = [0, 0, 0]: give the plane's normal pointing towards the "
-                         "body, e.g. [0, 0, 1] for a floor", key="contact.foundation.normal")
+        raise SceneError(
+            "contact.foundation.normal = [0, 0, 0]: give the plane's normal pointing towards the "
+            "body, e.g. [0, 0, 1] for a floor",
+            key="contact.foundation.normal",
+        )
     point = np.asarray(foundation["point"], dtype=float)
     for side in sides if probes is not None else ():
         x = np.stack(probes.side(side, s), axis=1)
         distance = (x - point) @ normal / np.linalg.norm(normal)
         if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
             i = int(np.argmin(distance))
-            raise SceneError(f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation plane at "
-                             f"x={x[i, 0]:.6g}, y={x[i, 1]:.6g}, z={x[i, 2]:.6g} (the body starts out penetrating "
-                             "it); move contact.foundation.point or flip contact.foundation.normal",
-                             key="contact.foundation")
+            raise SceneError(
+                f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation plane at "
+                f"x={x[i, 0]:.6g}, y={x[i, 1]:.6g}, z={x[i, 2]:.6g} (the body starts out penetrating "
+                "it); move contact.foundation.point or flip contact.foundation.normal",
+                key="contact.foundation",
+            )

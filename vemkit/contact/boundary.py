@@ -58,8 +58,10 @@ MAX_GAUSS_POINTS = 10
 def gauss_rule(points: int):
     """Gauss-Legendre points and weights on [0, 1] (weights sum to 1), exact for degree 2 points - 1."""
     if not (isinstance(points, (int, np.integer)) and 1 <= points <= MAX_GAUSS_POINTS):
-        raise SceneError(f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to "
-                         f"{MAX_GAUSS_POINTS}", key="discretization.contact_gauss_points")
+        raise SceneError(
+            f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to {MAX_GAUSS_POINTS}",
+            key="discretization.contact_gauss_points",
+        )
     x, w = np.polynomial.legendre.leggauss(int(points))
     return 0.5 * (x + 1.0), 0.5 * w
 
@@ -106,13 +108,18 @@ class ContactBoundary:
 
     def __post_init__(self):
         if self.quadrature not in QUADRATURES:
-            raise SceneError(f"discretization.contact_quadrature = {self.quadrature!r}: use nodal or gauss",
-                             key="discretization.contact_quadrature")
+            raise SceneError(
+                f"discretization.contact_quadrature = {self.quadrature!r}: use nodal or gauss",
+                key="discretization.contact_quadrature",
+            )
         if self.quadrature == "gauss":
             free = self.edge_vertex >= 0
             if not np.array_equal(self.edge_gap[free], self.gap[self.edge_vertex[free]]):
-                raise InputError("the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
-                                 "quadrature: use ContactBoundary.with_gap", key="contact.gap")
+                raise InputError(
+                    "the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
+                    "quadrature: use ContactBoundary.with_gap",
+                    key="contact.gap",
+                )
 
     @property
     def size(self) -> int:
@@ -150,8 +157,11 @@ class ContactBoundary:
             if self.dimension == 2:
                 value = normal_part * self.normal[:, i] + tangential_part * self.tangent[:, i]
             else:
-                value = (normal_part * self.normal[:, i] + tangential_part[:, 0] * self.tangent[:, i]
-                         + tangential_part[:, 1] * self.tangent2[:, i])
+                value = (
+                    normal_part * self.normal[:, i]
+                    + tangential_part[:, 0] * self.tangent[:, i]
+                    + tangential_part[:, 1] * self.tangent2[:, i]
+                )
             if self.fixed is not None:
                 value = np.where(self.fixed[:, i], 0.0, value)
             np.add.at(out, self.dofs[:, i], value)
@@ -268,7 +278,6 @@ class ContactBoundary:
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
 
-
 def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
     """(|e|, |e| nu_e, vertex weights, vertex normal sums) of the contact ``edges`` (a, b), nu_e the
     outward normal (CCW boundary): each end of an edge gets ``end_weight`` |e| (trapezoid 1/2,
@@ -289,9 +298,12 @@ def check_quadrature(space, quadrature: str) -> None:
     if space.element.dimension != 2:
         return  # 3D: ``vemkit.contact.boundary3d`` (nodal only)
     if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
-        raise SceneError(f"discretization.contact_quadrature = {quadrature!r} is not available with "
-                         f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
-                         "midpoints is used); set contact_quadrature: nodal", key="discretization.contact_quadrature")
+        raise SceneError(
+            f"discretization.contact_quadrature = {quadrature!r} is not available with "
+            f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
+            "midpoints is used); set contact_quadrature: nodal",
+            key="discretization.contact_quadrature",
+        )
 
 
 def contact_nodes(dofs, nodes, keep_partial: bool = True) -> np.ndarray:
@@ -355,8 +367,16 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     fixed = fixed_components(dofs, point_dofs)
     if w_mid is not None:  # the Gauss option needs linear traces: no edge data
         return ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed)
-    return _with_edges(ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed),
-                       mesh, edges, dofs, gap, length, weighted_normal, gauss_points)
+    return _with_edges(
+        ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed),
+        mesh,
+        edges,
+        dofs,
+        gap,
+        length,
+        weighted_normal,
+        gauss_points,
+    )
 
 
 def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):
@@ -369,6 +389,14 @@ def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weigh
     edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, cb.gap, edge_normal)
     prescribed = np.einsum("eai,ei->ea", dofs.prescribed_displacement()[edges], edge_normal)
     s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
-    return replace(cb, edge_vertex=edge_vertex, edge_normal=edge_normal, edge_length=length, edge_gap=edge_gap,
-                   edge_coords=edge_coords, gauss_points=s, gauss_weights=w,
-                   edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed))
+    return replace(
+        cb,
+        edge_vertex=edge_vertex,
+        edge_normal=edge_normal,
+        edge_length=length,
+        edge_gap=edge_gap,
+        edge_coords=edge_coords,
+        gauss_points=s,
+        gauss_weights=w,
+        edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed),
+    )

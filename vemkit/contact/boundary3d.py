@@ -73,9 +73,11 @@ def tangent_basis(normal: np.ndarray):
 def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal") -> ContactBoundary:
     """The contact points of the named boundary face sets ``parts`` (module docstring)."""
     if quadrature != "nodal":
-        raise SceneError(f"discretization.contact_quadrature = {quadrature!r} is not available on 3D bodies yet "
-                         "(the nodal rule at the Gamma_C vertices is); set contact_quadrature: nodal",
-                         key="discretization.contact_quadrature")
+        raise SceneError(
+            f"discretization.contact_quadrature = {quadrature!r} is not available on 3D bodies yet "
+            "(the nodal rule at the Gamma_C vertices is); set contact_quadrature: nodal",
+            key="discretization.contact_quadrature",
+        )
     mesh = space.mesh
     faces = contact_faces(mesh, parts)
     ids, face_weight, va = face_vertex_weights(mesh, faces)
@@ -87,5 +89,15 @@ def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal") -> C
     coords = mesh.vertices[verts]
     free = dofs.free_index[verts]
     point_dofs = np.stack([3 * free, 3 * free + 1, 3 * free + 2], axis=1).reshape(-1, 3)
-    return ContactBoundary(verts, point_dofs, weight[verts], normal, t1, _gap_values(gap, coords, normal), coords,
-                           quadrature, tangent2=t2, fixed=fixed_components(dofs, point_dofs))
+    return ContactBoundary(
+        verts,
+        point_dofs,
+        weight[verts],
+        normal,
+        t1,
+        _gap_values(gap, coords, normal),
+        coords,
+        quadrature,
+        tangent2=t2,
+        fixed=fixed_components(dofs, point_dofs),
+    )

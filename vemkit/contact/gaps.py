@@ -38,11 +38,14 @@ def _gap_values(gap, coords, normals, check=True):
         where = f"{g[bad]:.6g} at " + ", ".join(f"{a}={c:.6g}" for a, c in zip("xyz", coords[bad]))
         if isinstance(gap, FoundationLine):
             what = "line" if gap.normal.size == 2 else "plane"
-            raise SceneError(f"contact.foundation: the contact side is beyond the foundation {what} (gap {where}: the "
-                             "body starts out penetrating it); move contact.foundation.point or flip its normal",
-                             key="contact.foundation")
-        raise SceneError(f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}",
-                         key="contact.gap")
+            raise SceneError(
+                f"contact.foundation: the contact side is beyond the foundation {what} (gap {where}: the "
+                "body starts out penetrating it); move contact.foundation.point or flip its normal",
+                key="contact.foundation",
+            )
+        raise SceneError(
+            f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}", key="contact.gap"
+        )
     return g
 
 

@@ -94,8 +94,9 @@ class DiscreteProblem:
 def check_parts(mesh: Mesh, names) -> None:
     for name in names:
         if name not in mesh.boundary:
-            raise SceneError(f"boundary part {name!r} is not in the mesh; parts: {', '.join(sorted(mesh.boundary))}",
-                             key="boundary")
+            raise SceneError(
+                f"boundary part {name!r} is not in the mesh; parts: {', '.join(sorted(mesh.boundary))}", key="boundary"
+            )
 
 
 def constrained(space: VirtualElementSpace, dirichlet) -> DofMap:
@@ -109,8 +110,9 @@ def constrained(space: VirtualElementSpace, dirichlet) -> DofMap:
     return space.constrain(prescribed, values)
 
 
-def problem_load(space: VirtualElementSpace, neumann, pressure, body_force, projection: str, lam: float,
-                 mu: float) -> np.ndarray:
+def problem_load(
+    space: VirtualElementSpace, neumann, pressure, body_force, projection: str, lam: float, mu: float
+) -> np.ndarray:
     """(n_nodes, d) load vector: tractions, normal pressures and the body force (3.16)."""
     f = np.zeros((space.n_nodes, space.element.dimension))
     for name, traction in (neumann or {}).items():
@@ -123,10 +125,23 @@ def problem_load(space: VirtualElementSpace, neumann, pressure, body_force, proj
 
 
 def discrete_problem(
-    mesh: Mesh, E: float, nu: float, *, order: int = 1, dirichlet=("right",), neumann=None, pressure=None,
-    contact=(), gap=lambda x, *_: np.zeros_like(x), law: ContactLaw | None = None, body_force=None,
-    stabilization: str = "dofi-2mu", contact_quadrature: str = "nodal", contact_gauss_points: int = 3,
-    body_force_projection: str | None = None, model: str = "plane_stress",
+    mesh: Mesh,
+    E: float,
+    nu: float,
+    *,
+    order: int = 1,
+    dirichlet=("right",),
+    neumann=None,
+    pressure=None,
+    contact=(),
+    gap=lambda x, *_: np.zeros_like(x),
+    law: ContactLaw | None = None,
+    body_force=None,
+    stabilization: str = "dofi-2mu",
+    contact_quadrature: str = "nodal",
+    contact_gauss_points: int = 3,
+    body_force_projection: str | None = None,
+    model: str = "plane_stress",
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -157,8 +172,9 @@ def discrete_problem(
     K, f = change_variables(K, f, dofs.change)
     K, f = apply_fixed_dofs(K, f, dofs)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
-    return DiscreteProblem(space, dofs, K, f, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization,
-                           interior, model=model)
+    return DiscreteProblem(
+        space, dofs, K, f, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization, interior, model=model
+    )
 
 
 def _scene_gap(scene):
@@ -178,12 +194,21 @@ def scene_problem_data(scene) -> dict:
     normal, friction = scene.normal_compliance, scene.friction_bound
     law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
     pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
-    return dict(order=scene.order, dirichlet=scene.dirichlet, pressure=pressures, contact=scene.contact_sides,
-                gap=_scene_gap(scene), law=law, body_force=body, stabilization=scene.stabilization,
-                neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides
-                         if side not in pressures},
-                contact_quadrature=scene.contact_quadrature, contact_gauss_points=scene.contact_gauss_points,
-                body_force_projection=scene.body_force_projection, model=scene.model)
+    return dict(
+        order=scene.order,
+        dirichlet=scene.dirichlet,
+        pressure=pressures,
+        contact=scene.contact_sides,
+        gap=_scene_gap(scene),
+        law=law,
+        body_force=body,
+        stabilization=scene.stabilization,
+        neumann={side: vector_field(scene.traction(side)) for side in scene.neumann_sides if side not in pressures},
+        contact_quadrature=scene.contact_quadrature,
+        contact_gauss_points=scene.contact_gauss_points,
+        body_force_projection=scene.body_force_projection,
+        model=scene.model,
+    )
 
 
 def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:

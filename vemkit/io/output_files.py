@@ -39,11 +39,14 @@ CREATED: set[str] = set()
 WRITTEN: list[str] = []
 #: in a worker under ``vemkit.io.supervisor``: the pipe to the parent (see :func:`_report`)
 REPORT_FD: int | None = None
-HANDLED_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
-                        if hasattr(signal, name))
-_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-          (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"))
+HANDLED_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+)
 
 
 def _kind(mode: int) -> str:
@@ -76,7 +79,7 @@ def shown(path, limit: int = 80) -> str:
     if len(text) <= limit:
         return text
     tail = max(20, min(len(os.path.basename(text)) + 1, limit - 23))  # the name whole if it fits
-    return text[:limit - 3 - tail] + "..." + text[-tail:]
+    return text[: limit - 3 - tail] + "..." + text[-tail:]
 
 
 def output_target(path, option: str = "-o", inputs=()) -> Path:
@@ -89,22 +92,24 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
     target = Path(os.path.realpath(text))  # follow links: replace what they point to
     name_max, path_max = _limits(str(target.parent) if target.parent.is_dir() else "/")
     if len(os.fsencode(str(target))) >= path_max or len(os.fsencode(target.name)) > name_max - 24:
-        raise OutputError(f"{where}: the path is too long (at most {path_max - 1} bytes, a name "
-                          f"at most {name_max - 24} bytes here); choose a shorter one", key=option)
+        raise OutputError(
+            f"{where}: the path is too long (at most {path_max - 1} bytes, a name "
+            f"at most {name_max - 24} bytes here); choose a shorter one",
+            key=option,
+        )
     for source in inputs:
         if source is not None and same_file(source, target):
-            raise OutputError(f"{where}: this is the input file {shown(source)}; write the output to "
-                              "another path", key=option)
+            raise OutputError(
+                f"{where}: this is the input file {shown(source)}; write the output to another path", key=option
+            )
     try:
         mode = os.stat(target).st_mode
     except FileNotFoundError:
         mode = None
     except OSError as error:  # a path under a file (ENOTDIR), a loop, no permission
-        raise OutputError(f"{where}: cannot use this path ({error.strerror}); choose another",
-                          key=option) from None
+        raise OutputError(f"{where}: cannot use this path ({error.strerror}); choose another", key=option) from None
     if mode is not None and not stat.S_ISREG(mode):
-        raise OutputError(f"{where}: exists and is {_kind(mode)}; give the path of a regular "
-                          "file", key=option)
+        raise OutputError(f"{where}: exists and is {_kind(mode)}; give the path of a regular file", key=option)
     _check_directory(target.parent, where, option)
     _check_replaceable(target, mode, where, option)
     return target
@@ -115,23 +120,24 @@ def _check_directory(directory: Path, where: str, option: str) -> None:
     try:
         mode = os.stat(directory).st_mode
     except FileNotFoundError:
-        raise OutputError(f"{where}: the directory {folder} does not exist; create it first",
-                          key=option) from None
+        raise OutputError(f"{where}: the directory {folder} does not exist; create it first", key=option) from None
     except OSError as error:
-        raise OutputError(f"{where}: cannot use the directory {folder} ({error.strerror}); "
-                          "choose another path", key=option) from None
+        raise OutputError(
+            f"{where}: cannot use the directory {folder} ({error.strerror}); choose another path", key=option
+        ) from None
     if not stat.S_ISDIR(mode):
-        raise OutputError(f"{where}: {folder} is not a directory; choose another path",
-                          key=option)
+        raise OutputError(f"{where}: {folder} is not a directory; choose another path", key=option)
     if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputError(f"{where}: the directory {folder} is not writable; choose another "
-                          "path", key=option)
+        raise OutputError(f"{where}: the directory {folder} is not writable; choose another path", key=option)
     flags = _inode_flags(directory)
     if flags & (FS_APPEND_FL | FS_IMMUTABLE_FL):
         kind = "append-only" if flags & FS_APPEND_FL else "immutable"
-        raise OutputError(f"{where}: the directory {folder} is {kind} (chattr +{kind[0]}): a file "
-                          "made there could not be renamed into place nor removed; choose another "
-                          f"directory or lift it with chattr -{kind[0]}", key=option)
+        raise OutputError(
+            f"{where}: the directory {folder} is {kind} (chattr +{kind[0]}): a file "
+            "made there could not be renamed into place nor removed; choose another "
+            f"directory or lift it with chattr -{kind[0]}",
+            key=option,
+        )
 
 
 #: Linux inode flags (``chattr``): a directory flagged so lets files be created in it but not
@@ -165,14 +171,23 @@ def _check_replaceable(target: Path, mode, where: str, option: str) -> None:
     if mode is None:
         return
     if _inode_flags(target) & (FS_APPEND_FL | FS_IMMUTABLE_FL):
-        raise OutputError(f"{where}: the file is append-only or immutable (chattr); it cannot be "
-                          "replaced: choose another path", key=option)
+        raise OutputError(
+            f"{where}: the file is append-only or immutable (chattr); it cannot be replaced: choose another path",
+            key=option,
+        )
     parent = os.stat(target.parent)
     uid = os.geteuid() if hasattr(os, "geteuid") else None
-    if uid not in (None, 0) and parent.st_mode & stat.S_ISVTX and os.stat(target).st_uid != uid \
-            and parent.st_uid != uid:
-        raise OutputError(f"{where}: the file belongs to another user in a sticky directory; it "
-                          "cannot be replaced: choose another path", key=option)
+    if (
+        uid not in (None, 0)
+        and parent.st_mode & stat.S_ISVTX
+        and os.stat(target).st_uid != uid
+        and parent.st_uid != uid
+    ):
+        raise OutputError(
+            f"{where}: the file belongs to another user in a sticky directory; it "
+            "cannot be replaced: choose another path",
+            key=option,
+        )
 
 
 def _report(record: str) -> None:
@@ -210,8 +225,11 @@ def _writer_path(temporary: Path, keep: list) -> Path:
         return temporary
     except UnicodeEncodeError:
         if not os.path.isdir("/proc/self/fd"):
-            raise OutputError(f"{shown(temporary.parent)}: the directory's name is not UTF-8, which the "
-                              "netCDF library cannot open here; choose another directory", key="-o") from None
+            raise OutputError(
+                f"{shown(temporary.parent)}: the directory's name is not UTF-8, which the "
+                "netCDF library cannot open here; choose another directory",
+                key="-o",
+            ) from None
         fd = os.open(temporary.parent, os.O_RDONLY)
         keep.append(fd)
         return Path(f"/proc/self/fd/{fd}/{temporary.name}")
@@ -265,8 +283,7 @@ def _signals_deferred():
     if threading.current_thread() is not threading.main_thread():
         yield received
         return
-    previous = {s: signal.signal(s, lambda number, _frame: received.append(number))
-                for s in HANDLED_SIGNALS}
+    previous = {s: signal.signal(s, lambda number, _frame: received.append(number)) for s in HANDLED_SIGNALS}
     _report("hold")  # a supervising parent now forwards signals instead of ending this process
     try:
         yield received
@@ -324,9 +341,12 @@ def _left_behind(left, failure) -> None:
     name, reason = left[0]
     written = f"wrote {', '.join(map(shown, WRITTEN))}" if WRITTEN else "nothing was written"
     cause = f" after {failure.strerror or failure}" if isinstance(failure, OSError) else ""
-    raise OutputError(f"could not finish the output{cause}: {written}, and the temporary file "
-                      f"{shown(name)} could not be removed ({reason}); remove it by hand and check the "
-                      "directory's permissions and attributes (lsattr -d)", key="-o")
+    raise OutputError(
+        f"could not finish the output{cause}: {written}, and the temporary file "
+        f"{shown(name)} could not be removed ({reason}); remove it by hand and check the "
+        "directory's permissions and attributes (lsattr -d)",
+        key="-o",
+    )
 
 
 def deliver(number: int) -> None:

@@ -26,9 +26,11 @@ def package_versions(names=VERSIONED_PACKAGES) -> dict:
 def git_commit(path=".") -> str:
     """``git rev-parse HEAD`` of the repository holding ``path`` (with ``-dirty`` if the tracked
     files are modified), or ``"unknown"`` outside a git checkout or without git."""
+
     def git(*args):
-        return subprocess.run(["git", *args], cwd=path, capture_output=True, text=True, timeout=10,
-                              check=True).stdout.strip()
+        return subprocess.run(
+            ["git", *args], cwd=path, capture_output=True, text=True, timeout=10, check=True
+        ).stdout.strip()
 
     try:
         commit = git("rev-parse", "HEAD")

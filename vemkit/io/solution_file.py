@@ -18,8 +18,8 @@ import xarray as xr
 import vemkit
 from vemkit.exceptions import ResultError
 from vemkit.io.output_files import atomic_outputs
-from vemkit.vem.projection import shear_energy_density, stress
 from vemkit.mesh.files import mesh_to_ugrid_dataset, read_ugrid
+from vemkit.vem.projection import shear_energy_density, stress
 
 STATE_MEANINGS = "separated stick slip"
 
@@ -40,10 +40,21 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
     sig = stress(strain, problem.lam, problem.mu)
     ds = mesh_to_ugrid_dataset(mesh)
     node, face = "mesh2d_nNodes", "mesh2d_nFaces"
-    ds["u1"] = (node, u[:, 0], {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
-    ds["u2"] = (node, u[:, 1], {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"})
-    face_attrs = {"mesh": "mesh2d", "location": "face",
-                  "comment": f"cell mean of the strain of the projection Pi_{element_order} (3.8) (constant per cell for k = 1)"}
+    ds["u1"] = (
+        node,
+        u[:, 0],
+        {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"},
+    )
+    ds["u2"] = (
+        node,
+        u[:, 1],
+        {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"},
+    )
+    face_attrs = {
+        "mesh": "mesh2d",
+        "location": "face",
+        "comment": f"cell mean of the strain of the projection Pi_{element_order} (3.8) (constant per cell for k = 1)",
+    }
     for name, values, long_name, units in (
         ("strain_11", strain[:, 0], "strain eps11 of Pi u", "1"),
         ("strain_22", strain[:, 1], "strain eps22 of Pi u", "1"),
@@ -51,8 +62,12 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
         ("stress_11", sig[:, 0], "stress sigma11 = C eps(Pi u)", "daN/mm2"),
         ("stress_22", sig[:, 1], "stress sigma22", "daN/mm2"),
         ("stress_12", sig[:, 2], "stress sigma12", "daN/mm2"),
-        ("shear_energy_density", shear_energy_density(sig, problem.lam, problem.mu, problem.model),
-         "|dev sigma|^2/(4 mu) (Fig. 6)", "daN/mm2"),
+        (
+            "shear_energy_density",
+            shear_energy_density(sig, problem.lam, problem.mu, problem.model),
+            "|dev sigma|^2/(4 mu) (Fig. 6)",
+            "daN/mm2",
+        ),
     ):
         ds[name] = (face, values, dict(face_attrs, long_name=long_name, units=units))
 
@@ -77,8 +92,13 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
         ):
             ds[name] = (c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
         ds["contact_state"] = (
-            c, np.asarray(st.state, dtype=np.int8)[order],
-            {"long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS},
+            c,
+            np.asarray(st.state, dtype=np.int8)[order],
+            {
+                "long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)",
+                "flag_values": np.array([0, 1, 2], np.int8),
+                "flag_meanings": STATE_MEANINGS,
+            },
         )
     if len(problem.space.element.layout) > 1:
         _add_node_fields(ds, problem, solution)
@@ -123,18 +143,34 @@ def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
     for entity in (e for e in space.element.layout if e != "vertex"):
         dimension, suffix, location = ENTITY_VARIABLES[entity]
         for c in (1, 2):
-            ds[f"u{c}_{suffix}"] = (dimension, values[space.node_range(entity), c - 1], {
-                "long_name": f"mean of u{c} over the {'cell' if entity == 'cell' else entity} "
-                             f"(k = {space.order} degree of freedom)", "units": "mm", "mesh": "mesh2d", "location": location})
+            ds[f"u{c}_{suffix}"] = (
+                dimension,
+                values[space.node_range(entity), c - 1],
+                {
+                    "long_name": f"mean of u{c} over the {'cell' if entity == 'cell' else entity} "
+                    f"(k = {space.order} degree of freedom)",
+                    "units": "mm",
+                    "mesh": "mesh2d",
+                    "location": location,
+                },
+            )
     cb = problem.contact
     if cb.size and "edge" in space.element.layout:
         nv = problem.mesh.n_vertices
         node = cb.vertices[np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))]
-        ds["contact_vertex"] = ("contact_node", np.where(node < nv, node, -1), {
-            "long_name": "mesh2d node index of the contact vertex (-1: an edge midpoint)"})
-        ds["contact_edge"] = ("contact_node", np.where(node < nv, -1, node - nv), {
-            "long_name": "mesh2d edge index of the contact edge midpoint (-1: a vertex)"})
-        ds["contact_weight"].attrs["long_name"] = "Simpson quadrature weight on Gamma_C (|e|/6 at vertices, 4|e|/6 at midpoints)"
+        ds["contact_vertex"] = (
+            "contact_node",
+            np.where(node < nv, node, -1),
+            {"long_name": "mesh2d node index of the contact vertex (-1: an edge midpoint)"},
+        )
+        ds["contact_edge"] = (
+            "contact_node",
+            np.where(node < nv, -1, node - nv),
+            {"long_name": "mesh2d edge index of the contact edge midpoint (-1: a vertex)"},
+        )
+        ds["contact_weight"].attrs["long_name"] = (
+            "Simpson quadrature weight on Gamma_C (|e|/6 at vertices, 4|e|/6 at midpoints)"
+        )
 
 
 def check_finite(ds: xr.Dataset, what: str = "result") -> None:

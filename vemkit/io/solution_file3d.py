@@ -39,25 +39,39 @@ def solution_dataset3d(problem, solution, *, scene_yaml: str = "", extra_attrs=N
     ds = mesh3d_to_dataset(problem.mesh)
     node, volume = f"{TOPOLOGY}_nNodes", f"{TOPOLOGY}_nVolumes"
     for c, axis in enumerate(AXES):
-        ds[f"u{c + 1}"] = (node, u[:, c], {"long_name": f"displacement along {axis}", "units": "mm",
-                                            "mesh": TOPOLOGY, "location": "node"})
-    cell = {"mesh": TOPOLOGY, "location": "volume",
-            "comment": "of the projection Pi_1 (3.8): constant per cell (k = 1)"}
+        ds[f"u{c + 1}"] = (
+            node,
+            u[:, c],
+            {"long_name": f"displacement along {axis}", "units": "mm", "mesh": TOPOLOGY, "location": "node"},
+        )
+    cell = {
+        "mesh": TOPOLOGY,
+        "location": "volume",
+        "comment": "of the projection Pi_1 (3.8): constant per cell (k = 1)",
+    }
     for k, ij in enumerate(COMPONENTS_3D):
         ds[f"strain_{ij}"] = (volume, strain[:, k], dict(cell, long_name=f"strain eps{ij} of Pi u", units="1"))
     for k, ij in enumerate(COMPONENTS_3D):
-        ds[f"stress_{ij}"] = (volume, sigma[:, k], dict(cell, long_name=f"stress sigma{ij} = C eps(Pi u)",
-                                                         units="daN/mm2"))
-    ds["von_mises"] = (volume, von_mises(sigma), dict(cell, long_name="von Mises stress sqrt(3/2 |dev sigma|^2)",
-                                                       units="daN/mm2"))
+        ds[f"stress_{ij}"] = (
+            volume,
+            sigma[:, k],
+            dict(cell, long_name=f"stress sigma{ij} = C eps(Pi u)", units="daN/mm2"),
+        )
+    ds["von_mises"] = (
+        volume,
+        von_mises(sigma),
+        dict(cell, long_name="von Mises stress sqrt(3/2 |dev sigma|^2)", units="daN/mm2"),
+    )
     if problem.contact.size:
         ds = _with_contact(ds, problem, solution)
     return with_solver_record(ds, problem, solution, scene_yaml, extra_attrs)
 
 
-TANGENT_BASIS = ("tangential quantities (dimension contact_tangent) are the components along the per-vertex "
-                 "orthonormal basis (contact_tangent1, contact_tangent2): t1 = e x nu / |e x nu| with e the "
-                 "coordinate axis least aligned with the outward normal nu (first on ties), t2 = nu x t1")
+TANGENT_BASIS = (
+    "tangential quantities (dimension contact_tangent) are the components along the per-vertex "
+    "orthonormal basis (contact_tangent1, contact_tangent2): t1 = e x nu / |e x nu| with e the "
+    "coordinate axis least aligned with the outward normal nu (first on ties), t2 = nu x t1"
+)
 
 
 def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
@@ -69,11 +83,18 @@ def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
     st = contact_state(problem, solution.u, solution.multiplier)
     order = np.lexsort((cb.coords[:, 2], cb.coords[:, 1], cb.coords[:, 0]))
     c, t = "contact_node", "contact_tangent"
-    ds = ds.assign_coords({f"contact_{a}": (c, cb.coords[order, k], {"long_name": f"{a} of contact vertex",
-                                                                       "units": "mm"}) for k, a in enumerate(AXES)})
+    ds = ds.assign_coords(
+        {
+            f"contact_{a}": (c, cb.coords[order, k], {"long_name": f"{a} of contact vertex", "units": "mm"})
+            for k, a in enumerate(AXES)
+        }
+    )
     ds["contact_vertex"] = (c, cb.vertices[order], {"long_name": "mesh3d node index of the contact vertex"})
-    ds["contact_weight"] = (c, cb.weight[order], {"long_name": "nodal weight on Gamma_C: sum over its faces of "
-                                                                "int_F Pi^F phi_i ds", "units": "mm2"})
+    ds["contact_weight"] = (
+        c,
+        cb.weight[order],
+        {"long_name": "nodal weight on Gamma_C: sum over its faces of int_F Pi^F phi_i ds", "units": "mm2"},
+    )
     for name, values, long_name, units in (
         ("normal_pressure", st.normal_pressure, "p_nu(u_nu - g_a) (2.6)", "daN/mm2"),
         ("friction_bound", st.friction_bound, "p_tau(u_nu - g_a)", "daN/mm2"),
@@ -88,10 +109,19 @@ def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
         ds[name] = ((c, t), np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
     for name, vectors in (("normal", cb.normal), ("tangent1", cb.tangent), ("tangent2", cb.tangent2)):
         for k, a in enumerate(AXES):
-            ds[f"contact_{name}_{a}"] = (c, vectors[order, k], {"long_name": f"{a} component of the unit "
-                                                                f"{'outward normal nu' if name == 'normal' else name}"})
-    ds["contact_state"] = (c, np.asarray(st.state, dtype=np.int8)[order], {
-        "long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)",
-        "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": STATE_MEANINGS})
+            ds[f"contact_{name}_{a}"] = (
+                c,
+                vectors[order, k],
+                {"long_name": f"{a} component of the unit {'outward normal nu' if name == 'normal' else name}"},
+            )
+    ds["contact_state"] = (
+        c,
+        np.asarray(st.state, dtype=np.int8)[order],
+        {
+            "long_name": "contact state (separated: u_nu <= g_a; stick: u_tau = 0; slip)",
+            "flag_values": np.array([0, 1, 2], np.int8),
+            "flag_meanings": STATE_MEANINGS,
+        },
+    )
     ds.attrs["contact_tangent_basis"] = TANGENT_BASIS
     return ds

@@ -146,8 +146,9 @@ class _Supervisor:
                 os.unlink(name)
             except OSError:
                 pass
-        done = f"; wrote {', '.join(map(output_files.shown, self.done))} before it" if self.done \
-            else "; no output written"
+        done = (
+            f"; wrote {', '.join(map(output_files.shown, self.done))} before it" if self.done else "; no output written"
+        )
         try:
             os.write(2, f"vemkit: {what}{done}\n".encode("utf-8", "backslashreplace"))
         finally:
@@ -167,8 +168,11 @@ class _Supervisor:
         self.drain()
         if os.WIFSIGNALED(status):  # killed from outside (the out-of-memory killer, kill -9)
             number = os.WTERMSIG(status)
-            self._finish(number, f"error: the run was ended by {signal.Signals(number).name} from outside "
-                                 "vemkit (e.g. the system ran out of memory)")
+            self._finish(
+                number,
+                f"error: the run was ended by {signal.Signals(number).name} from outside "
+                "vemkit (e.g. the system ran out of memory)",
+            )
         code = os.waitstatus_to_exitcode(status)
         if code == 0 and self.forwarded is not None:  # the signal came as the worker finished
             self._finish(self.forwarded, f"interrupted by {signal.Signals(self.forwarded).name}")

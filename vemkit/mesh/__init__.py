@@ -8,8 +8,8 @@ centroid, point binning) and mesh files (``files``: UGRID netCDF, gmsh .msh, VTU
 Imports from vemkit: ``exceptions`` and ``config`` only.
 """
 
-from vemkit.mesh.mesh import Mesh, from_polygons
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import build_mesh
+from vemkit.mesh.mesh import Mesh, from_polygons
 
 __all__ = ["Mesh", "build_mesh", "from_polygons", "validate_mesh"]

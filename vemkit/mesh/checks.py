@@ -102,9 +102,7 @@ def _check_cells(mesh: Mesh) -> None:
     cw = np.flatnonzero(area < 0)
     if cw.size:
         k = int(cw[0])
-        raise MeshError(
-            f"cell {k} is clockwise (signed area {area[k]:.3g}); list its vertices counter-clockwise"
-        )
+        raise MeshError(f"cell {k} is clockwise (signed area {area[k]:.3g}); list its vertices counter-clockwise")
 
 
 @numba.njit(cache=True)
@@ -408,4 +406,3 @@ def _check_boundary_parts(mesh: Mesh) -> None:
                     f"boundary part '{name}' edge ({a}, {b}) runs clockwise; list it as ({b}, {a}) (counter-clockwise)"
                 )
             raise MeshError(f"boundary part '{name}' edge ({a}, {b}) is not a boundary edge of the mesh")
-

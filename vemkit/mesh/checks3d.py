@@ -37,8 +37,9 @@ PLANARITY_TOL = 1e-8
 DEGENERATE_TOL = 1e-12
 
 
-def validate_mesh3d(mesh: PolyhedralMesh, tol: float = 1e-12, planarity: float = PLANARITY_TOL,
-                    require_named: bool = True) -> None:
+def validate_mesh3d(
+    mesh: PolyhedralMesh, tol: float = 1e-12, planarity: float = PLANARITY_TOL, require_named: bool = True
+) -> None:
     """Raise ``MeshError`` for the first defect found (module doc); ``tol`` is relative to the mesh extent."""
     _check_arrays(mesh)
     _check_face_use(mesh)
@@ -64,13 +65,17 @@ def _csr(offsets, values, what, item, count, least):
     small = np.flatnonzero(sizes < least)
     if small.size:
         k = int(small[0])
-        raise MeshError(f"{item} {k} has {sizes[k]} {'vertices' if item == 'face' else 'faces'}; a "
-                        f"{'polygon' if item == 'face' else 'polyhedron'} needs at least {least}")
+        raise MeshError(
+            f"{item} {k} has {sizes[k]} {'vertices' if item == 'face' else 'faces'}; a "
+            f"{'polygon' if item == 'face' else 'polyhedron'} needs at least {least}"
+        )
     out = np.flatnonzero((values < -count if item == "cell" else values < 0) | (values >= count))
     if out.size:
         k = int(np.searchsorted(offsets, out[0], side="right") - 1)
-        raise MeshError(f"{item} {k} refers to {'face' if item == 'cell' else 'vertex'} {values[out[0]]} but there are "
-                        f"{count}; fix its list")
+        raise MeshError(
+            f"{item} {k} refers to {'face' if item == 'cell' else 'vertex'} {values[out[0]]} but there are "
+            f"{count}; fix its list"
+        )
 
 
 def _first_repeat(offsets, values):
@@ -110,8 +115,9 @@ def _check_face_use(mesh: PolyhedralMesh) -> None:
     crowded = np.flatnonzero(uses > 2)
     if crowded.size:
         f = int(crowded[0])
-        raise MeshError(f"face {f} belongs to {uses[f]} cells {cells[faces == f].tolist()}; a face is shared by at "
-                        "most 2 cells")
+        raise MeshError(
+            f"face {f} belongs to {uses[f]} cells {cells[faces == f].tolist()}; a face is shared by at most 2 cells"
+        )
     unused = np.flatnonzero(uses == 0)
     if unused.size:
         raise MeshError(f"face {unused[0]} belongs to no cell; remove it (and renumber)")
@@ -121,8 +127,10 @@ def _check_face_use(mesh: PolyhedralMesh) -> None:
         f = int(same[0])
         owners = cells[faces == f].tolist()
         way = "as stored" if forward[f] == 2 else "reversed"
-        raise MeshError(f"face {f} is used {way} by both its cells {owners}; a shared face points out of one cell and "
-                        "into the other (one of the cells is inside out)")
+        raise MeshError(
+            f"face {f} is used {way} by both its cells {owners}; a shared face points out of one cell and "
+            "into the other (one of the cells is inside out)"
+        )
 
 
 def _check_faces(mesh: PolyhedralMesh, planarity: float) -> None:
@@ -138,8 +146,9 @@ def _check_faces(mesh: PolyhedralMesh, planarity: float) -> None:
     flat = np.flatnonzero(area <= DEGENERATE_TOL * diameter**2)
     if flat.size:
         f = int(flat[0])
-        raise MeshError(f"face {f} has zero area (its vertices are collinear or coincide); remove it or fix its "
-                        "vertices")
+        raise MeshError(
+            f"face {f} has zero area (its vertices are collinear or coincide); remove it or fix its vertices"
+        )
     unit = va / area[:, None]
     off = np.abs(np.einsum("ij,ij->i", p - centre[owner], unit[owner]))
     worst = np.zeros(mesh.n_faces)
@@ -147,8 +156,10 @@ def _check_faces(mesh: PolyhedralMesh, planarity: float) -> None:
     bent = np.flatnonzero(worst > planarity * diameter)
     if bent.size:
         f = int(bent[0])
-        raise MeshError(f"face {f} is not planar: a vertex lies {worst[f] / diameter[f]:.2e} x its diameter off its "
-                        f"plane (tolerance {planarity:.0e}); split it into planar faces")
+        raise MeshError(
+            f"face {f} is not planar: a vertex lies {worst[f] / diameter[f]:.2e} x its diameter off its "
+            f"plane (tolerance {planarity:.0e}); split it into planar faces"
+        )
 
 
 def _check_closed(mesh: PolyhedralMesh) -> None:
@@ -179,11 +190,15 @@ def _check_closed(mesh: PolyhedralMesh) -> None:
         i = starts[bad[0]]
         c, x, y = (int(t) for t in key[i])
         if count[bad[0]] != 2:
-            raise MeshError(f"cell {c} is not closed: its edge ({x}, {y}) belongs to {count[bad[0]]} of its faces "
-                            "instead of 2 (a missing face, or a neighbour's hanging node missing from this cell's "
-                            "faces)")
-        raise MeshError(f"cell {c} is not consistently oriented: its two faces at edge ({x}, {y}) run along it in the "
-                        "same direction; reverse one of them (cells list their faces outward)")
+            raise MeshError(
+                f"cell {c} is not closed: its edge ({x}, {y}) belongs to {count[bad[0]]} of its faces "
+                "instead of 2 (a missing face, or a neighbour's hanging node missing from this cell's "
+                "faces)"
+            )
+        raise MeshError(
+            f"cell {c} is not consistently oriented: its two faces at edge ({x}, {y}) run along it in the "
+            "same direction; reverse one of them (cells list their faces outward)"
+        )
 
 
 def _check_volumes(mesh: PolyhedralMesh) -> None:
@@ -195,8 +210,10 @@ def _check_volumes(mesh: PolyhedralMesh) -> None:
     inward = np.flatnonzero(vol < 0)
     if inward.size:
         c = int(inward[0])
-        raise MeshError(f"cell {c} is inside out (volume {vol[c]:.3g} < 0 by the divergence theorem); list its faces "
-                        "outward (flip every sign in its face list)")
+        raise MeshError(
+            f"cell {c} is inside out (volume {vol[c]:.3g} < 0 by the divergence theorem); list its faces "
+            "outward (flip every sign in its face list)"
+        )
 
 
 def _check_vertices(mesh: PolyhedralMesh, tol: float) -> None:
@@ -227,8 +244,10 @@ def _check_boundary(mesh: PolyhedralMesh, require_named: bool) -> None:
             raise MeshError(f"boundary part '{name}' refers to face {out[0]} but there are {mesh.n_faces} faces")
         inner = part[~is_boundary[part]]
         if inner.size:
-            raise MeshError(f"boundary part '{name}' face {inner[0]} is not a boundary face (two cells share it); "
-                            "remove it from the part")
+            raise MeshError(
+                f"boundary part '{name}' face {inner[0]} is not a boundary face (two cells share it); "
+                "remove it from the part"
+            )
         twice = part[owner[part] >= 0]
         if twice.size or np.unique(part).size != part.size:
             f = int(twice[0]) if twice.size else int(part[np.flatnonzero(np.diff(np.sort(part)) == 0)[0]])
@@ -239,5 +258,7 @@ def _check_boundary(mesh: PolyhedralMesh, require_named: bool) -> None:
         rest = unnamed_boundary_faces(mesh)
         if rest.size:
             where = tuple(np.round(mesh.face_centroids[rest[0]], 12).tolist())
-            raise MeshError(f"{rest.size} boundary faces carry no side name (first: face {rest[0]}, centroid {where}); "
-                            "name them in a boundary part")
+            raise MeshError(
+                f"{rest.size} boundary faces carry no side name (first: face {rest[0]}, centroid {where}); "
+                "name them in a boundary part"
+            )

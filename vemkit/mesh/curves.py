@@ -39,14 +39,18 @@ def domain_curves(domain_spec) -> list:
             pieces.append({"side": domain.sides[i], "segment": [list(a), list(b)]})
         else:
             r, t0, dt = arc_angles(a, b, centre)
-            pieces.append({"side": domain.sides[i], "circle": [float(centre[0]), float(centre[1]), r], "sweep": [t0, dt]})
+            pieces.append(
+                {"side": domain.sides[i], "circle": [float(centre[0]), float(centre[1]), r], "sweep": [t0, dt]}
+            )
     for hole in domain.holes:
         if isinstance(hole, CircleHole):
             pieces.append({"side": hole.side, "circle": [hole.cx, hole.cy, hole.r], "sweep": None})
             continue
         m = len(hole.polygon)
-        pieces += [{"side": hole.sides[j], "segment": [list(hole.polygon[j]), list(hole.polygon[(j + 1) % m])]}
-                   for j in range(m)]
+        pieces += [
+            {"side": hole.sides[j], "segment": [list(hole.polygon[j]), list(hole.polygon[(j + 1) % m])]}
+            for j in range(m)
+        ]
     return pieces
 
 
@@ -68,8 +72,9 @@ def _arc_distance(points: np.ndarray, piece: dict) -> np.ndarray:
     t0, dt = piece["sweep"]
     angle = np.arctan2(points[:, 1] - cy, points[:, 0] - cx)
     s = np.remainder((angle - t0) * math.copysign(1.0, dt), 2.0 * math.pi) / abs(dt)
-    ends = np.array([[cx + r * math.cos(t0), cy + r * math.sin(t0)],
-                     [cx + r * math.cos(t0 + dt), cy + r * math.sin(t0 + dt)]])
+    ends = np.array(
+        [[cx + r * math.cos(t0), cy + r * math.sin(t0)], [cx + r * math.cos(t0 + dt), cy + r * math.sin(t0 + dt)]]
+    )
     to_ends = np.min(np.hypot(points[:, None, 0] - ends[None, :, 0], points[:, None, 1] - ends[None, :, 1]), axis=1)
     return np.where(s <= 1.0, radial, to_ends)
 

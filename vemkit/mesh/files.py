@@ -42,8 +42,8 @@ from vemkit.config.limits import check_resources, estimate_resources, memory_bud
 from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.mesh.gmsh_errors import gmsh_read_error, meshio_warnings
 from vemkit.mesh.geometry import counter_clockwise
+from vemkit.mesh.gmsh_errors import gmsh_read_error, meshio_warnings
 from vemkit.mesh.mesh import Mesh
 
 TOPOLOGY = "mesh2d"
@@ -63,8 +63,12 @@ def padded_face_nodes(mesh: Mesh, fill_value: int = FILL_VALUE) -> np.ndarray:
 def mesh_to_ugrid_dataset(mesh: Mesh) -> xr.Dataset:
     """The mesh as a UGRID-1.0 ``xarray.Dataset`` (see the module docstring), ready to take node or face data."""
     grid = xugrid.Ugrid2d(
-        mesh.vertices[:, 0], mesh.vertices[:, 1], FILL_VALUE, padded_face_nodes(mesh),
-        name=TOPOLOGY, edge_node_connectivity=mesh.edges,
+        mesh.vertices[:, 0],
+        mesh.vertices[:, 1],
+        FILL_VALUE,
+        padded_face_nodes(mesh),
+        name=TOPOLOGY,
+        edge_node_connectivity=mesh.edges,
     )
     ds = grid.to_dataset()
     names = list(mesh.boundary)
@@ -72,9 +76,13 @@ def mesh_to_ugrid_dataset(mesh: Mesh) -> xr.Dataset:
         if not SIDE_NAME.fullmatch(name):
             raise ValueError(f"boundary part name {name!r}: use letters, digits, _ and - only")
         ds[f"boundary_{name}"] = xr.DataArray(
-            mesh.boundary[name], dims=(f"boundary_{name}_nEdges", "two"),
-            attrs={"long_name": f"boundary part {name}: edges as vertex pairs, counter-clockwise",
-                   "start_index": 0, "mesh": TOPOLOGY},
+            mesh.boundary[name],
+            dims=(f"boundary_{name}_nEdges", "two"),
+            attrs={
+                "long_name": f"boundary part {name}: edges as vertex pairs, counter-clockwise",
+                "start_index": 0,
+                "mesh": TOPOLOGY,
+            },
         )
     ds[TOPOLOGY].attrs["vemkit_boundary_parts"] = json.dumps(names)
     ds[TOPOLOGY].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=json_scalar)
@@ -109,8 +117,10 @@ def read_ugrid(path) -> Mesh:
         except ValueError:
             meta = None
     if not isinstance(meta, dict):
-        raise MeshError(f"{Path(path).name}: the attribute vemkit_meta must be a JSON mapping (text); fix or remove it",
-                        key=str(path))
+        raise MeshError(
+            f"{Path(path).name}: the attribute vemkit_meta must be a JSON mapping (text); fix or remove it",
+            key=str(path),
+        )
     valid = table != fill
     sizes = valid.sum(axis=1)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
@@ -176,8 +186,9 @@ def read_mesh(path) -> Mesh:
     size (a node tag of 10^10 in a small file would otherwise make meshio allocate gigabytes)."""
     path = Path(path)
     header = mesh_file_header(path)
-    check_resources(estimate_resources(header.cells, header.vertices), None, what=f"the mesh file {path.name}",
-                    fix="a coarser mesh")
+    check_resources(
+        estimate_resources(header.cells, header.vertices), None, what=f"the mesh file {path.name}", fix="a coarser mesh"
+    )
     kind = MESH_SUFFIXES[path.suffix]
     try:
         with memory_budget(READ_BASE_BYTES + READ_BYTES_PER_FILE_BYTE * header.size):
@@ -185,13 +196,16 @@ def read_mesh(path) -> Mesh:
     except MeshError:
         raise
     except MemoryError:
-        raise MeshError(f"{path.name}: cannot be read as {kind}: reading it needs far more memory than a mesh of "
-                        f"{header.vertices:,} nodes (a node number or count beyond what the file holds)",
-                        key=str(path)) from None
+        raise MeshError(
+            f"{path.name}: cannot be read as {kind}: reading it needs far more memory than a mesh of "
+            f"{header.vertices:,} nodes (a node number or count beyond what the file holds)",
+            key=str(path),
+        ) from None
     except Exception as error:  # a file the reader cannot parse: say which and why, in one line
         reason = " ".join(str(error).split())
-        raise MeshError(f"{path.name}: cannot be read as {kind}: {reason[:200] or type(error).__name__}",
-                        key=str(path)) from None
+        raise MeshError(
+            f"{path.name}: cannot be read as {kind}: {reason[:200] or type(error).__name__}", key=str(path)
+        ) from None
     _check_precision(mesh, path)
     try:
         validate_mesh(mesh)
@@ -205,8 +219,14 @@ def _check_precision(mesh: Mesh, path: Path) -> None:
     (a unit square at x = 1e9: its shoelace area is rounding noise): refused naming the file when the
     ratio passes ``MAX_FILE_COORDINATE_OVER_EDGE`` (a plate at 1e6 still solves to 15 digits)."""
     v, refs = mesh.vertices, mesh.cell_vertices
-    if v.size == 0 or refs.size == 0 or not np.isfinite(v).all() or refs.min() < 0 or refs.max() >= v.shape[0] \
-            or mesh.cell_sizes.min() < 3:
+    if (
+        v.size == 0
+        or refs.size == 0
+        or not np.isfinite(v).all()
+        or refs.min() < 0
+        or refs.max() >= v.shape[0]
+        or mesh.cell_sizes.min() < 3
+    ):
         return  # validate_mesh names the vertex or the cell
     half = mesh.half_edges
     length = np.hypot(*(v[half[:, 1]] - v[half[:, 0]]).T)
@@ -215,9 +235,12 @@ def _check_precision(mesh: Mesh, path: Path) -> None:
     worst = int(np.argmax(ratio))
     if ratio[worst] > MAX_FILE_COORDINATE_OVER_EDGE:
         a, b = half[worst]
-        raise MeshError(f"{path.name}: edge ({a}, {b}) is {length[worst]:.3g} long at |x|, |y| = {reach[worst]:.3g}, more "
-                        f"than {MAX_FILE_COORDINATE_OVER_EDGE:.0e} times shorter than its distance from the origin: too "
-                        "small for double precision there; shift the mesh near the origin", key=str(path))
+        raise MeshError(
+            f"{path.name}: edge ({a}, {b}) is {length[worst]:.3g} long at |x|, |y| = {reach[worst]:.3g}, more "
+            f"than {MAX_FILE_COORDINATE_OVER_EDGE:.0e} times shorter than its distance from the origin: too "
+            "small for double precision there; shift the mesh near the origin",
+            key=str(path),
+        )
 
 
 def read_gmsh(path) -> Mesh:
@@ -226,22 +249,30 @@ def read_gmsh(path) -> Mesh:
     data = _meshio_gmsh(path)
     if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
         v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
-        raise MeshError(f"{path.name}: node {v} (counting from 0) has z = {data.points[v, 2]:g}; give a plane mesh "
-                        "(z = 0)", key=str(path))
+        raise MeshError(
+            f"{path.name}: node {v} (counting from 0) has z = {data.points[v, 2]:g}; give a plane mesh (z = 0)",
+            key=str(path),
+        )
     polygons, lines, line_tags = [], [], []
     physical = data.cell_data.get("gmsh:physical", [None] * len(data.cells))
     for block, tags in zip(data.cells, physical):
         if block.dim == 2:
             if block.type not in _GMSH_CELLS:
-                raise MeshError(f"{path.name}: element type {block.type!r} is not supported; give linear triangles or "
-                                "quadrilaterals", key=str(path))
+                raise MeshError(
+                    f"{path.name}: element type {block.type!r} is not supported; give linear triangles or "
+                    "quadrilaterals",
+                    key=str(path),
+                )
             polygons.append(np.asarray(block.data, dtype=np.int64))
         elif block.type == "line":
             lines.append(np.asarray(block.data, dtype=np.int64))
             line_tags.append(np.zeros(len(block.data), np.int64) if tags is None else np.asarray(tags, np.int64))
         elif block.dim != 0:
-            raise MeshError(f"{path.name}: element type {block.type!r} ({block.dim}D) is not supported; give a plane "
-                            "mesh of linear triangles and quadrilaterals with linear lines", key=str(path))
+            raise MeshError(
+                f"{path.name}: element type {block.type!r} ({block.dim}D) is not supported; give a plane "
+                "mesh of linear triangles and quadrilaterals with linear lines",
+                key=str(path),
+            )
     if not polygons:
         raise MeshError(f"{path.name}: no triangles or quadrilaterals in the file", key=str(path))
     sizes = np.concatenate([np.full(len(p), p.shape[1]) for p in polygons])
@@ -251,14 +282,22 @@ def read_gmsh(path) -> Mesh:
     renumber = np.cumsum(used) - 1
     vertices = np.asarray(data.points[used, :2], dtype=np.float64)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    mesh = Mesh(vertices, offsets, counter_clockwise(vertices, offsets, renumber[refs]), {},
-                {"file": path.name, "format": "gmsh"})
+    mesh = Mesh(
+        vertices,
+        offsets,
+        counter_clockwise(vertices, offsets, renumber[refs]),
+        {},
+        {"file": path.name, "format": "gmsh"},
+    )
     names = {int(tag): name for name, (tag, dim) in data.field_data.items() if int(dim) == 1}
     if lines:
         lines = np.concatenate(lines)
         if not used[lines].all():
-            raise MeshError(f"{path.name}: a line element uses node {int(lines[~used[lines]][0])} (counting from 0), "
-                            "which no cell uses; tag boundary lines of the mesh only", key=str(path))
+            raise MeshError(
+                f"{path.name}: a line element uses node {int(lines[~used[lines]][0])} (counting from 0), "
+                "which no cell uses; tag boundary lines of the mesh only",
+                key=str(path),
+            )
         return mesh.with_boundary(**_gmsh_sides(mesh, renumber[lines], np.concatenate(line_tags), names, path))
     return mesh.with_boundary(untagged=mesh.boundary_edges)
 
@@ -290,14 +329,18 @@ def _gmsh_sides(mesh: Mesh, lines: np.ndarray, tags: np.ndarray, names: dict, pa
     edge = np.array([forward.get(int(a) * n + int(b), backward.get(int(a) * n + int(b), -1)) for a, b in lines])
     if (edge < 0).any():
         a, b = lines[edge < 0][0]
-        raise MeshError(f"{path.name}: line element ({a}, {b}) of physical group {tags[edge < 0][0]} is not a boundary "
-                        "edge of the mesh; tag boundary lines only", key=str(path))
+        raise MeshError(
+            f"{path.name}: line element ({a}, {b}) of physical group {tags[edge < 0][0]} is not a boundary "
+            "edge of the mesh; tag boundary lines only",
+            key=str(path),
+        )
     parts = {}
     for tag in dict.fromkeys(tags.tolist()):
         name = names.get(tag, str(tag)) if tag else "untagged"
         if not SIDE_NAME.fullmatch(name):
-            raise MeshError(f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ and -",
-                            key=str(path))
+            raise MeshError(
+                f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ and -", key=str(path)
+            )
         parts[name] = be[np.unique(edge[tags == tag])]
     rest = np.setdiff1d(np.arange(be.shape[0]), edge)
     if rest.size:

@@ -54,21 +54,33 @@ def mesh3d_to_dataset(mesh: PolyhedralMesh) -> xr.Dataset:
     faces = csr_rows(mesh.face_offsets, mesh.face_vertices, FACE_FILL)
     volumes = csr_rows(mesh.cell_offsets, mesh.cell_faces, VOLUME_FILL)
     data = {f"{t}_node_{a}": ((f"{t}_nNodes",), mesh.vertices[:, k]) for k, a in enumerate("xyz")}
-    data[f"{t}_face_nodes"] = ((f"{t}_nFaces", f"{t}_nMax_face_nodes"), faces,
-                               {"cf_role": "face_node_connectivity", "start_index": 0})
-    data[f"{t}_volume_faces"] = ((f"{t}_nVolumes", f"{t}_nMax_volume_faces"), volumes,
-                                 {"cf_role": "volume_face_connectivity", "start_index": 0,
-                                  "orientation": "outward; -(f+1) is face f reversed"})
+    data[f"{t}_face_nodes"] = (
+        (f"{t}_nFaces", f"{t}_nMax_face_nodes"),
+        faces,
+        {"cf_role": "face_node_connectivity", "start_index": 0},
+    )
+    data[f"{t}_volume_faces"] = (
+        (f"{t}_nVolumes", f"{t}_nMax_volume_faces"),
+        volumes,
+        {"cf_role": "volume_face_connectivity", "start_index": 0, "orientation": "outward; -(f+1) is face f reversed"},
+    )
     for name, part in mesh.boundary.items():
         data[f"{t}_boundary_{name}"] = ((f"{t}_boundary_{name}_nFaces",), np.asarray(part, np.int64))
     ds = xr.Dataset(data)
     ds[f"{t}_face_nodes"].encoding["_FillValue"] = FACE_FILL
     ds[f"{t}_volume_faces"].encoding["_FillValue"] = VOLUME_FILL
-    ds[t] = xr.DataArray(np.int32(0), attrs={
-        "cf_role": "mesh_topology", "topology_dimension": 3,
-        "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z", "face_node_connectivity": f"{t}_face_nodes",
-        "volume_face_connectivity": f"{t}_volume_faces", "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
-        "vemkit_boundary_parts": json.dumps(list(mesh.boundary))})
+    ds[t] = xr.DataArray(
+        np.int32(0),
+        attrs={
+            "cf_role": "mesh_topology",
+            "topology_dimension": 3,
+            "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z",
+            "face_node_connectivity": f"{t}_face_nodes",
+            "volume_face_connectivity": f"{t}_volume_faces",
+            "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
+            "vemkit_boundary_parts": json.dumps(list(mesh.boundary)),
+        },
+    )
     return ds
 
 
@@ -83,8 +95,9 @@ def read_ugrid3d(path) -> PolyhedralMesh:
     try:
         with xr.open_dataset(path, mask_and_scale=False, decode_times=False) as ds:
             if t not in ds.variables:
-                raise MeshError(f"{path.name}: no variable {t!r}; give a file written by vemkit (a mesh3d topology)",
-                                key=str(path))
+                raise MeshError(
+                    f"{path.name}: no variable {t!r}; give a file written by vemkit (a mesh3d topology)", key=str(path)
+                )
             mesh = _mesh_from_dataset(ds, path)
     except MeshError:
         raise
@@ -113,13 +126,20 @@ def _mesh_from_dataset(ds: xr.Dataset, path: Path) -> PolyhedralMesh:
     for name in parts:
         key = f"{t}_boundary_{name}"
         if key not in ds.variables:
-            raise MeshError(f"{path.name}: boundary part {name!r} is listed but variable {key} is missing",
-                            key=str(path))
+            raise MeshError(
+                f"{path.name}: boundary part {name!r} is listed but variable {key} is missing", key=str(path)
+            )
         boundary[name] = ds[key].values.astype(np.int64)
     meta = json.loads(str(ds[t].attrs.get("vemkit_meta", "{}")))
-    return PolyhedralMesh(vertices, np.concatenate([[0], np.cumsum(valid.sum(axis=1))]), table[valid],
-                          np.concatenate([[0], np.cumsum(vvalid.sum(axis=1))]), vtable[vvalid], boundary,
-                          meta if isinstance(meta, dict) else {})
+    return PolyhedralMesh(
+        vertices,
+        np.concatenate([[0], np.cumsum(valid.sum(axis=1))]),
+        table[valid],
+        np.concatenate([[0], np.cumsum(vvalid.sum(axis=1))]),
+        vtable[vvalid],
+        boundary,
+        meta if isinstance(meta, dict) else {},
+    )
 
 
 def _validated(mesh: PolyhedralMesh, path: Path) -> PolyhedralMesh:
@@ -150,8 +170,12 @@ def polyhedron_streams(mesh: PolyhedralMesh):
     stream = np.empty(int(ends[-1]), dtype=np.int64)
     cell_start = ends - length
     stream[cell_start] = per_cell
-    face_pos = cell_start[cells] + 1 + (np.cumsum(sizes + 1) - (sizes + 1)) - np.repeat(
-        (np.cumsum(sizes + 1) - (sizes + 1))[mesh.cell_offsets[:-1]], per_cell)
+    face_pos = (
+        cell_start[cells]
+        + 1
+        + (np.cumsum(sizes + 1) - (sizes + 1))
+        - np.repeat((np.cumsum(sizes + 1) - (sizes + 1))[mesh.cell_offsets[:-1]], per_cell)
+    )
     stream[face_pos] = sizes
     stream[np.repeat(face_pos + 1, sizes) + (np.arange(entry.size) - np.repeat(np.cumsum(sizes) - sizes, sizes))] = ids
     return conn, conn_offsets[1:], stream, ends
@@ -178,13 +202,20 @@ def write_vtu3d(mesh: PolyhedralMesh, path, point_data: dict | None = None, cell
                 raise ValueError(f"{where} data {name!r} has {values.shape[0]} rows; the mesh has {count} {where}")
             arrays[where][name] = values
     arrays["cells"]["cell_index"] = np.arange(mesh.n_cells, dtype=np.int64)
-    parts = ['<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
-             'header_type="UInt64">\n<UnstructuredGrid>\n',
-             f'<Piece NumberOfPoints="{mesh.n_vertices}" NumberOfCells="{mesh.n_cells}">\n',
-             "<Points>\n", _data_array("Points", mesh.vertices.astype("<f8"), 3), "</Points>\n<Cells>\n",
-             _data_array("connectivity", conn), _data_array("offsets", offsets),
-             _data_array("types", np.full(mesh.n_cells, VTK_POLYHEDRON, dtype=np.uint8)),
-             _data_array("faces", faces), _data_array("faceoffsets", faceoffsets), "</Cells>\n"]
+    parts = [
+        '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n<UnstructuredGrid>\n',
+        f'<Piece NumberOfPoints="{mesh.n_vertices}" NumberOfCells="{mesh.n_cells}">\n',
+        "<Points>\n",
+        _data_array("Points", mesh.vertices.astype("<f8"), 3),
+        "</Points>\n<Cells>\n",
+        _data_array("connectivity", conn),
+        _data_array("offsets", offsets),
+        _data_array("types", np.full(mesh.n_cells, VTK_POLYHEDRON, dtype=np.uint8)),
+        _data_array("faces", faces),
+        _data_array("faceoffsets", faceoffsets),
+        "</Cells>\n",
+    ]
     for tag, where in (("PointData", "points"), ("CellData", "cells")):
         parts.append(f"<{tag}>\n")
         for name, values in arrays[where].items():
@@ -215,7 +246,7 @@ def _element_soup(points: np.ndarray, kind: str, nodes: np.ndarray):
     for f, face in enumerate(table):
         ids = nodes[:, face]
         ids[det < 0] = ids[det < 0][:, ::-1]
-        rows[:, f, :len(face)] = ids
+        rows[:, f, : len(face)] = ids
     return rows.reshape(-1, 4), np.full(nodes.shape[0], len(table))
 
 
@@ -243,23 +274,34 @@ def read_gmsh3d(path) -> PolyhedralMesh:
             surfaces += [np.sort(np.asarray(block.data, np.int64), axis=1)]
             tags.append(np.zeros(len(block.data), np.int64) if tag is None else np.asarray(tag, np.int64))
         elif block.dim == 3 or block.dim == 2:
-            raise MeshError(f"{path.name}: element type {block.type!r} is not supported; give linear tetrahedra, "
-                            "hexahedra, prisms (wedge) or pyramids, with triangles or quadrilaterals as surfaces",
-                            key=str(path))
+            raise MeshError(
+                f"{path.name}: element type {block.type!r} is not supported; give linear tetrahedra, "
+                "hexahedra, prisms (wedge) or pyramids, with triangles or quadrilaterals as surfaces",
+                key=str(path),
+            )
     if not soups:
-        raise MeshError(f"{path.name}: no tetrahedra, hexahedra, prisms or pyramids in the file; give a 3D mesh",
-                        key=str(path))
+        raise MeshError(
+            f"{path.name}: no tetrahedra, hexahedra, prisms or pyramids in the file; give a 3D mesh", key=str(path)
+        )
     rows = np.concatenate(soups)
     used = np.unique(rows[rows >= 0])
     renumber = np.full(points.shape[0], -1, dtype=np.int64)
     renumber[used] = np.arange(used.size)
     valid = rows >= 0
-    mesh = from_face_soup(points[used], np.concatenate(counts), valid.sum(axis=1), renumber[rows[valid]], None, (),
-                          {"file": path.name, "format": "gmsh"})
+    mesh = from_face_soup(
+        points[used],
+        np.concatenate(counts),
+        valid.sum(axis=1),
+        renumber[rows[valid]],
+        None,
+        (),
+        {"file": path.name, "format": "gmsh"},
+    )
     names = {int(tag): name for name, (tag, dim) in data.field_data.items() if int(dim) == 2}
     parts = _gmsh_sides3d(mesh, surfaces, tags, renumber, names, path)
-    mesh = PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          parts, mesh.meta)
+    mesh = PolyhedralMesh(
+        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
+    )
     return _validated(mesh, path)
 
 
@@ -283,14 +325,18 @@ def _gmsh_sides3d(mesh, surfaces, tags, renumber, names, path) -> dict:
         faces = np.array([lookup.get(tuple(k), -1) for k in ids.tolist()], dtype=np.int64)
         if (faces < 0).any():
             bad = int(np.flatnonzero(faces < 0)[0])
-            raise MeshError(f"{path.name}: surface element {nodes[bad].tolist()} (nodes counting from 0) of physical "
-                            f"group {tag[bad]} is not a boundary face of the mesh; tag boundary surfaces only",
-                            key=str(path))
+            raise MeshError(
+                f"{path.name}: surface element {nodes[bad].tolist()} (nodes counting from 0) of physical "
+                f"group {tag[bad]} is not a boundary face of the mesh; tag boundary surfaces only",
+                key=str(path),
+            )
         for t in dict.fromkeys(tag.tolist()):
             name = names.get(t, str(t)) if t else "untagged"
             if not SIDE_NAME.fullmatch(name):
-                raise MeshError(f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ "
-                                "and -", key=str(path))
+                raise MeshError(
+                    f"{path.name}: physical name {name!r} is not an identifier; use letters, digits, _ and -",
+                    key=str(path),
+                )
             part = np.unique(faces[tag == t])
             parts[name] = np.union1d(parts.get(name, np.zeros(0, np.int64)), part)
             seen[part] = True
@@ -309,5 +355,6 @@ def read_mesh3d(path) -> PolyhedralMesh:
         return read_gmsh3d(path)
     if path.suffix == ".nc":
         return read_ugrid3d(path)
-    raise MeshError(f"{path.name}: unknown mesh file type {path.suffix!r}; give a .msh (gmsh) or .nc (mesh3d) file",
-                    key=str(path))
+    raise MeshError(
+        f"{path.name}: unknown mesh file type {path.suffix!r}; give a .msh (gmsh) or .nc (mesh3d) file", key=str(path)
+    )

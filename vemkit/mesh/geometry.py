@@ -144,8 +144,11 @@ def area_centroid_many(points, refs, start, stop, work):
     for i in range(n):
         work[0, i], work[1, i], work[2, i] = _shoelace_terms(points, refs, start, n, i)
     area = 0.5 * (work[0, 0] + _pairwise_sum(work[0], 1, n - 1))
-    return (area, (work[1, 0] + _pairwise_sum(work[1], 1, n - 1)) / (6 * area),
-            (work[2, 0] + _pairwise_sum(work[2], 1, n - 1)) / (6 * area))
+    return (
+        area,
+        (work[1, 0] + _pairwise_sum(work[1], 1, n - 1)) / (6 * area),
+        (work[2, 0] + _pairwise_sum(work[2], 1, n - 1)) / (6 * area),
+    )
 
 
 @numba.njit(cache=True, inline="always")
@@ -164,7 +167,7 @@ def _shoelace_terms(points, refs, start, n, i):
 def _pairwise_sum(a, lo, n):
     """numpy's pairwise sum of a[lo:lo + n], 8 <= n <= 128 (what ``np.add.reduceat`` adds to a
     segment's first element): 8 running sums, combined pairwise, then the rest in order."""
-    r = a[lo:lo + 8].copy()
+    r = a[lo : lo + 8].copy()
     i = 8
     while i < n - n % 8:
         for j in range(8):

@@ -17,9 +17,41 @@ import meshio.gmsh
 from vemkit.exceptions import MeshError
 
 #: nodes of each gmsh element type (gmsh reference manual, "MSH file format": element types)
-NODES_PER_TYPE = {1: 2, 2: 3, 3: 4, 4: 4, 5: 8, 6: 6, 7: 5, 8: 3, 9: 6, 10: 9, 11: 10, 12: 27, 13: 18,
-                  14: 14, 15: 1, 16: 8, 17: 20, 18: 15, 19: 13, 20: 9, 21: 10, 22: 12, 23: 15, 24: 15,
-                  25: 21, 26: 4, 27: 5, 28: 6, 29: 20, 30: 35, 31: 56, 92: 64, 93: 125}
+NODES_PER_TYPE = {
+    1: 2,
+    2: 3,
+    3: 4,
+    4: 4,
+    5: 8,
+    6: 6,
+    7: 5,
+    8: 3,
+    9: 6,
+    10: 9,
+    11: 10,
+    12: 27,
+    13: 18,
+    14: 14,
+    15: 1,
+    16: 8,
+    17: 20,
+    18: 15,
+    19: 13,
+    20: 9,
+    21: 10,
+    22: 12,
+    23: 15,
+    24: 15,
+    25: 21,
+    26: 4,
+    27: 5,
+    28: 6,
+    29: 20,
+    30: 35,
+    31: 56,
+    92: 64,
+    93: 125,
+}
 FIX = "fix that line, or export the mesh again from gmsh as ASCII (format 2.2 or 4.1)"
 
 
@@ -37,8 +69,11 @@ def gmsh_read_error(path, reason: str) -> MeshError:
     except OSError:
         found = None
     if found is None:
-        return MeshError(f"{path.name}: cannot be read as gmsh ({reason[:160]}); check that gmsh opens it and "
-                         "export it again as ASCII (format 2.2 or 4.1)", key=str(path))
+        return MeshError(
+            f"{path.name}: cannot be read as gmsh ({reason[:160]}); check that gmsh opens it and "
+            "export it again as ASCII (format 2.2 or 4.1)",
+            key=str(path),
+        )
     return MeshError(f"{path.name}, line {found.line}: {found.text}; {FIX}", key=str(path))
 
 
@@ -91,11 +126,15 @@ def _numbers(lines, index: int, what: str, count=None, kind=int) -> list:
     try:
         values = [kind(f) for f in fields]
     except ValueError:
-        raise _Problem(index, f"{what} must be {'integers' if kind is int else 'numbers'}, found "
-                              f"{_show(lines[index])}") from None
+        raise _Problem(
+            index, f"{what} must be {'integers' if kind is int else 'numbers'}, found {_show(lines[index])}"
+        ) from None
     if count is not None and len(values) != count:
-        raise _Problem(index, f"{what} has {count} {'integers' if kind is int else 'numbers'}, found "
-                              f"{len(values)} ({_show(lines[index])})")
+        raise _Problem(
+            index,
+            f"{what} has {count} {'integers' if kind is int else 'numbers'}, found "
+            f"{len(values)} ({_show(lines[index])})",
+        )
     return values
 
 
@@ -106,8 +145,9 @@ def _format(lines, start: int, end: int):
     try:
         version, binary = float(fields[0]), int(fields[1])
     except (ValueError, IndexError):
-        raise _Problem(start, f"the format line is 'version file-type data-size', e.g. '2.2 0 8', found "
-                              f"{_show(lines[start])}") from None
+        raise _Problem(
+            start, f"the format line is 'version file-type data-size', e.g. '2.2 0 8', found {_show(lines[start])}"
+        ) from None
     if int(version) not in (2, 4):
         raise _Problem(start, f"gmsh format {version:g}; vemkit reads 2.2 and 4.1")
     return None if binary else version
@@ -147,7 +187,7 @@ def _elements_2(lines, start: int, end: int, tags: set) -> None:
         fields = _numbers(lines, i, "an element line 'tag type ntags tags... nodes...'")
         if len(fields) < 3 or len(fields) < 3 + fields[2]:
             raise _Problem(i, f"an element line is 'tag type ntags tags... nodes...', found {_show(lines[i])}")
-        _element(lines, i, fields[1], fields[3 + fields[2]:], tags)
+        _element(lines, i, fields[1], fields[3 + fields[2] :], tags)
     if end - first != count:
         raise _Problem(start, f"$Elements declares {count} elements but lists {end - first}")
 
@@ -181,8 +221,11 @@ def _elements_4(lines, start: int, end: int, tags: set) -> None:
 @contextmanager
 def meshio_warnings(notes: list):
     """meshio's gmsh warnings collected in ``notes`` instead of printed on the terminal."""
-    modules = [m for m in vars(meshio.gmsh).values() if hasattr(m, "warn") and callable(getattr(m, "warn"))
-               and getattr(m, "__name__", "").startswith("meshio.gmsh")]
+    modules = [
+        m
+        for m in vars(meshio.gmsh).values()
+        if hasattr(m, "warn") and callable(getattr(m, "warn")) and getattr(m, "__name__", "").startswith("meshio.gmsh")
+    ]
     saved = [(m, m.warn) for m in modules]
     for module in modules:
         module.warn = lambda text, *args, **kwargs: notes.append(str(text))

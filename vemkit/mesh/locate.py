@@ -47,7 +47,11 @@ def _winding_inside(vertices, offsets, cell_vertices, c, x, y):
         xa, ya = vertices[a, 0], vertices[a, 1]
         xb, yb = vertices[b, 0], vertices[b, 1]
         cross = (xb - xa) * (y - ya) - (yb - ya) * (x - xa)
-        if abs(cross) <= 1e-14 * (abs(xb - xa) + abs(yb - ya)) and min(xa, xb) - 1e-14 <= x <= max(xa, xb) + 1e-14 and min(ya, yb) - 1e-14 <= y <= max(ya, yb) + 1e-14:
+        if (
+            abs(cross) <= 1e-14 * (abs(xb - xa) + abs(yb - ya))
+            and min(xa, xb) - 1e-14 <= x <= max(xa, xb) + 1e-14
+            and min(ya, yb) - 1e-14 <= y <= max(ya, yb) + 1e-14
+        ):
             return True
         if (ya > y) != (yb > y):
             xi = xa + (y - ya) * (xb - xa) / (yb - ya)

@@ -37,11 +37,17 @@ class PolyhedralMesh:
     dimension = 3
 
     def __post_init__(self):
-        for name, dtype in (("vertices", np.float64), ("face_offsets", np.int64), ("face_vertices", np.int64),
-                            ("cell_offsets", np.int64), ("cell_faces", np.int64)):
+        for name, dtype in (
+            ("vertices", np.float64),
+            ("face_offsets", np.int64),
+            ("face_vertices", np.int64),
+            ("cell_offsets", np.int64),
+            ("cell_faces", np.int64),
+        ):
             object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=dtype))
-        object.__setattr__(self, "boundary", {str(k): np.asarray(v, dtype=np.int64).ravel()
-                                              for k, v in self.boundary.items()})
+        object.__setattr__(
+            self, "boundary", {str(k): np.asarray(v, dtype=np.int64).ravel() for k, v in self.boundary.items()}
+        )
 
     # -- sizes -----------------------------------------------------------------------------
     n_vertices = property(lambda self: self.vertices.shape[0], doc="number of vertices")
@@ -49,11 +55,11 @@ class PolyhedralMesh:
     n_cells = property(lambda self: self.cell_offsets.shape[0] - 1, doc="number of cells")
 
     def face(self, f: int) -> np.ndarray:
-        return self.face_vertices[self.face_offsets[f]:self.face_offsets[f + 1]]
+        return self.face_vertices[self.face_offsets[f] : self.face_offsets[f + 1]]
 
     def cell_face_list(self, c: int) -> np.ndarray:
         """The signed faces of cell c."""
-        return self.cell_faces[self.cell_offsets[c]:self.cell_offsets[c + 1]]
+        return self.cell_faces[self.cell_offsets[c] : self.cell_offsets[c + 1]]
 
     # -- derived topology --------------------------------------------------------------------
     @cached_property
@@ -127,8 +133,11 @@ class PolyhedralMesh:
         sign = np.where(self.cell_faces >= 0, 1.0, -1.0)
         faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
         cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))
-        ref = self.vertices[self.face_vertices[self.face_offsets[faces[self.cell_offsets[:-1]]]]] \
-            if self.n_cells else np.zeros((0, 3))
+        ref = (
+            self.vertices[self.face_vertices[self.face_offsets[faces[self.cell_offsets[:-1]]]]]
+            if self.n_cells
+            else np.zeros((0, 3))
+        )
         x = self.face_centroids[faces] - ref[cells]
         flux = sign * np.einsum("ij,ij->i", x, self.face_vector_areas[faces]) / 3.0
         return np.bincount(cells, weights=flux, minlength=self.n_cells)
@@ -169,7 +178,7 @@ def diameters_numpy(vertices, offsets, ids) -> np.ndarray:
         cells = np.flatnonzero(sizes == size)
         step = max(1, 2_000_000 // int(size * size))
         for s in range(0, cells.size, step):
-            chunk = cells[s:s + step]
+            chunk = cells[s : s + step]
             p = vertices[ids[offsets[chunk][:, None] + np.arange(size)]]
             d = ((p[:, :, None, :] - p[:, None, :, :]) ** 2).sum(axis=-1)
             out[chunk] = np.sqrt(d.reshape(chunk.size, -1).max(axis=1))
@@ -205,11 +214,14 @@ def from_polyhedra(vertices, cells, boundary=None, meta=None) -> PolyhedralMesh:
                 cell_faces.append(key_of[key])
         offsets.append(len(cell_faces))
     face_offsets = np.concatenate([[0], np.cumsum([len(f) for f in face_lists])])
-    parts = {side: [key_of[tuple(sorted(int(v) for v in face))] for face in faces]
-             for side, faces in (boundary or {}).items()}
+    parts = {
+        side: [key_of[tuple(sorted(int(v) for v in face))] for face in faces]
+        for side, faces in (boundary or {}).items()
+    }
     flat = np.concatenate([np.asarray(f, dtype=np.int64) for f in face_lists]) if face_lists else np.zeros(0, np.int64)
-    return PolyhedralMesh(np.asarray(vertices, float), face_offsets, flat, np.asarray(offsets), np.asarray(cell_faces),
-                          parts, meta or {})
+    return PolyhedralMesh(
+        np.asarray(vertices, float), face_offsets, flat, np.asarray(offsets), np.asarray(cell_faces), parts, meta or {}
+    )
 
 
 def _same_orientation(face, stored) -> bool:

@@ -33,8 +33,9 @@ def _successor_of_min(table: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     return table[np.arange(table.shape[0]), (at + 1) % np.maximum(sizes, 1)]
 
 
-def from_face_soup(vertices, cell_sizes, face_sizes, face_vertices, labels=None, label_names=(),
-                   meta=None) -> PolyhedralMesh:
+def from_face_soup(
+    vertices, cell_sizes, face_sizes, face_vertices, labels=None, label_names=(), meta=None
+) -> PolyhedralMesh:
     """The mesh of cells given by their outward faces.
 
     ``cell_sizes`` (M,): number of faces of each cell; ``face_sizes`` (O,) and ``face_vertices``: the
@@ -75,8 +76,15 @@ def from_face_soup(vertices, cell_sizes, face_sizes, face_vertices, labels=None,
             if faces.size or name not in boundary:
                 boundary[name] = np.concatenate([boundary.get(name, np.zeros(0, np.int64)), faces])
     cell_offsets = np.concatenate([[0], np.cumsum(np.asarray(cell_sizes, dtype=np.int64))])
-    return PolyhedralMesh(np.asarray(vertices, dtype=float), np.concatenate([[0], np.cumsum(stored_sizes)]),
-                          stored, cell_offsets, signed, {k: np.sort(v) for k, v in boundary.items()}, meta or {})
+    return PolyhedralMesh(
+        np.asarray(vertices, dtype=float),
+        np.concatenate([[0], np.cumsum(stored_sizes)]),
+        stored,
+        cell_offsets,
+        signed,
+        {k: np.sort(v) for k, v in boundary.items()},
+        meta or {},
+    )
 
 
 def tag_box_faces(mesh: PolyhedralMesh, lower, upper, sides, tol: float = 1e-10) -> PolyhedralMesh:
@@ -95,5 +103,6 @@ def tag_box_faces(mesh: PolyhedralMesh, lower, upper, sides, tol: float = 1e-10)
         faces = bf[on[bf]]
         parts[name] = np.concatenate([parts.get(name, np.zeros(0, np.int64)), faces])
     parts = {k: np.sort(v) for k, v in parts.items()}
-    return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          parts, dict(mesh.meta))
+    return PolyhedralMesh(
+        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, dict(mesh.meta)
+    )

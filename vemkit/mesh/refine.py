@@ -34,8 +34,14 @@ import scipy.sparse as sp
 from vemkit.exceptions import InputError
 from vemkit.mesh.curves import as_pieces, on_curves
 from vemkit.mesh.mesh import Mesh
-from vemkit.mesh.refine_kernels import (augmented_rings, children, corner_flags, max_inner_vertices,
-                                        midpoint_requests, split_centres)
+from vemkit.mesh.refine_kernels import (
+    augmented_rings,
+    children,
+    corner_flags,
+    max_inner_vertices,
+    midpoint_requests,
+    split_centres,
+)
 
 
 class RefinedMesh(NamedTuple):
@@ -83,8 +89,9 @@ def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: list) -> _
 
 def _rings(mesh: Mesh, splits: _Splits):
     points = np.concatenate([mesh.vertices, splits.points])
-    offsets, ring = augmented_rings(mesh.cell_offsets, mesh.cell_vertices, splits.keys, splits.ptr,
-                                    splits.vertices, np.int64(mesh.n_vertices))
+    offsets, ring = augmented_rings(
+        mesh.cell_offsets, mesh.cell_vertices, splits.keys, splits.ptr, splits.vertices, np.int64(mesh.n_vertices)
+    )
     return points, offsets, ring
 
 
@@ -121,7 +128,7 @@ def _centres(mesh: Mesh, refine, splits: _Splits, points, offsets, ring):
     stuck = refine[np.isnan(centres[:, 0])]
     if stuck.size == 0:
         return centres, points
-    slots = np.concatenate([ring[offsets[c]:offsets[c + 1]] for c in stuck]) - mesh.n_vertices
+    slots = np.concatenate([ring[offsets[c] : offsets[c + 1]] for c in stuck]) - mesh.n_vertices
     new = slots[slots >= 0]
     moved = new[np.any(splits.points[new] != splits.chords[new], axis=1)]
     if moved.size == 0:
@@ -158,11 +165,17 @@ def _split_boundary(edges: np.ndarray, splits: _Splits, n_old: int) -> np.ndarra
     """
     if edges.size == 0:
         return edges.reshape(0, 2)
-    offsets, ring = augmented_rings(np.arange(0, 2 * edges.shape[0] + 1, 2), edges.ravel(), splits.keys,
-                                    splits.ptr, splits.vertices, np.int64(n_old))
+    offsets, ring = augmented_rings(
+        np.arange(0, 2 * edges.shape[0] + 1, 2),
+        edges.ravel(),
+        splits.keys,
+        splits.ptr,
+        splits.vertices,
+        np.int64(n_old),
+    )
     out = []
     for start, stop in zip(offsets[:-1], offsets[1:]):
-        path = ring[start:start + (stop - start) // 2 + 1]
+        path = ring[start : start + (stop - start) // 2 + 1]
         out.append(np.stack([path[:-1], path[1:]], axis=1))
     return np.concatenate(out).astype(np.int64)
 
@@ -171,9 +184,15 @@ def _prolongation(mesh: Mesh, splits: _Splits, split: np.ndarray) -> sp.csr_matr
     """Old vertex values to new ones: identity, linear along split edges, cell mean at centres."""
     n_old, n_edge = mesh.n_vertices, splits.t.size
     sizes = mesh.cell_sizes[split]
-    rows = np.r_[np.arange(n_old), np.repeat(n_old + np.arange(n_edge), 2),
-                 np.repeat(n_old + n_edge + np.arange(split.size), sizes)]
-    cols = np.r_[np.arange(n_old), splits.ends.ravel(),
-                 np.concatenate([mesh.cell(k) for k in split]) if split.size else np.zeros(0, np.int64)]
+    rows = np.r_[
+        np.arange(n_old),
+        np.repeat(n_old + np.arange(n_edge), 2),
+        np.repeat(n_old + n_edge + np.arange(split.size), sizes),
+    ]
+    cols = np.r_[
+        np.arange(n_old),
+        splits.ends.ravel(),
+        np.concatenate([mesh.cell(k) for k in split]) if split.size else np.zeros(0, np.int64),
+    ]
     vals = np.r_[np.ones(n_old), np.stack([1.0 - splits.t, splits.t], axis=1).ravel(), np.repeat(1.0 / sizes, sizes)]
     return sp.csr_matrix((vals, (rows, cols)), shape=(n_old + n_edge + split.size, n_old))

@@ -269,4 +269,8 @@ def children(points, offsets, ring, corner, cells, centres):
                 j = (j + 1) % n
             child_offsets.append(len(child_ring))
             parent.append(k)
-    return np.array(child_offsets, dtype=np.int64), np.array(child_ring, dtype=np.int64), np.array(parent, dtype=np.int64)
+    return (
+        np.array(child_offsets, dtype=np.int64),
+        np.array(child_ring, dtype=np.int64),
+        np.array(parent, dtype=np.int64),
+    )

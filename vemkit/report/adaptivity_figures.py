@@ -30,13 +30,29 @@ def adaptive_convergence_figure(histories: dict, error: str = "true_error_h1", t
         dofs = h["n_dofs"]
         if error in h:
             rate = fitted_rate(dofs, h[error])
-            ax.loglog(dofs, h[error], marker=marker, color=color, ms=4, lw=1.2,
-                      label=f"{name}: {error.replace('_', ' ')} (rate {rate['rate']:.2f})")
+            ax.loglog(
+                dofs,
+                h[error],
+                marker=marker,
+                color=color,
+                ms=4,
+                lw=1.2,
+                label=f"{name}: {error.replace('_', ' ')} (rate {rate['rate']:.2f})",
+            )
             fit = np.array([rate["from_dofs"], rate["to_dofs"]], float)
             ax.loglog(fit, rate["constant"] * fit ** rate["rate"], color=color, lw=3, alpha=0.25)
         est = fitted_rate(dofs, h["estimate"])
-        ax.loglog(dofs, h["estimate"], marker=marker, mfc="none", color=color, ms=4, lw=1, ls="--",
-                  label=f"{name}: estimate η (rate {est['rate']:.2f})")
+        ax.loglog(
+            dofs,
+            h["estimate"],
+            marker=marker,
+            mfc="none",
+            color=color,
+            ms=4,
+            lw=1,
+            ls="--",
+            label=f"{name}: estimate η (rate {est['rate']:.2f})",
+        )
     everything = np.concatenate([h["n_dofs"] for h in histories.values()])
     first = histories.get("adaptive", next(iter(histories.values())))
     start = first.get(error, first["estimate"])[0]
@@ -53,15 +69,22 @@ def adaptive_convergence_figure(histories: dict, error: str = "true_error_h1", t
 
 def _polygons(mesh):
     xy, off = mesh.vertices, mesh.cell_offsets
-    return [xy[mesh.cell_vertices[off[k]:off[k + 1]]] for k in range(mesh.n_cells)]
+    return [xy[mesh.cell_vertices[off[k] : off[k + 1]]] for k in range(mesh.n_cells)]
 
 
 def _cells_panel(fig, ax, mesh, values, label: str, cmap: str):
     values = np.maximum(np.asarray(values, float), np.finfo(float).tiny)
     positive = values[values > np.finfo(float).tiny]
     norm = LogNorm(vmin=positive.min() if positive.size else 1e-300, vmax=values.max())
-    cells = PolyCollection(_polygons(mesh), array=values, cmap=cmap, norm=norm, edgecolors="k",
-                           linewidths=0.15 if mesh.n_cells < 5000 else 0.0, rasterized=True)
+    cells = PolyCollection(
+        _polygons(mesh),
+        array=values,
+        cmap=cmap,
+        norm=norm,
+        edgecolors="k",
+        linewidths=0.15 if mesh.n_cells < 5000 else 0.0,
+        rasterized=True,
+    )
     ax.add_collection(cells)
     ax.autoscale_view()
     ax.set_aspect("equal")

@@ -46,7 +46,7 @@ def save(fig: Figure, *paths, dpi: int = 150) -> list[Path]:
 def _cell_polygons(mesh, vertices=None) -> list[np.ndarray]:
     xy = mesh.vertices if vertices is None else vertices
     off = mesh.cell_offsets
-    return [xy[mesh.cell_vertices[off[k]:off[k + 1]]] for k in range(mesh.n_cells)]
+    return [xy[mesh.cell_vertices[off[k] : off[k + 1]]] for k in range(mesh.n_cells)]
 
 
 def _edges(mesh, vertices=None, **kw) -> LineCollection:
@@ -133,12 +133,13 @@ def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "
         verts = ds["contact_vertex"].values.astype(int)
         pen = ds["penetration"].values > 0
         p = xy[verts]
-        segs = [p[i:i + 2] for i in range(len(p) - 1) if pen[i] and pen[i + 1]]
+        segs = [p[i : i + 2] for i in range(len(p) - 1) if pen[i] and pen[i + 1]]
         if segs:
             ax.add_collection(LineCollection(segs, colors="red", linewidths=2.5, zorder=5))
         if pen.any():
-            ax.plot(p[pen, 0], p[pen, 1], "o", color="red", ms=3, zorder=6,
-                    label=r"penetration $u_\nu > g_a$ on $\Gamma_C$")
+            ax.plot(
+                p[pen, 0], p[pen, 1], "o", color="red", ms=3, zorder=6, label=r"penetration $u_\nu > g_a$ on $\Gamma_C$"
+            )
         ax.set_xlim(x0, x1)
     else:
         ax.set_xlim(lo[0] - pad, hi[0] + pad)
@@ -167,8 +168,9 @@ def contact_figure(ds, title: str = "") -> Figure:
     x = ds["contact_x"].values
     order = np.argsort(x)
     x = x[order]
-    get = {k: ds[k].values[order] for k in ("normal_pressure", "tangential_stress", "slip", "penetration",
-                                           "contact_state")}
+    get = {
+        k: ds[k].values[order] for k in ("normal_pressure", "tangential_stress", "slip", "penetration", "contact_state")
+    }
     friction = _scene(ds).get("contact", {}).get("friction")
     fig = Figure(figsize=(8.0, 9.0), layout="constrained")
     axes = fig.subplots(4, 1, sharex=True, height_ratios=(3, 3, 3, 1))
@@ -198,8 +200,13 @@ def contact_figure(ds, title: str = "") -> Figure:
     ax.set_yticks([])
     ax.set_ylabel("zone")
     counts = {code: int(np.sum(get["contact_state"] == code)) for code in STATE_COLORS}
-    ax.legend(handles=[Patch(color=c, label=f"{name} ({counts[code]})") for code, (name, c) in STATE_COLORS.items()],
-              ncol=3, fontsize=8, loc="center", framealpha=0.9)
+    ax.legend(
+        handles=[Patch(color=c, label=f"{name} ({counts[code]})") for code, (name, c) in STATE_COLORS.items()],
+        ncol=3,
+        fontsize=8,
+        loc="center",
+        framealpha=0.9,
+    )
     ax.set_xlabel(r"$x_1$ on $\Gamma_C$ (mm)")
     ax.set_xlim(x[0], x[-1])
     fig.suptitle(title or r"contact boundary $\Gamma_C$", fontsize=11)
@@ -233,8 +240,16 @@ def convergence_figure(ds, norm: str = "h1", paper: bool = True, title: str = ""
             if not ok.any():
                 continue
             marker, line = STAB_STYLES[j % len(STAB_STYLES)]
-            ax.loglog(h[ok], e[ok], marker=marker, ls=line, color=FAMILY_COLORS[i % len(FAMILY_COLORS)],
-                      ms=4.5, lw=1.2, label=f"{fam} / {stab}")
+            ax.loglog(
+                h[ok],
+                e[ok],
+                marker=marker,
+                ls=line,
+                color=FAMILY_COLORS[i % len(FAMILY_COLORS)],
+                ms=4.5,
+                lw=1.2,
+                label=f"{fam} / {stab}",
+            )
             values.append(e[ok])
     if paper and norm == PAPER_TABLE1["norm"]:
         ax.loglog(PAPER_TABLE1["h"], PAPER_TABLE1["error"], "kx", ms=8, mew=2, label="paper, Table 1")
@@ -244,9 +259,13 @@ def convergence_figure(ds, norm: str = "h1", paper: bool = True, title: str = ""
         c = 0.5 * np.exp(np.mean(np.log(allv))) / np.exp(np.mean(np.log(h)))
         ax.loglog(hh, c * hh, "k--", lw=1.5, label="slope 1")
     ax.set_xlabel("$h = 1/n$ (mm)")
-    ax.set_ylabel({"paper": r"$|\Pi_1^{ref}(I_{ref} u_h - u_{ref})|_{H^1} / |\Pi_1^{ref} u_{ref}|_{H^1}$",
-                   "h1": r"$\|\Pi_1(u_h - u_{ref})\|_{H^1} / \|\Pi_1 u_{ref}\|_{H^1}$",
-                   "h1_semi": r"$|\Pi_1(u_h - u_{ref})|_{H^1} / |\Pi_1 u_{ref}|_{H^1}$"}[norm])
+    ax.set_ylabel(
+        {
+            "paper": r"$|\Pi_1^{ref}(I_{ref} u_h - u_{ref})|_{H^1} / |\Pi_1^{ref} u_{ref}|_{H^1}$",
+            "h1": r"$\|\Pi_1(u_h - u_{ref})\|_{H^1} / \|\Pi_1 u_{ref}\|_{H^1}$",
+            "h1_semi": r"$|\Pi_1(u_h - u_{ref})|_{H^1} / |\Pi_1 u_{ref}|_{H^1}$",
+        }[norm]
+    )
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2, loc="lower right", framealpha=0.9)
     ax.set_title(title or "convergence against the square $h = 2^{-8}$ reference", fontsize=10)

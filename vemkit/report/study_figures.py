@@ -64,10 +64,23 @@ def sweep_map_figure(ds, x: str, y: str, quantities, select=None, title: str = "
     for ax, name in zip(axes, quantities):
         data = sub[name].transpose(y, x).values.astype(float)
         positive = np.isfinite(data) & (data > 0)
-        norm = LogNorm(data[positive].min(), data[positive].max()) if (
-            positive.any() and np.all(data[np.isfinite(data)] > 0) and data[positive].max() > 100 * data[positive].min()) else None
-        mesh = ax.pcolormesh(np.arange(data.shape[1] + 1) - 0.5, np.arange(data.shape[0] + 1) - 0.5,
-                             np.ma.masked_invalid(data), cmap="viridis", norm=norm, shading="flat")
+        norm = (
+            LogNorm(data[positive].min(), data[positive].max())
+            if (
+                positive.any()
+                and np.all(data[np.isfinite(data)] > 0)
+                and data[positive].max() > 100 * data[positive].min()
+            )
+            else None
+        )
+        mesh = ax.pcolormesh(
+            np.arange(data.shape[1] + 1) - 0.5,
+            np.arange(data.shape[0] + 1) - 0.5,
+            np.ma.masked_invalid(data),
+            cmap="viridis",
+            norm=norm,
+            shading="flat",
+        )
         fig.colorbar(mesh, ax=ax, label=_label(ds, name))
         bad = np.argwhere(sub["status"].transpose(y, x).values != 0)
         if bad.size:
@@ -97,11 +110,25 @@ def sweep_lines_figure(ds, x: str, hue: str | None, quantities, select=None, tit
             line = sub.sel({hue: h}) if hue else sub
             bad = line["status"].values != 0
             values = np.where(bad, np.nan, line[name].values.astype(float))  # only converged points on the line
-            ax.plot(positions, values, marker=MARKERS[k % len(MARKERS)], color=COLORS[k % len(COLORS)], ms=4,
-                    label=f"{hue} = {_value_labels([h])[0]}" if hue else None)
+            ax.plot(
+                positions,
+                values,
+                marker=MARKERS[k % len(MARKERS)],
+                color=COLORS[k % len(COLORS)],
+                ms=4,
+                label=f"{hue} = {_value_labels([h])[0]}" if hue else None,
+            )
             if bad.any():  # not converged: a cross at the foot of the panel
-                ax.plot(positions[bad], np.full(bad.sum(), 0.03), "x", color=COLORS[k % len(COLORS)], ms=7, mew=2,
-                        transform=ax.get_xaxis_transform(), clip_on=False)
+                ax.plot(
+                    positions[bad],
+                    np.full(bad.sum(), 0.03),
+                    "x",
+                    color=COLORS[k % len(COLORS)],
+                    ms=7,
+                    mew=2,
+                    transform=ax.get_xaxis_transform(),
+                    clip_on=False,
+                )
         shown = sub[name].where(sub["status"] == 0).values.astype(float)
         shown = shown[np.isfinite(shown)]
         if shown.size and np.all(shown > 0) and shown.max() > 100 * shown.min():
@@ -156,14 +183,23 @@ def pareto_figure(ds, error: str = "error_h1", targets=(0.01,)) -> Figure:
     fam = np.array([str(f) for f in ds["family"].values])
     sol = np.array([str(s) for s in ds["solver"].values])
     err = ds[error].values
-    for ax, cost, front, xlabel in ((axes[0], "cost_time", "pareto_time", "wall time: assembly + solve [s]"),
-                                    (axes[1], "n_dofs", "pareto_dofs", "free unknowns (DOFs)")):
+    for ax, cost, front, xlabel in (
+        (axes[0], "cost_time", "pareto_time", "wall time: assembly + solve [s]"),
+        (axes[1], "n_dofs", "pareto_dofs", "free unknowns (DOFs)"),
+    ):
         c = ds[cost].values.astype(float)
         for i, f in enumerate(families):
             for j, s in enumerate(solvers):
                 sel = ok & (fam == f) & (sol == s)
-                ax.scatter(c[sel], err[sel], s=14, color=COLORS[i % len(COLORS)], marker=MARKERS[j % len(MARKERS)],
-                           alpha=0.55, linewidths=0)
+                ax.scatter(
+                    c[sel],
+                    err[sel],
+                    s=14,
+                    color=COLORS[i % len(COLORS)],
+                    marker=MARKERS[j % len(MARKERS)],
+                    alpha=0.55,
+                    linewidths=0,
+                )
         on = ok & (ds[front].values == 1)
         order = np.argsort(c[on])
         ax.step(c[on][order], err[on][order], where="post", color="k", lw=1.2)
@@ -175,8 +211,12 @@ def pareto_figure(ds, error: str = "error_h1", targets=(0.01,)) -> Figure:
         ax.set_xlabel(xlabel)
         ax.set_ylabel(f"{error} (relative)")
         ax.grid(alpha=0.3, which="both")
-    handles = [Line2D([], [], color=COLORS[i % len(COLORS)], marker="o", ls="", label=f) for i, f in enumerate(families)]
-    handles += [Line2D([], [], color="grey", marker=MARKERS[j % len(MARKERS)], ls="", label=s) for j, s in enumerate(solvers)]
+    handles = [
+        Line2D([], [], color=COLORS[i % len(COLORS)], marker="o", ls="", label=f) for i, f in enumerate(families)
+    ]
+    handles += [
+        Line2D([], [], color="grey", marker=MARKERS[j % len(MARKERS)], ls="", label=s) for j, s in enumerate(solvers)
+    ]
     handles += [Line2D([], [], color="k", marker="o", mfc="none", label="Pareto front")]
     axes[1].legend(handles=handles, fontsize=7, loc="upper right")
     fig.suptitle("speed-accuracy: every (family, solver, tolerance, stabilization, h)", fontsize=10)
@@ -193,8 +233,19 @@ def stability_figure(ds) -> Figure:
     height = max(4.0, 0.19 * len(cases) + 1.2)
     fig = Figure(figsize=(12.0, height), layout="constrained")
     left, right = fig.subplots(1, 2, width_ratios=(1.0, 1.4))
-    palette = ["#4daf4a", "#e41a1c", "#ff7f00", "#984ea3", "#a65628", "#f781bf", "#999999", "#377eb8",
-               "#ffff33", "#000000", "#66c2a5"]
+    palette = [
+        "#4daf4a",
+        "#e41a1c",
+        "#ff7f00",
+        "#984ea3",
+        "#a65628",
+        "#f781bf",
+        "#999999",
+        "#377eb8",
+        "#ffff33",
+        "#000000",
+        "#66c2a5",
+    ]
     cmap = ListedColormap(palette[: len(STATUS_MEANINGS)])
     norm = BoundaryNorm(np.arange(len(STATUS_MEANINGS) + 1) - 0.5, cmap.N)
     left.pcolormesh(np.arange(len(solvers) + 1) - 0.5, np.arange(len(cases) + 1) - 0.5, status, cmap=cmap, norm=norm)
@@ -207,8 +258,13 @@ def stability_figure(ds) -> Figure:
     left.set_yticks(range(len(cases)), cases, fontsize=6)
     left.invert_yaxis()
     used = sorted(set(status.ravel()))
-    left.legend(handles=[Line2D([], [], color=palette[c], marker="s", ls="", ms=8, label=STATUS_MEANINGS[c]) for c in used],
-                fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.02 - 0.5 / height), ncol=1)
+    left.legend(
+        handles=[Line2D([], [], color=palette[c], marker="s", ls="", ms=8, label=STATUS_MEANINGS[c]) for c in used],
+        fontsize=6,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.02 - 0.5 / height),
+        ncol=1,
+    )
     left.set_title("outcome (number: iterations)", fontsize=9)
     worst = ds["check_worst"].values.astype(float)
     for j, s in enumerate(solvers):

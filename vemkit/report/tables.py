@@ -35,11 +35,18 @@ ORDER_TARGET = 0.1  # |order - paper order| <= 0.1
 PAPER_ERROR_TARGET = 0.001  # the paper's measure: |ratio - 1| <= 0.1 %
 PAPER_ORDER_TARGET = 0.002
 #: measure -> (error variable, order variable, label), the paper's measure first
-NORMS = {"paper": ("error_paper", "order_paper", "paper's measure"),
-         "paper_gauss": ("error_paper_gauss", "order_paper_gauss", "paper's measure, Gauss on Γ_C"),
-         "h1": ("error_h1", "order", "H1"), "h1_semi": ("error_h1_semi", "order_h1_semi", "H1 semi")}
-TARGETS = {"paper": (PAPER_ERROR_TARGET, PAPER_ORDER_TARGET), "paper_gauss": (PAPER_ERROR_TARGET, PAPER_ORDER_TARGET),
-           "h1": (ERROR_TARGET, ORDER_TARGET), "h1_semi": (ERROR_TARGET, ORDER_TARGET)}
+NORMS = {
+    "paper": ("error_paper", "order_paper", "paper's measure"),
+    "paper_gauss": ("error_paper_gauss", "order_paper_gauss", "paper's measure, Gauss on Γ_C"),
+    "h1": ("error_h1", "order", "H1"),
+    "h1_semi": ("error_h1_semi", "order_h1_semi", "H1 semi"),
+}
+TARGETS = {
+    "paper": (PAPER_ERROR_TARGET, PAPER_ORDER_TARGET),
+    "paper_gauss": (PAPER_ERROR_TARGET, PAPER_ORDER_TARGET),
+    "h1": (ERROR_TARGET, ORDER_TARGET),
+    "h1_semi": (ERROR_TARGET, ORDER_TARGET),
+}
 
 
 def h_label(h: float, latex: bool = False) -> str:
@@ -80,13 +87,20 @@ def table1_rows(ds: xr.Dataset, family: str = "square") -> list[dict]:
                     continue
                 order = _value(cell[order_key])
                 p_err, p_order = paper_value(float(h), "error"), paper_value(float(h), "order")
-                rows.append({
-                    "stabilization": stab, "norm": norm, "n": int(round(1 / float(h))), "h": float(h),
-                    "error": error, "paper_error": p_err,
-                    "ratio": error / p_err if p_err else None,
-                    "order": order if np.isfinite(order) else None, "paper_order": p_order,
-                    "order_difference": (order - p_order) if (p_order is not None and np.isfinite(order)) else None,
-                })
+                rows.append(
+                    {
+                        "stabilization": stab,
+                        "norm": norm,
+                        "n": int(round(1 / float(h))),
+                        "h": float(h),
+                        "error": error,
+                        "paper_error": p_err,
+                        "ratio": error / p_err if p_err else None,
+                        "order": order if np.isfinite(order) else None,
+                        "paper_order": p_order,
+                        "order_difference": (order - p_order) if (p_order is not None and np.isfinite(order)) else None,
+                    }
+                )
     return rows
 
 
@@ -102,13 +116,19 @@ def table1_summary(ds: xr.Dataset, family: str = "square") -> list[dict]:
         worst_ratio = max(ratios) if ratios else float("nan")
         worst_order = max(orders) if orders else float("nan")
         error_target, order_target = TARGETS[norm]
-        out.append({
-            "stabilization": stab, "norm": norm, "compared": len(ratios),
-            "max_error_deviation": worst_ratio, "max_order_deviation": worst_order,
-            "meets_target": bool(ratios) and worst_ratio <= error_target and
-            (not orders or worst_order <= order_target),
-        })
-    out.sort(key=lambda s: (s["max_error_deviation"] if np.isfinite(s["max_error_deviation"]) else np.inf))
+        out.append(
+            {
+                "stabilization": stab,
+                "norm": norm,
+                "compared": len(ratios),
+                "max_error_deviation": worst_ratio,
+                "max_order_deviation": worst_order,
+                "meets_target": bool(ratios)
+                and worst_ratio <= error_target
+                and (not orders or worst_order <= order_target),
+            }
+        )
+    out.sort(key=lambda s: s["max_error_deviation"] if np.isfinite(s["max_error_deviation"]) else np.inf)
     return out
 
 
@@ -126,22 +146,27 @@ def _grid(ds: xr.Dataset, family: str):
     """(h values, per (stab, norm) quantity lines) for the wide tables."""
     rows = table1_rows(ds, family)
     hs = sorted({r["h"] for r in rows}, reverse=True)
-    lines = [("paper", "Table 1", "error", [_fmt(paper_value(h, "error"), "error") for h in hs]),
-             ("paper", "Table 1", "order", [_fmt(paper_value(h, "order"), "order") for h in hs])]
+    lines = [
+        ("paper", "Table 1", "error", [_fmt(paper_value(h, "error"), "error") for h in hs]),
+        ("paper", "Table 1", "order", [_fmt(paper_value(h, "order"), "order") for h in hs]),
+    ]
     stabs = list(dict.fromkeys(r["stabilization"] for r in rows))
     norms = list(NORMS)
     # the paper's measure first (each stabilization with its variants), then H1 and H1 semi
-    groups = sorted(dict.fromkeys((r["norm"], r["stabilization"]) for r in rows),
-                    key=lambda g: (0 if g[0].startswith("paper") else norms.index(g[0]), stabs.index(g[1]),
-                                   norms.index(g[0])))
+    groups = sorted(
+        dict.fromkeys((r["norm"], r["stabilization"]) for r in rows),
+        key=lambda g: (0 if g[0].startswith("paper") else norms.index(g[0]), stabs.index(g[1]), norms.index(g[0])),
+    )
     for norm, stab in groups:
         norm_name = NORMS[norm][2]
         by_h = {r["h"]: r for r in rows if r["stabilization"] == stab and r["norm"] == norm}
         get = lambda key, kind: [_fmt(by_h[h][key], kind) if h in by_h else "–" for h in hs]  # noqa: E731
-        lines += [(stab, norm_name, "error", get("error", "error")),
-                  (stab, norm_name, "ratio to paper", get("ratio", "ratio")),
-                  (stab, norm_name, "order", get("order", "order")),
-                  (stab, norm_name, "order − paper", get("order_difference", "diff"))]
+        lines += [
+            (stab, norm_name, "error", get("error", "error")),
+            (stab, norm_name, "ratio to paper", get("ratio", "ratio")),
+            (stab, norm_name, "order", get("order", "order")),
+            (stab, norm_name, "order − paper", get("order_difference", "diff")),
+        ]
     return hs, lines
 
 
@@ -151,9 +176,11 @@ def _summary_lines(ds, family) -> list[str]:
     for s in summary:
         norm = NORMS[s["norm"]][2]
         error_target, order_target = TARGETS[s["norm"]]
-        out.append(f"{s['stabilization']} / {norm}: max |ratio − 1| = {s['max_error_deviation']:.4%}, "
-                   f"max |order − paper| = {s['max_order_deviation']:.5f} over {s['compared']} levels"
-                   f" — target (≤ {error_target:.1%}, ± {order_target}) {'met' if s['meets_target'] else 'NOT met'}")
+        out.append(
+            f"{s['stabilization']} / {norm}: max |ratio − 1| = {s['max_error_deviation']:.4%}, "
+            f"max |order − paper| = {s['max_order_deviation']:.5f} over {s['compared']} levels"
+            f" — target (≤ {error_target:.1%}, ± {order_target}) {'met' if s['meets_target'] else 'NOT met'}"
+        )
     if summary:
         best = summary[0]
         out.append(f"closest to the paper: {best['stabilization']} with the {NORMS[best['norm']][2]}")
@@ -167,7 +194,7 @@ def table1_markdown(ds: xr.Dataset, family: str = "square") -> str:
         "Table 1 — relative errors on square meshes against u_ref on h = 2^-8 of the same stabilization "
         "(SPEC §5). paper's measure (the one the paper's Table 1 prints): |Π₁^ref(I_ref u_h − u_ref)|_H1 / "
         "|Π₁^ref u_ref|_H1, I_ref u_h the bilinear interpolant of u_h at the reference vertices, Π₁^ref the "
-        "projection (3.8) on the reference cells, H1 seminorm; \"Gauss on Γ_C\": the same with the normal-compliance "
+        'projection (3.8) on the reference cells, H1 seminorm; "Gauss on Γ_C": the same with the normal-compliance '
         "integral by Gauss points on each Γ_C edge instead of the nodal rule (config table1.gauss). "
         "H1 / H1 semi: ‖Π₁(u_h − u_ref)‖ / ‖Π₁u_ref‖, "
         "Π₁ on each solution's own mesh, full H1 norm / H1 seminorm. ratio = ours / paper; order − paper = "
@@ -182,8 +209,18 @@ def table1_markdown(ds: xr.Dataset, family: str = "square") -> str:
 
 
 def table1_csv(ds: xr.Dataset, family: str = "square") -> str:
-    keys = ["stabilization", "norm", "n", "h", "error", "paper_error", "ratio", "order", "paper_order",
-            "order_difference"]  # norm: paper (the paper's measure), h1, h1_semi
+    keys = [
+        "stabilization",
+        "norm",
+        "n",
+        "h",
+        "error",
+        "paper_error",
+        "ratio",
+        "order",
+        "paper_order",
+        "order_difference",
+    ]  # norm: paper (the paper's measure), h1, h1_semi
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=keys, lineterminator="\n")
     writer.writeheader()
@@ -193,8 +230,14 @@ def table1_csv(ds: xr.Dataset, family: str = "square") -> str:
 
 
 def _latex_escape(text: str) -> str:
-    return (text.replace("\\", r"\textbackslash{}").replace("_", r"\_").replace("%", r"\%")
-            .replace("&", r"\&").replace("–", "--").replace("−", "$-$"))
+    return (
+        text.replace("\\", r"\textbackslash{}")
+        .replace("_", r"\_")
+        .replace("%", r"\%")
+        .replace("&", r"\&")
+        .replace("–", "--")
+        .replace("−", "$-$")
+    )
 
 
 def table1_latex(ds: xr.Dataset, family: str = "square") -> str:
@@ -231,23 +274,43 @@ def convergence_rows(ds: xr.Dataset) -> list[dict]:
                 order, order_semi = _value(cell["order"]), _value(cell["order_h1_semi"])
                 paper = _value(cell["error_paper"]) if "error_paper" in ds else float("nan")
                 order_paper = _value(cell["order_paper"]) if "order_paper" in ds else float("nan")
-                rows.append({
-                    "family": fam, "stabilization": stab, "n": int(round(1 / float(h))), "h": float(h),
-                    "error_h1": e1, "order": order if np.isfinite(order) else None,
-                    "error_h1_semi": _value(cell["error_h1_semi"]),
-                    "order_h1_semi": order_semi if np.isfinite(order_semi) else None,
-                    "error_paper": paper if np.isfinite(paper) else None,
-                    "order_paper": order_paper if np.isfinite(order_paper) else None,
-                    "n_dofs": int(_value(cell["n_dofs"])), "iterations": int(_value(cell["iterations"])),
-                    "wall_time": _value(cell["wall_time"]),
-                })
+                rows.append(
+                    {
+                        "family": fam,
+                        "stabilization": stab,
+                        "n": int(round(1 / float(h))),
+                        "h": float(h),
+                        "error_h1": e1,
+                        "order": order if np.isfinite(order) else None,
+                        "error_h1_semi": _value(cell["error_h1_semi"]),
+                        "order_h1_semi": order_semi if np.isfinite(order_semi) else None,
+                        "error_paper": paper if np.isfinite(paper) else None,
+                        "order_paper": order_paper if np.isfinite(order_paper) else None,
+                        "n_dofs": int(_value(cell["n_dofs"])),
+                        "iterations": int(_value(cell["iterations"])),
+                        "wall_time": _value(cell["wall_time"]),
+                    }
+                )
     return rows
 
 
 def convergence_csv(ds: xr.Dataset) -> str:
     rows = convergence_rows(ds)
-    keys = ["family", "stabilization", "n", "h", "error_paper", "order_paper", "error_h1", "order",
-            "error_h1_semi", "order_h1_semi", "n_dofs", "iterations", "wall_time"]
+    keys = [
+        "family",
+        "stabilization",
+        "n",
+        "h",
+        "error_paper",
+        "order_paper",
+        "error_h1",
+        "order",
+        "error_h1_semi",
+        "order_h1_semi",
+        "n_dofs",
+        "iterations",
+        "wall_time",
+    ]
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=keys, lineterminator="\n")
     writer.writeheader()
@@ -280,24 +343,31 @@ def _convergence_grid(ds: xr.Dataset):
 def convergence_markdown(ds: xr.Dataset) -> str:
     hs, lines = _convergence_grid(ds)
     head = ["family", "stabilization", "measure"] + [f"h = {h_label(h)}" for h in hs]
-    text = ["Convergence on every mesh family: relative errors against the square h = 2^-8 reference "
-            "(SPEC §5) and, in parentheses, the observed order. paper: the paper's measure "
-            "|Π₁^ref(I_ref u_h − u_ref)|_H1 / |Π₁^ref u_ref|_H1 (I_ref: bilinear on squares, Wachspress "
-            "coordinates on convex cells, mean value coordinates on cells with hanging nodes); H1: "
-            "‖Π₁(u_h − u_ref)‖_H1 / ‖Π₁u_ref‖_H1 with Π₁ on each mesh, whose integral resolves the coarse "
-            "cell boundaries of non-nested meshes to the reference mesh size.", "",
-            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    text = [
+        "Convergence on every mesh family: relative errors against the square h = 2^-8 reference "
+        "(SPEC §5) and, in parentheses, the observed order. paper: the paper's measure "
+        "|Π₁^ref(I_ref u_h − u_ref)|_H1 / |Π₁^ref u_ref|_H1 (I_ref: bilinear on squares, Wachspress "
+        "coordinates on convex cells, mean value coordinates on cells with hanging nodes); H1: "
+        "‖Π₁(u_h − u_ref)‖_H1 / ‖Π₁u_ref‖_H1 with Π₁ on each mesh, whose integral resolves the coarse "
+        "cell boundaries of non-nested meshes to the reference mesh size.",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
     text += ["| " + " | ".join([f, s, m, *cells]) + " |" for f, s, m, cells in lines]
     return "\n".join(text) + "\n"
 
 
 def convergence_latex(ds: xr.Dataset) -> str:
     hs, lines = _convergence_grid(ds)
-    out = ["% Convergence on every mesh family: relative errors (order), paper's measure and H1.",
-           "% Generated by vemkit.report.tables.",
-           r"\begin{tabular}{lll" + "r" * len(hs) + "}", r"\hline",
-           " & ".join(["family", "stabilization", "measure"] + [f"$h = {h_label(h, True)}$" for h in hs]) + r" \\",
-           r"\hline"]
+    out = [
+        "% Convergence on every mesh family: relative errors (order), paper's measure and H1.",
+        "% Generated by vemkit.report.tables.",
+        r"\begin{tabular}{lll" + "r" * len(hs) + "}",
+        r"\hline",
+        " & ".join(["family", "stabilization", "measure"] + [f"$h = {h_label(h, True)}$" for h in hs]) + r" \\",
+        r"\hline",
+    ]
     out += [" & ".join(_latex_escape(x) for x in (f, s, m, *cells)) + r" \\" for f, s, m, cells in lines]
     out += [r"\hline", r"\end{tabular}"]
     return "\n".join(out) + "\n"

@@ -19,7 +19,6 @@ from contextlib import contextmanager, nullcontext
 import numpy as np
 
 from vemkit.exceptions import ConvergenceError, SceneError, TimeBudgetExceeded
-
 from vemkit.solvers.ssn import solve_ssn
 from vemkit.solvers.uzawa import solve_uzawa
 
@@ -49,7 +48,10 @@ def _budgeted(progress, budget, method: str):
             raise TimeBudgetExceeded(
                 f"{method} ran past solver.time_budget = {budget:g} s ({elapsed:.1f} s after "
                 f"{iteration} iterations); raise solver.time_budget or use a coarser mesh",
-                solver=method, iterations=iteration)
+                solver=method,
+                iterations=iteration,
+            )
+
     return watched
 
 
@@ -94,4 +96,6 @@ def solve(problem, solver_options: dict, progress=None, initial=None):
         raise ConvergenceError(
             f"{method}: floating-point failure during the solve ({error}); the scene's numbers are "
             "too large or too small for double precision: rescale the units (E, k, tractions)",
-            solver=method, reason="diverged") from error
+            solver=method,
+            reason="diverged",
+        ) from error

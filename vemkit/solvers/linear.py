@@ -47,8 +47,9 @@ def v_cycle_preconditioner(hierarchy):
         here.A = here.A.tocsr()
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
-    return spla.LinearOperator(levels[0].A.shape, dtype=float,
-                               matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b)))
+    return spla.LinearOperator(
+        levels[0].A.shape, dtype=float, matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
+    )
 
 
 class AMGSolver:
@@ -98,14 +99,17 @@ class AMGSolver:
         def callback(xk):
             count[0] += 1
 
-        x, info = spla.cg(A, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback)
+        x, info = spla.cg(
+            A, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback
+        )
         self.iterations = count[0]
         self.residual = float(np.linalg.norm(b - A @ x) / bnorm)
         if info != 0 or not np.all(np.isfinite(x)):
             raise LinearSolveError(
                 f"AMG-CG stopped after {count[0]} iterations at relative residual {self.residual:.2e} "
                 f"(asked {tol:.1e}); try solver.linear=direct",
-                solver="amg", iterations=count[0],
+                solver="amg",
+                iterations=count[0],
             )
         return x
 
@@ -130,7 +134,8 @@ class DirectSolver:
         except RuntimeError as exc:  # exactly singular
             raise LinearSolveError(
                 f"the stiffness matrix is singular ({exc}); is the body held (Dirichlet part)?",
-                solver="direct", iterations=0,
+                solver="direct",
+                iterations=0,
             ) from None
 
     def solve(self, b, x0=None, tol=None, A=None):
@@ -143,7 +148,8 @@ class DirectSolver:
         if not np.all(np.isfinite(x)):
             raise LinearSolveError(
                 "the direct solve produced non-finite values; the matrix is singular or badly scaled",
-                solver="direct", iterations=1,
+                solver="direct",
+                iterations=1,
             )
         return x
 

@@ -66,11 +66,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import linear_solver
-from vemkit.contact.boundary import rank_one_blocks
-from vemkit.solvers.ssn_steps import (ReducedSolver, direction_diagonal, line_search, stick_basis,
-                                      tangential_diagonal)
 from vemkit.solvers.solution import (
     ContactSolution,
     contact_residual,
@@ -78,6 +76,7 @@ from vemkit.solvers.solution import (
     residual_scale,
     young_modulus,
 )
+from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 GAMMA_FACTOR = 0.5  # gamma = GAMMA_FACTOR kd / (|Gamma_C| b_ref), see the module docstring
@@ -175,8 +174,14 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
             progress(k, newton.records[-1])
     if _converged(newton, point):
         return _finish(newton, point.u, point.lam, max_iterations)
-    _fail(problem, max_iterations, f"residual {np.sqrt(point.theta) / point.scale:.1e} > tol {tol:.0e}",
-          newton.records, newton.contrast, reason="max_iterations")
+    _fail(
+        problem,
+        max_iterations,
+        f"residual {np.sqrt(point.theta) / point.scale:.1e} > tol {tol:.0e}",
+        newton.records,
+        newton.contrast,
+        reason="max_iterations",
+    )
 
 
 def _plain_start(problem, linear, tol, x0=None):
@@ -189,8 +194,16 @@ def _plain_start(problem, linear, tol, x0=None):
     except LinearSolveError as exc:
         raise ConvergenceError(f"ssn: {exc}", solver="ssn", reason="linear_solver_failed", iterations=0) from exc
     baseline = max(base.iterations, 1) / max(np.log10(1.0 / max(INITIAL_TOL, tol)), 1.0)
-    newton = _Newton(problem, tol, base, baseline, start, max(base.iterations, 1), {"linear": base.method},
-                     float(np.linalg.norm(problem.load)))
+    newton = _Newton(
+        problem,
+        tol,
+        base,
+        baseline,
+        start,
+        max(base.iterations, 1),
+        {"linear": base.method},
+        float(np.linalg.norm(problem.load)),
+    )
     return newton, u
 
 
@@ -208,8 +221,17 @@ def _finish(newton, u, lam, iterations):
     info = newton.info
     info["residual"] = contact_residual(newton.problem, u, lam)
     info["amg_rebuilds"] = newton.reduced.rebuilds if newton.reduced is not None else 0
-    return ContactSolution(u, lam, iterations, True, "ssn", history_arrays(newton.records),
-                           newton.linear_total, time.perf_counter() - newton.start, info)
+    return ContactSolution(
+        u,
+        lam,
+        iterations,
+        True,
+        "ssn",
+        history_arrays(newton.records),
+        newton.linear_total,
+        time.perf_counter() - newton.start,
+        info,
+    )
 
 
 def _prepare(newton, t):
@@ -268,8 +290,11 @@ def _converged(newton, point) -> bool:
     problem = newton.problem
     cb, law = problem.contact, problem.law
     stiff = cb.weight * np.minimum(law.normal_stiffness(point.t), newton.stiffness_cap) * np.abs(point.t + cb.gap)
-    size = newton.K_abs @ np.abs(point.u) + np.abs(problem.load) + cb.scatter(stiff, newton.zero_tangential,
-                                                                              problem.n_dofs)
+    size = (
+        newton.K_abs @ np.abs(point.u)
+        + np.abs(problem.load)
+        + cb.scatter(stiff, newton.zero_tangential, problem.n_dofs)
+    )
     point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
     return residual <= point.floor
 
@@ -277,8 +302,7 @@ def _converged(newton, point) -> bool:
 def _slope(newton, point, du_tau, du) -> float:
     """Directional derivative of the energy at ``point`` along du (one-sided for |u_tau|)."""
     cb, law = newton.problem.contact, newton.problem.law
-    friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau),
-                        cb.magnitude(du_tau))
+    friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau), cb.magnitude(du_tau))
     return float(point.gradient @ du + law.k_friction * (cb.weight @ friction))
 
 
@@ -288,8 +312,14 @@ def _newton_iteration(newton, point, k) -> _Point:
     cb, n = problem.contact, problem.n_dofs
     du, lam_new, its, changes = _newton_direction(newton, point, k)
     if not (np.all(np.isfinite(du)) and np.all(np.isfinite(lam_new))):
-        _fail(problem, k, "non-finite Newton step", newton.records, max(newton.contrast, 2 * CONTRAST_WARNING),
-              reason="diverged")
+        _fail(
+            problem,
+            k,
+            "non-finite Newton step",
+            newton.records,
+            max(newton.contrast, 2 * CONTRAST_WARNING),
+            reason="diverged",
+        )
     u, lam = point.u, point.lam
     dlam = lam_new - lam
     full = _evaluate(newton, u + du, lam_new)

@@ -57,7 +57,7 @@ def disk_direction(newton, point, k, sets, solve):
         weight = np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0)
         return rank_one_blocks(cb, weight, cb.tangent, n) + rank_one_blocks(cb, weight, cb.tangent2, n)
 
-    A = (K + cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n))
+    A = K + cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n)
     if not law.reduced:  # the friction bound's derivative w p_tau'(t) (t1, t2) lambda_hat nu^T (unsymmetric)
         lam_hat = np.where(slip[:, None], slip_base, np.where(stick[:, None], lam, 0.0))
         along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]

@@ -27,8 +27,11 @@ EXPAND_SLOPE = 0.1  # ... "steeply": the slope at the full step is still this fr
 def direction_diagonal(K, cb, direction):
     """d_c^T K_cc d_c at each contact vertex (the stiffness diagonal in direction d)."""
     if cb.dimension == 3:
-        return sum(direction[:, a] * direction[:, b] * np.asarray(K[cb.dofs[:, a], cb.dofs[:, b]]).ravel()
-                   for a in range(3) for b in range(3))
+        return sum(
+            direction[:, a] * direction[:, b] * np.asarray(K[cb.dofs[:, a], cb.dofs[:, b]]).ravel()
+            for a in range(3)
+            for b in range(3)
+        )
     i, j = cb.dofs[:, 0], cb.dofs[:, 1]
     Kii = np.asarray(K[i, i]).ravel()
     Kjj = np.asarray(K[j, j]).ravel()
@@ -142,7 +145,8 @@ class ReducedSolver:
             raise LinearSolveError(
                 f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
                 f"try solver.linear=direct",
-                solver="amg", iterations=count[0],
+                solver="amg",
+                iterations=count[0],
             )
         return y, count[0]
 

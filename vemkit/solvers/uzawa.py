@@ -67,6 +67,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vemkit.exceptions import ConvergenceError, LinearSolveError, SceneError
 from vemkit.solvers.linear import linear_solver
 from vemkit.solvers.solution import (
     ContactSolution,
@@ -76,7 +77,6 @@ from vemkit.solvers.solution import (
     residual_scale,
 )
 from vemkit.solvers.uzawa_failures import boundary_compliance, fail, refuse
-from vemkit.exceptions import ConvergenceError, LinearSolveError, SceneError
 
 RHO_FACTOR = 1.5  # rho = RHO_FACTOR / (k_tau b mu_tau); stable below 2
 STAGNATION_WINDOW = 200  # no new smallest |u^n - u^{n-1}| within this many iterations: stop
@@ -192,8 +192,12 @@ def solve_uzawa(
             return _finish(state, 0)
         return _iterate(state, progress)
     except LinearSolveError as exc:
-        raise ConvergenceError(f"uzawa: {exc}", solver="uzawa", reason="linear_solver_failed",
-                               iterations=state.n if state is not None else 0) from exc
+        raise ConvergenceError(
+            f"uzawa: {exc}",
+            solver="uzawa",
+            reason="linear_solver_failed",
+            iterations=state.n if state is not None else 0,
+        ) from exc
 
 
 def _start(problem, linear, options, initial=None) -> _Uzawa:
@@ -201,16 +205,28 @@ def _start(problem, linear, options, initial=None) -> _Uzawa:
     start = time.perf_counter()
     cb, law = problem.contact, problem.law
     solver = linear_solver(problem.stiffness, linear, near_nullspace=problem.near_nullspace, tol=options["tol"])
-    u0, lam0 = (np.zeros(problem.n_dofs), cb.zero_multiplier()) if initial is None else \
-        (np.asarray(initial[0], float), cb.project(initial[1]))
-    state = _Uzawa(problem, solver, options, start, u0, lam0, {"linear": solver.method, "stop": options["stop"]},
-                   warm=initial is not None)
+    u0, lam0 = (
+        (np.zeros(problem.n_dofs), cb.zero_multiplier())
+        if initial is None
+        else (np.asarray(initial[0], float), cb.project(initial[1]))
+    )
+    state = _Uzawa(
+        problem,
+        solver,
+        options,
+        start,
+        u0,
+        lam0,
+        {"linear": solver.method, "stop": options["stop"]},
+        warm=initial is not None,
+    )
     rhs = problem.load - contact_force_vector(problem, state.u, state.lam)
     u_first = solver.solve(rhs, x0=None if initial is None else u0)
     state.linear_total += max(solver.iterations, 1)
     t_first = cb.normal_displacement(u_first) - cb.gap
     if cb.size == 0 or (
-        not np.any(law.normal_pressure(t_first)) and not np.any(law.friction_bound(t_first))
+        not np.any(law.normal_pressure(t_first))
+        and not np.any(law.friction_bound(t_first))
         and not np.any(rhs - problem.load)
     ):
         state.u = u_first
@@ -230,8 +246,17 @@ def _start(problem, linear, options, initial=None) -> _Uzawa:
 
 
 def _finish(state, iterations):
-    return ContactSolution(state.u, state.lam, iterations, True, "uzawa", history_arrays(state.records),
-                           state.linear_total, time.perf_counter() - state.start, state.info)
+    return ContactSolution(
+        state.u,
+        state.lam,
+        iterations,
+        True,
+        "uzawa",
+        history_arrays(state.records),
+        state.linear_total,
+        time.perf_counter() - state.start,
+        state.info,
+    )
 
 
 def _step_length(state, bound) -> float:
@@ -315,8 +340,16 @@ def _advance(state, u_new, lam_new, rhs, dlam, lin_its):
     scale = residual_scale(float(np.linalg.norm(problem.load)), float(np.linalg.norm(new_forces)))
     residual = float(np.linalg.norm(new_forces - state.forces)) / scale
     state.forces = new_forces
-    state.records.append({"du": state.du, "dlambda": dlam, "residual": residual, "rho": state.rho,
-                          "linear_iterations": lin_its, "stop_refused": 0.0})
+    state.records.append(
+        {
+            "du": state.du,
+            "dlambda": dlam,
+            "residual": residual,
+            "rho": state.rho,
+            "linear_iterations": lin_its,
+            "stop_refused": 0.0,
+        }
+    )
 
 
 def _watch_progress(state):

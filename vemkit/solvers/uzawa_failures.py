@@ -28,8 +28,11 @@ def boundary_compliance(solver, problem, direction, iterations=20, rtol=1e-3):
     estimate, solves = 0.0, 0
     for _ in range(iterations):
         load = cb.times(sqrt_w, v)
-        rhs = cb.scatter(zero, load, problem.n_dofs) if direction == "tangent" else \
-            cb.scatter(load, cb.zero_multiplier(), problem.n_dofs)
+        rhs = (
+            cb.scatter(zero, load, problem.n_dofs)
+            if direction == "tangent"
+            else cb.scatter(load, cb.zero_multiplier(), problem.n_dofs)
+        )
         x = solver.solve(rhs, tol=1e-6)
         solves += max(solver.iterations, 1)
         comp = cb.tangential_displacement(x) if direction == "tangent" else cb.normal_displacement(x)
@@ -52,7 +55,9 @@ def refuse(state):
         f"uzawa stopped after {state.n} iterations by the {'|Δλ|' if stopped_by == 'dlambda' else '|Δu|'} test "
         f"but the discrete problem residual is {check['worst']:.1e} (accepted {accept:.0e}): "
         f"try --set solver.stop=both, smaller solver.eps_u/eps_lambda, or --set solver.method=ssn",
-        solver="uzawa", reason="inaccurate_stop", iterations=state.n,
+        solver="uzawa",
+        reason="inaccurate_stop",
+        iterations=state.n,
     )
 
 
@@ -85,7 +90,7 @@ def fail(state, what, reason):
     if friction_factor >= 1.9:
         raise ConvergenceError(
             f"{head}: solver.rho = {rho_n:.3g} is too large for contact.friction.k = {law.k_friction:g} "
-            f"(stable below {2.0 / (law.k_friction ** 2 * mu_tau):.3g}); try a smaller solver.rho or solver.method=ssn",
+            f"(stable below {2.0 / (law.k_friction**2 * mu_tau):.3g}); try a smaller solver.rho or solver.method=ssn",
             **typed,
         )
     if not law.reduced:

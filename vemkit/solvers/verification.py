@@ -49,14 +49,32 @@ import numpy as np
 from vemkit.exceptions import InputError, LinearSolveError, SolveError, TimeBudgetExceeded
 from vemkit.solvers.solution import contact_force_vector, contact_residual, residual_scale
 
-FAILURE_CLASSES = ("diverged", "stagnated", "max_iterations", "inaccurate_stop", "other", "time_budget",
-                   "check_failed", "linear_solver_failed", "invalid_input", "unexpected_exception")
+FAILURE_CLASSES = (
+    "diverged",
+    "stagnated",
+    "max_iterations",
+    "inaccurate_stop",
+    "other",
+    "time_budget",
+    "check_failed",
+    "linear_solver_failed",
+    "invalid_input",
+    "unexpected_exception",
+)
 _NOT_CONVERGED = FAILURE_CLASSES[:7]
 #: status code i <-> STATUS_MEANINGS[i] (netCDF flag_values / flag_meanings)
 STATUS_MEANINGS = ("converged",) + tuple(
-    ("not_converged_" if c in _NOT_CONVERGED else "error_") + c for c in FAILURE_CLASSES)
-CHECK_KEYS = ("equilibrium", "multiplier_bound", "complementarity", "normal_law", "friction_bound",
-              "slip_direction", "stick")
+    ("not_converged_" if c in _NOT_CONVERGED else "error_") + c for c in FAILURE_CLASSES
+)
+CHECK_KEYS = (
+    "equilibrium",
+    "multiplier_bound",
+    "complementarity",
+    "normal_law",
+    "friction_bound",
+    "slip_direction",
+    "stick",
+)
 DEFAULT_CHECK_TOL = 1e-6
 
 
@@ -100,8 +118,11 @@ def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL) -> d
         if cb.fixed is not None:  # a prescribed component's reaction is the constraint's
             r = np.where(cb.fixed, 0.0, r)
         r_nu = np.sum(r * cb.normal, axis=1)
-        r_tau = np.sum(r * cb.tangent, axis=1) if cb.dimension == 2 else \
-            np.stack([np.sum(r * t, axis=1) for t in cb.tangents], axis=1)
+        r_tau = (
+            np.sum(r * cb.tangent, axis=1)
+            if cb.dimension == 2
+            else np.stack([np.sum(r * t, axis=1) for t in cb.tangents], axis=1)
+        )
         scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(contact_force_vector(problem, u, lam))))
         t = cb.normal_displacement(u) - cb.gap
         slip = cb.tangential_displacement(u)
@@ -165,8 +186,14 @@ def prebuilt_linear_supported() -> bool:
         return False
 
 
-def guarded_solve(problem, solver_options: dict, *, linear=None, time_budget: float | None = None,
-                  check_tol: float | None = DEFAULT_CHECK_TOL) -> Outcome:
+def guarded_solve(
+    problem,
+    solver_options: dict,
+    *,
+    linear=None,
+    time_budget: float | None = None,
+    check_tol: float | None = DEFAULT_CHECK_TOL,
+) -> Outcome:
     """Run the configured solver on ``problem``; never raises (see :class:`Outcome`).
 
     ``linear``: a prebuilt solver of ``problem.stiffness`` (``vemkit.solvers.linear.linear_solver``),
@@ -183,8 +210,11 @@ def guarded_solve(problem, solver_options: dict, *, linear=None, time_budget: fl
 
     def progress(_iteration, _record):
         if time_budget is not None and time.perf_counter() - start > time_budget:
-            raise TimeBudgetExceeded(f"{method} ran past its time budget of {time_budget:g} s "
-                                     f"after {_iteration} iterations", solver=method, iterations=_iteration)
+            raise TimeBudgetExceeded(
+                f"{method} ran past its time budget of {time_budget:g} s after {_iteration} iterations",
+                solver=method,
+                iterations=_iteration,
+            )
 
     try:
         solution = solve(problem, options, progress=progress)
@@ -196,6 +226,8 @@ def guarded_solve(problem, solver_options: dict, *, linear=None, time_budget: fl
     if check_tol is not None and not checks["passed"]:
         worst = max(CHECK_KEYS, key=lambda k: checks[k])
         outcome.status = "check_failed"
-        outcome.message = (f"{method} reported convergence after {solution.iterations} iterations but the "
-                           f"independent check fails: {worst} = {checks[worst]:.1e} > {check_tol:.0e}")
+        outcome.message = (
+            f"{method} reported convergence after {solution.iterations} iterations but the "
+            f"independent check fails: {worst} = {checks[worst]:.1e} > {check_tol:.0e}"
+        )
     return outcome

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from vemkit.contact.problem import scene_problem
 from vemkit.config.limits import check_resources, estimate_resources
+from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.curves import domain_curves
@@ -41,8 +41,8 @@ from vemkit.solvers.solution import contact_state
 from vemkit.studies.convergence import RECORD_KEYS
 from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
-from vemkit.vem.space import VirtualElementSpace
 from vemkit.vem.quadrature import cell_averages
+from vemkit.vem.space import VirtualElementSpace
 
 
 @dataclass(frozen=True)
@@ -69,8 +69,13 @@ class AdaptivitySettings:
         (e.g. ``vemkit adapt --max-dofs``) caps ``adaptivity.max_dofs``."""
         options = scene.adaptivity_options
         cap = options["max_dofs"] if max_dofs is None else min(options["max_dofs"], int(max_dofs))
-        return cls(theta=options["marking"]["dorfler"], target=options["target"], max_dofs=cap,
-                   max_steps=options["max_steps"], max_hanging=options["max_hanging"])
+        return cls(
+            theta=options["marking"]["dorfler"],
+            target=options["target"],
+            max_dofs=cap,
+            max_steps=options["max_steps"],
+            max_hanging=options["max_hanging"],
+        )
 
 
 @dataclass
@@ -108,8 +113,16 @@ def scene_indicators(scene, problem, solution) -> dict:
         body = cell_averages(mesh, _pair(scene.body_force), triangles, parent)
     neumann = {side: _pair(scene.traction(side)) for side in scene.neumann_sides}
     contact = contact_tractions(problem, solution)
-    return error_indicators(problem.space, problem.node_values(solution.u), problem.lam, problem.mu,
-                            problem.stabilization, body_force=body, neumann=neumann, contact=contact)
+    return error_indicators(
+        problem.space,
+        problem.node_values(solution.u),
+        problem.lam,
+        problem.mu,
+        problem.stabilization,
+        body_force=body,
+        neumann=neumann,
+        contact=contact,
+    )
 
 
 def curved_sides(domain_spec) -> list:
@@ -151,6 +164,7 @@ def _coarse_field(problem, solution):
         cells[cells < 0] = nearest_cells(problem.mesh, points[cells < 0], within_diameter=False)
         values = projection.evaluate(cells, points)
         return values[:, 0].reshape(np.shape(x)), values[:, 1].reshape(np.shape(x))
+
     return field
 
 
@@ -172,8 +186,9 @@ def _prolongated_multiplier(refined, problem, solution, new_problem):
 
 def _checked(problem, solution, solver_options) -> dict:
     """The independent check of ``vemkit solve``; VerificationError naming the adapted mesh if it fails."""
-    return verified(problem, solution, solver_options, where=f" on the {problem.mesh.n_cells}-cell adapted mesh",
-                    source="")
+    return verified(
+        problem, solution, solver_options, where=f" on the {problem.mesh.n_cells}-cell adapted mesh", source=""
+    )
 
 
 def _solve_step(scene, mesh, previous, warm_start: bool, verify: bool, max_dofs: int):
@@ -181,21 +196,36 @@ def _solve_step(scene, mesh, previous, warm_start: bool, verify: bool, max_dofs:
     start = time.perf_counter()
     problem = scene_problem(scene, mesh)
     if problem.n_dofs > max_dofs:  # only the scene's own mesh can be too fine: refined meshes are checked
-        raise InputError(f"the scene's mesh has {problem.n_dofs} unknowns, more than adaptivity.max_dofs = {max_dofs}"
-                         " (or --max-dofs); use a coarser discretization.mesh or raise adaptivity.max_dofs",
-                         key="adaptivity.max_dofs")
+        raise InputError(
+            f"the scene's mesh has {problem.n_dofs} unknowns, more than adaptivity.max_dofs = {max_dofs}"
+            " (or --max-dofs); use a coarser discretization.mesh or raise adaptivity.max_dofs",
+            key="adaptivity.max_dofs",
+        )
     problem.info["contact_sides"] = tuple(scene.contact_sides)
     initial = prolongated_start(*previous, problem) if warm_start and previous is not None else None
     solution = solve(problem, scene.solver_options, initial=initial)
     checks = _checked(problem, solution, scene.solver_options) if verify else {}
-    record = {"n_dofs": problem.n_dofs, "n_cells": mesh.n_cells, "iterations": int(solution.iterations),
-              "linear_iterations": int(solution.linear_iterations), "solve_time": time.perf_counter() - start,
-              "warm_start": int(bool(solution.info.get("warm_start", initial is not None)))}
+    record = {
+        "n_dofs": problem.n_dofs,
+        "n_cells": mesh.n_cells,
+        "iterations": int(solution.iterations),
+        "linear_iterations": int(solution.linear_iterations),
+        "solve_time": time.perf_counter() - start,
+        "warm_start": int(bool(solution.info.get("warm_start", initial is not None))),
+    }
     return problem, solution, record, checks
 
 
-def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None, observe=None,
-          warm_start: bool = True, verify: bool = True) -> AdaptiveRun:
+def adapt(
+    scene,
+    settings: AdaptivitySettings,
+    *,
+    true_error=None,
+    progress=None,
+    observe=None,
+    warm_start: bool = True,
+    verify: bool = True,
+) -> AdaptiveRun:
     """Run the loop from the scene's own mesh (module docstring). ``settings.theta = 1`` marks every
     cell: uniform refinement of the scene's mesh, the yardstick of the adaptive runs.
 
@@ -223,14 +253,25 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
         run = AdaptiveRun(problem, solution, found, (run.history if run else []) + [record], checks=checks)
         reason = _stop_reason(found["estimate"], step, settings)
         if reason is None:
-            marked = np.arange(mesh.n_cells) if settings.theta >= 1.0 else dorfler_marking(found["indicator"], settings.theta)
+            marked = (
+                np.arange(mesh.n_cells)
+                if settings.theta >= 1.0
+                else dorfler_marking(found["indicator"], settings.theta)
+            )
             refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
             reason = _limit_reason(refined.mesh, settings.max_dofs, problem.space.element)  # before it is solved
             if reason is None and refined.refined.size == 0:
                 reason = "unrefinable"
-            mesh = refined.mesh if reason is not None else checked_mesh(  # as every mesh a command solves
-                refined.mesh, f"the refined mesh of step {step + 2}", "please report it; meanwhile try another mesh size")
+            mesh = (
+                refined.mesh
+                if reason is not None
+                else checked_mesh(  # as every mesh a command solves
+                    refined.mesh,
+                    f"the refined mesh of step {step + 2}",
+                    "please report it; meanwhile try another mesh size",
+                )
+            )
             previous = (refined, problem, solution)
         record["wall_time"] = time.perf_counter() - start
         if progress is not None:
@@ -245,7 +286,7 @@ def adapt(scene, settings: AdaptivitySettings, *, true_error=None, progress=None
 
 
 def _limit_reason(mesh, max_dofs: int, element):
-    """"max_dofs" or "memory" when solving ``mesh`` with ``element`` would pass ``max_dofs`` or the memory
+    """ "max_dofs" or "memory" when solving ``mesh`` with ``element`` would pass ``max_dofs`` or the memory
     this machine has (the prediction of ``vemkit.config.limits`` from the space's nodes), else None."""
     estimate = estimate_resources(mesh.n_cells, VirtualElementSpace(mesh, element).n_nodes)
     if estimate.dofs > max_dofs:
@@ -287,8 +328,10 @@ _STEP_VARIABLES = (  # (name, long name, units) of what only the adaptive loop r
     ("solve_time", "assembly, contact solve and independent check", "s"),
 )
 #: name: (long name, units) of the per-step history; n_dofs, n_cells, iterations as in the convergence records
-HISTORY_ATTRS = {**{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
-                 **{name: (long_name, units) for name, long_name, units in _STEP_VARIABLES}}
+HISTORY_ATTRS = {
+    **{name: RECORD_KEYS[name] for name in ("n_dofs", "n_cells", "iterations")},
+    **{name: (long_name, units) for name, long_name, units in _STEP_VARIABLES},
+}
 _INTEGER_HISTORY = ("n_dofs", "n_cells", "marked", "skipped", "iterations", "linear_iterations", "warm_start")
 
 
@@ -300,11 +343,20 @@ def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
         with floating_point_errors_raise():
             ds = solution_dataset(run.problem, run.solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
     except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
-        raise ResultError(f"the stresses of the solution overflow double precision ({error}); "
-                          "rescale the units of the scene (E, k, tractions)") from None
-    ds["error_indicator"] = ("mesh2d_nFaces", run.indicators["indicator"],
-                             {"long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
-                              "mesh": "mesh2d", "location": "face", "units": "sqrt(energy)"})
+        raise ResultError(
+            f"the stresses of the solution overflow double precision ({error}); "
+            "rescale the units of the scene (E, k, tractions)"
+        ) from None
+    ds["error_indicator"] = (
+        "mesh2d_nFaces",
+        run.indicators["indicator"],
+        {
+            "long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
+            "mesh": "mesh2d",
+            "location": "face",
+            "units": "sqrt(energy)",
+        },
+    )
     steps = len(run.history)
     for name, (long_name, units) in HISTORY_ATTRS.items():
         values = [record.get(name, 0 if name in ("marked", "skipped") else None) for record in run.history]
@@ -313,7 +365,12 @@ def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
         dtype = np.int64 if name in _INTEGER_HISTORY else float
         ds[f"adapt_{name}"] = ("adapt_step", np.asarray(values, dtype=dtype), {"long_name": long_name, "units": units})
     ds = ds.assign_coords(adapt_step=("adapt_step", np.arange(steps), {"long_name": "adaptive step"}))
-    ds.attrs.update({"adapt_stop_reason": run.reason, "adapt_steps": steps,
-                     "adapt_estimate": float(run.history[-1]["estimate"]),
-                     "adapt_wall_time": float(sum(r["wall_time"] for r in run.history))})
+    ds.attrs.update(
+        {
+            "adapt_stop_reason": run.reason,
+            "adapt_steps": steps,
+            "adapt_estimate": float(run.history[-1]["estimate"]),
+            "adapt_wall_time": float(sum(r["wall_time"] for r in run.history)),
+        }
+    )
     return ds

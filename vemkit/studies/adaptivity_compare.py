@@ -26,8 +26,11 @@ ASYMPTOTIC_FROM = 8.0  # fit the rate over the steps with >= this x the first st
 
 def history(ds) -> dict:
     """The per-step arrays of an adaptive file: n_dofs, estimate, true_error(_h1), wall_time, ... (floats)."""
-    return {name[len("adapt_"):]: np.asarray(ds[name].values, dtype=float)
-            for name in ds.data_vars if name.startswith("adapt_")}
+    return {
+        name[len("adapt_") :]: np.asarray(ds[name].values, dtype=float)
+        for name in ds.data_vars
+        if name.startswith("adapt_")
+    }
 
 
 def fitted_rate(dofs, error, start_factor: float = ASYMPTOTIC_FROM) -> dict:
@@ -37,8 +40,13 @@ def fitted_rate(dofs, error, start_factor: float = ASYMPTOTIC_FROM) -> dict:
     if use.sum() < 3:
         use = np.arange(dofs.size) >= max(0, dofs.size - 3)
     slope, intercept = np.polyfit(np.log(dofs[use]), np.log(error[use]), 1)
-    return {"rate": float(slope), "constant": float(np.exp(intercept)), "from_dofs": int(dofs[use].min()),
-            "to_dofs": int(dofs[use].max()), "points": int(use.sum())}
+    return {
+        "rate": float(slope),
+        "constant": float(np.exp(intercept)),
+        "from_dofs": int(dofs[use].min()),
+        "to_dofs": int(dofs[use].max()),
+        "points": int(use.sum()),
+    }
 
 
 def dofs_at_error(dofs, error, target: float):
@@ -59,7 +67,7 @@ def _time_to(steps: dict, target: float, cumulative: bool):
     if reached.size == 0:
         return None
     k = int(reached[0])
-    return float(np.sum(steps["wall_time"][:k + 1]) if cumulative else steps["solve_time"][k])
+    return float(np.sum(steps["wall_time"][: k + 1]) if cumulative else steps["solve_time"][k])
 
 
 def compare(adaptive, uniform, error: str = "true_error_h1", targets=(0.01,)) -> dict:
@@ -75,15 +83,29 @@ def compare(adaptive, uniform, error: str = "true_error_h1", targets=(0.01,)) ->
     finest = float(uniform["error"][-1])
     adaptive_dofs = dofs_at_error(adaptive["n_dofs"], adaptive["error"], finest)
     out["finest_uniform"] = {
-        "error": finest, "uniform_dofs": int(uniform["n_dofs"][-1]), "adaptive_dofs": adaptive_dofs,
+        "error": finest,
+        "uniform_dofs": int(uniform["n_dofs"][-1]),
+        "adaptive_dofs": adaptive_dofs,
         "dofs_ratio": None if adaptive_dofs is None else float(uniform["n_dofs"][-1] / adaptive_dofs),
-        "uniform_time": float(uniform["solve_time"][-1]), "adaptive_time": _time_to(adaptive, finest, True)}
+        "uniform_time": float(uniform["solve_time"][-1]),
+        "adaptive_time": _time_to(adaptive, finest, True),
+    }
     out["targets"] = []
     for target in targets:
-        a, u = dofs_at_error(adaptive["n_dofs"], adaptive["error"], target), dofs_at_error(uniform["n_dofs"], uniform["error"], target)
-        out["targets"].append({"target": float(target), "adaptive_dofs": a, "uniform_dofs": u,
-                               "dofs_ratio": None if a is None or u is None else float(u / a),
-                               "adaptive_time": _time_to(adaptive, target, True), "uniform_time": _time_to(uniform, target, False)})
+        a, u = (
+            dofs_at_error(adaptive["n_dofs"], adaptive["error"], target),
+            dofs_at_error(uniform["n_dofs"], uniform["error"], target),
+        )
+        out["targets"].append(
+            {
+                "target": float(target),
+                "adaptive_dofs": a,
+                "uniform_dofs": u,
+                "dofs_ratio": None if a is None or u is None else float(u / a),
+                "adaptive_time": _time_to(adaptive, target, True),
+                "uniform_time": _time_to(uniform, target, False),
+            }
+        )
     return out
 
 
@@ -93,27 +115,38 @@ def _number(value, fmt: str) -> str:
 
 def summary_markdown(comparisons: dict) -> str:
     """{scene: compare(...)} as the Markdown table of results/adaptive/summary.md."""
-    lines = ["# Adaptive against uniform refinement", "",
-             "Rates: slope of log(error) against log(DOFs) over the asymptotic steps (optimal k = 1: −0.5). "
-             "DOFs ratio: uniform / adaptive DOFs at the finest uniform step's error. Times: the adaptive loop's "
-             "cumulative wall time to that error against the uniform run's single solve there.", "",
-             "| scene | error | rate adaptive | rate uniform | finest uniform error | DOFs uniform | DOFs adaptive "
-             "| DOFs ratio | time adaptive [s] | time uniform [s] | effectivity (adaptive) |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    lines = [
+        "# Adaptive against uniform refinement",
+        "",
+        "Rates: slope of log(error) against log(DOFs) over the asymptotic steps (optimal k = 1: −0.5). "
+        "DOFs ratio: uniform / adaptive DOFs at the finest uniform step's error. Times: the adaptive loop's "
+        "cumulative wall time to that error against the uniform run's single solve there.",
+        "",
+        "| scene | error | rate adaptive | rate uniform | finest uniform error | DOFs uniform | DOFs adaptive "
+        "| DOFs ratio | time adaptive [s] | time uniform [s] | effectivity (adaptive) |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|",
+    ]
     for scene, c in comparisons.items():
         f = c["finest_uniform"]
         eff = c.get("effectivity_adaptive")
-        lines.append(f"| {scene} | {c['error']} | {c['rates']['adaptive']['rate']:.3f} | {c['rates']['uniform']['rate']:.3f} | "
-                     f"{f['error']:.3e} | {f['uniform_dofs']} | {_number(f['adaptive_dofs'], '.0f')} | "
-                     f"{_number(f['dofs_ratio'], '.2f')} | {_number(f['adaptive_time'], '.2f')} | {f['uniform_time']:.2f} | "
-                     f"{'—' if eff is None else f'{eff[0]:.2f} – {eff[1]:.2f}'} |")
-    lines += ["", "| scene | target error | DOFs adaptive | DOFs uniform | DOFs ratio | time adaptive [s] | time uniform [s] |",
-              "|---|---:|---:|---:|---:|---:|---:|"]
+        lines.append(
+            f"| {scene} | {c['error']} | {c['rates']['adaptive']['rate']:.3f} | {c['rates']['uniform']['rate']:.3f} | "
+            f"{f['error']:.3e} | {f['uniform_dofs']} | {_number(f['adaptive_dofs'], '.0f')} | "
+            f"{_number(f['dofs_ratio'], '.2f')} | {_number(f['adaptive_time'], '.2f')} | {f['uniform_time']:.2f} | "
+            f"{'—' if eff is None else f'{eff[0]:.2f} – {eff[1]:.2f}'} |"
+        )
+    lines += [
+        "",
+        "| scene | target error | DOFs adaptive | DOFs uniform | DOFs ratio | time adaptive [s] | time uniform [s] |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for scene, c in comparisons.items():
         for t in c["targets"]:
-            lines.append(f"| {scene} | {100 * t['target']:.3g} % | {_number(t['adaptive_dofs'], '.0f')} | "
-                         f"{_number(t['uniform_dofs'], '.0f')} | {_number(t['dofs_ratio'], '.2f')} | "
-                         f"{_number(t['adaptive_time'], '.2f')} | {_number(t['uniform_time'], '.2f')} |")
+            lines.append(
+                f"| {scene} | {100 * t['target']:.3g} % | {_number(t['adaptive_dofs'], '.0f')} | "
+                f"{_number(t['uniform_dofs'], '.0f')} | {_number(t['dofs_ratio'], '.2f')} | "
+                f"{_number(t['adaptive_time'], '.2f')} | {_number(t['uniform_time'], '.2f')} |"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -129,8 +162,13 @@ def run_settings(case: dict, mode: str):
 
     if mode == "uniform":
         return AdaptivitySettings(theta=1.0, target=1e-9, max_dofs=10**8, max_steps=int(case["uniform_steps"]))
-    return AdaptivitySettings(theta=case["theta"], target=case["target"], max_dofs=case["max_dofs"],
-                              max_steps=case["max_steps"], max_hanging=case.get("max_hanging"))
+    return AdaptivitySettings(
+        theta=case["theta"],
+        target=case["target"],
+        max_dofs=case["max_dofs"],
+        max_steps=case["max_steps"],
+        max_hanging=case.get("max_hanging"),
+    )
 
 
 def reference_dataset(scene, reference: dict, theta: float = 0.5, progress=None):
@@ -145,7 +183,7 @@ def reference_dataset(scene, reference: dict, theta: float = 0.5, progress=None)
     from vemkit.studies.adaptivity import AdaptivitySettings, adapt, adaptive_dataset, curved_sides
     from vemkit.studies.scene_solve import solve_scene
 
-    (kind, size), = reference.items()
+    ((kind, size),) = reference.items()
     if kind == "uniform":
         mesh, circles = scene_mesh(scene), curved_sides(scene.domain)
         for _ in range(int(size)):
@@ -158,8 +196,19 @@ def reference_dataset(scene, reference: dict, theta: float = 0.5, progress=None)
     return ds
 
 
-def tradeoff_records(scene, reference, *, theta: float, max_dofs: int, solvers, tolerances, stabilization: str,
-                     max_iterations=None, label: str = "adaptive", progress=None) -> list[dict]:
+def tradeoff_records(
+    scene,
+    reference,
+    *,
+    theta: float,
+    max_dofs: int,
+    solvers,
+    tolerances,
+    stabilization: str,
+    max_iterations=None,
+    label: str = "adaptive",
+    progress=None,
+) -> list[dict]:
     """The adaptive loop as configurations of the speed-accuracy study (``vemkit.studies.tradeoff``): one
     record per step and (solver, tolerance), errors against the study's ``reference`` (a ReferenceSolution;
     the common-refinement measure of ``adaptivity_errors``, exact where the adapted mesh is finer), cost =
@@ -180,8 +229,15 @@ def tradeoff_records(scene, reference, *, theta: float, max_dofs: int, solvers, 
                 options += [f"solver.eps_u={float(tol)}", f"solver.eps_lambda={float(tol)}"]
             if (max_iterations or {}).get(solver):
                 options.append(f"solver.max_iterations={int(max_iterations[solver])}")
-            base = {"family": label, "family_name": f"adaptive (theta {theta:g})", "solver": solver, "tol": float(tol),
-                    "stabilization": stabilization, "n": int(scene.mesh_options.get("n", 0)), "mesh_time": 0.0}
+            base = {
+                "family": label,
+                "family_name": f"adaptive (theta {theta:g})",
+                "solver": solver,
+                "tol": float(tol),
+                "stabilization": stabilization,
+                "n": int(scene.mesh_options.get("n", 0)),
+                "mesh_time": 0.0,
+            }
             spent = [0.0]
 
             def record(step, run, base=base, spent=spent):
@@ -189,21 +245,50 @@ def tradeoff_records(scene, reference, *, theta: float, max_dofs: int, solvers, 
                 spent[0] += r["wall_time"]
                 edges = mesh.vertices[mesh.edges]
                 found = reference_errors(mesh, run.problem.projected(run.solution.u), reference)
-                records.append({**base, "n_dofs": int(r["n_dofs"]), "n_cells": int(r["n_cells"]),
-                                "h_min": float(np.min(np.linalg.norm(edges[:, 1] - edges[:, 0], axis=1))),
-                                "iterations": int(r["iterations"]), "status": 0, "message": f"step {step + 1}",
-                                "wall_time": float(r["solve_time"]), "assembly_time": 0.0, "cost_time": spent[0],
-                                "residual": float(run.checks.get("check_worst", np.nan)), **found})
+                records.append(
+                    {
+                        **base,
+                        "n_dofs": int(r["n_dofs"]),
+                        "n_cells": int(r["n_cells"]),
+                        "h_min": float(np.min(np.linalg.norm(edges[:, 1] - edges[:, 0], axis=1))),
+                        "iterations": int(r["iterations"]),
+                        "status": 0,
+                        "message": f"step {step + 1}",
+                        "wall_time": float(r["solve_time"]),
+                        "assembly_time": 0.0,
+                        "cost_time": spent[0],
+                        "residual": float(run.checks.get("check_worst", np.nan)),
+                        **found,
+                    }
+                )
                 if progress is not None:
                     progress(records[-1])
 
             try:
-                adapt(run_scene.with_overrides(options), AdaptivitySettings(theta=theta, target=1e-9, max_dofs=max_dofs,
-                                                                           max_steps=1000), observe=record)
+                adapt(
+                    run_scene.with_overrides(options),
+                    AdaptivitySettings(theta=theta, target=1e-9, max_dofs=max_dofs, max_steps=1000),
+                    observe=record,
+                )
             except Exception as exc:  # noqa: BLE001 - a failed configuration is a record, as in tradeoff.run_family
                 outcome = failed(solver, exc, "solve")
                 nan = float("nan")
-                records.append({**base, "n_dofs": 0, "n_cells": 0, "h_min": nan, "iterations": outcome.iterations,
-                                "status": outcome.code, "message": outcome.message, "wall_time": nan, "assembly_time": 0.0,
-                                "cost_time": nan, "residual": nan, "error_h1": nan, "error_h1_semi": nan, "error_l2": nan})
+                records.append(
+                    {
+                        **base,
+                        "n_dofs": 0,
+                        "n_cells": 0,
+                        "h_min": nan,
+                        "iterations": outcome.iterations,
+                        "status": outcome.code,
+                        "message": outcome.message,
+                        "wall_time": nan,
+                        "assembly_time": 0.0,
+                        "cost_time": nan,
+                        "residual": nan,
+                        "error_h1": nan,
+                        "error_h1_semi": nan,
+                        "error_l2": nan,
+                    }
+                )
     return records

@@ -25,10 +25,10 @@ import numpy as np
 
 from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
+from vemkit.mesh.locate import locate_points, nearest_cells
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.reference_file import read_reference_file
 from vemkit.studies.tradeoff import check_reference_scene
-from vemkit.mesh.locate import locate_points, nearest_cells
 from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import relative_exact_errors
 from vemkit.vem.quadrature import reference_quadrature
@@ -41,8 +41,11 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     if np.any(cells < 0):
         cells[cells < 0] = nearest_cells(mesh, points[cells < 0])
     if np.any(cells < 0):
-        raise InputError("adaptivity.reference: the reference mesh covers points outside the adapted mesh "
-                         "(another body?); give a solution file of this scene", key="adaptivity.reference")
+        raise InputError(
+            "adaptivity.reference: the reference mesh covers points outside the adapted mesh "
+            "(another body?); give a solution file of this scene",
+            key="adaptivity.reference",
+        )
     n_ref = reference.mesh.n_cells
     low, high = np.full(n_ref, np.iinfo(np.int64).max), np.full(n_ref, -1)
     np.minimum.at(low, ref_cells, cells)
@@ -52,8 +55,12 @@ def _common_quadrature(mesh, reference: ReferenceSolution):
     fine_ref = locate_points(reference.mesh, fine_points)
     take = (fine_ref >= 0) & split[np.maximum(fine_ref, 0)]
     keep = ~split[ref_cells]
-    return (np.concatenate([points[keep], fine_points[take]]), np.concatenate([weights[keep], fine_weights[take]]),
-            np.concatenate([cells[keep], fine_cells[take]]), np.concatenate([ref_cells[keep], fine_ref[take]]))
+    return (
+        np.concatenate([points[keep], fine_points[take]]),
+        np.concatenate([weights[keep], fine_weights[take]]),
+        np.concatenate([cells[keep], fine_cells[take]]),
+        np.concatenate([ref_cells[keep], fine_ref[take]]),
+    )
 
 
 def reference_errors(mesh, mine, reference: ReferenceSolution) -> dict:
@@ -68,9 +75,12 @@ def reference_errors(mesh, mine, reference: ReferenceSolution) -> dict:
     grad = mine.gradient_at(cells, points) - ref_gradient
     l2, semi = np.sum(weights * np.sum(diff**2, axis=1)), np.sum(weights * np.sum(grad**2, axis=(1, 2)))
     ref_l2 = np.sum(weights * np.sum(ref_values**2, axis=1))
-    ref_semi = np.sum(weights * np.sum(ref_gradient ** 2, axis=(1, 2)))
-    return {"error_h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
-            "error_h1_semi": float(np.sqrt(semi / ref_semi)), "error_l2": float(np.sqrt(l2 / ref_l2))}
+    ref_semi = np.sum(weights * np.sum(ref_gradient**2, axis=(1, 2)))
+    return {
+        "error_h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
+        "error_h1_semi": float(np.sqrt(semi / ref_semi)),
+        "error_l2": float(np.sqrt(l2 / ref_l2)),
+    }
 
 
 def reference_path(scene) -> Path | None:
@@ -89,14 +99,19 @@ def load_reference(scene) -> ReferenceSolution | None:
     if path is None:
         return None
     if not path.exists():
-        raise InputError(f"adaptivity.reference = {str(path)!r}: no such file; give a solution file written by "
-                         "vemkit solve (relative to the scene file)", key="adaptivity.reference")
+        raise InputError(
+            f"adaptivity.reference = {str(path)!r}: no such file; give a solution file written by "
+            "vemkit solve (relative to the scene file)",
+            key="adaptivity.reference",
+        )
     mesh, dataset, scene_data = read_reference_file(path)
     try:
         check_reference_scene(scene, scene_data)
     except ValueError as error:
-        raise InputError(f"adaptivity.reference = {str(path)!r}: {error}; solve this scene on a fine mesh for "
-                         "the reference", key="adaptivity.reference") from None
+        raise InputError(
+            f"adaptivity.reference = {str(path)!r}: {error}; solve this scene on a fine mesh for the reference",
+            key="adaptivity.reference",
+        ) from None
     return ReferenceSolution(path, solution=(mesh, dataset))
 
 

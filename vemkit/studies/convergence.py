@@ -27,9 +27,7 @@ import xarray as xr
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import git_commit, package_versions
 from vemkit.io.solution_file import read_solution
-from vemkit.studies.solution_order import (projected_solution_file, refuse_order2, require_order1,  # noqa: F401
-                                          solution_order)
-
+from vemkit.studies.solution_order import projected_solution_file, refuse_order2, require_order1, solution_order  # noqa: F401
 
 #: keys of one error record, with their meaning and units
 RECORD_KEYS = {
@@ -43,15 +41,28 @@ RECORD_KEYS = {
     "error_h1": ("||Pi_1(u_h - u_ref)||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm, broken, SPEC 5)", "1"),
     "error_h1_semi": ("|Pi_1(u_h - u_ref)|_H1 / |Pi_1 u_ref|_H1 (H1 seminorm, broken, SPEC 5)", "1"),
     "error_l2": ("||Pi_1(u_h - u_ref)||_L2 / ||Pi_1 u_ref||_L2", "1"),
-    "error_paper": ("|Pi_1^ref(I_ref u_h - u_ref)|_H1 / |Pi_1^ref u_ref|_H1: the paper's measure, I_ref the "
-                    "interpolant at the reference vertices (bilinear on squares, Wachspress / mean value "
-                    "coordinates elsewhere), H1 seminorm broken over the reference cells (SPEC 5)", "1"),
+    "error_paper": (
+        "|Pi_1^ref(I_ref u_h - u_ref)|_H1 / |Pi_1^ref u_ref|_H1: the paper's measure, I_ref the "
+        "interpolant at the reference vertices (bilinear on squares, Wachspress / mean value "
+        "coordinates elsewhere), H1 seminorm broken over the reference cells (SPEC 5)",
+        "1",
+    ),
     "iterations": ("nonlinear contact solver iterations", "1"),
     "wall_time": ("contact solver wall time (with the linear solver set-up)", "s"),
     "assembly_time": ("assembly wall time of the discrete problem", "s"),
 }
-_VARIABLES = ("error_h1", "error_h1_semi", "error_l2", "error_paper", "n_dofs", "n_cells", "iterations", "wall_time",
-              "assembly_time", "h_max")
+_VARIABLES = (
+    "error_h1",
+    "error_h1_semi",
+    "error_l2",
+    "error_paper",
+    "n_dofs",
+    "n_cells",
+    "iterations",
+    "wall_time",
+    "assembly_time",
+    "h_max",
+)
 
 
 # -- orders ---------------------------------------------------------------------------------------
@@ -81,8 +92,9 @@ def convergence_orders(h, errors) -> np.ndarray:
 SCENE_MESH_OPTIONS = ("kind", "seed", "levels", "rule", "fraction", "lloyd_iterations")
 
 
-def study_scene(scene_path, overrides=(), family: str | None = None, options=None, n=None,
-                stabilization: str | None = None):
+def study_scene(
+    scene_path, overrides=(), family: str | None = None, options=None, n=None, stabilization: str | None = None
+):
     """The scene of one run of a study: the scene file, ``overrides`` ("key.path=value"), then
     the run's stabilization and a ``discretization.mesh`` describing the run's mesh.
 
@@ -142,7 +154,9 @@ class ReferenceSolution:
         self.order = solution_order(self.dataset)
         self.projected = CachedProjection(projected_solution_file(self.mesh, self.dataset))
         # exact for the product of two projections of degree k: degree 2k (the degree-2 or degree-5 rule)
-        self.quadrature = quadrature if quadrature is not None else reference_quadrature(self.mesh, degree=2 * self.order)
+        self.quadrature = (
+            quadrature if quadrature is not None else reference_quadrature(self.mesh, degree=2 * self.order)
+        )
         self.displacement = _displacement(self.dataset)
         self.areas = self.mesh.cell_areas
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
@@ -155,8 +169,9 @@ class ReferenceSolution:
         refuse_order2(self.dataset, "the convergence study's reference")
         refuse_order2(dataset, "a solution of the convergence study")
         out = projection_error(mesh, _projected(mesh, dataset), self.mesh, self.projected, self.quadrature)
-        out["paper"] = paper_error(mesh, _displacement(dataset), self.mesh, self.displacement,
-                                   self.projected, self.areas)
+        out["paper"] = paper_error(
+            mesh, _displacement(dataset), self.mesh, self.displacement, self.projected, self.areas
+        )
         return out
 
 
@@ -169,9 +184,13 @@ def _projected(mesh, ds):
 
 
 def _same_mesh(a, b) -> bool:
-    return (a.vertices.shape == b.vertices.shape and a.cell_vertices.shape == b.cell_vertices.shape
-            and np.array_equal(a.vertices, b.vertices) and np.array_equal(a.cell_offsets, b.cell_offsets)
-            and np.array_equal(a.cell_vertices, b.cell_vertices))
+    return (
+        a.vertices.shape == b.vertices.shape
+        and a.cell_vertices.shape == b.cell_vertices.shape
+        and np.array_equal(a.vertices, b.vertices)
+        and np.array_equal(a.cell_offsets, b.cell_offsets)
+        and np.array_equal(a.cell_vertices, b.cell_vertices)
+    )
 
 
 def run_record(family: str, stabilization: str, n, mesh, ds, reference: ReferenceSolution) -> dict:
@@ -228,8 +247,9 @@ def error_records(family: str, stabilization: str, runs, reference_path) -> list
     return family_error_records(family, [(stabilization, n, p) for n, p in runs], {stabilization: reference_path})
 
 
-def solved_error_records(family: str, spec: dict, stabilization: str, meshes, reference_mesh, scene_path,
-                         overrides=()) -> list[dict]:
+def solved_error_records(
+    family: str, spec: dict, stabilization: str, meshes, reference_mesh, scene_path, overrides=()
+) -> list[dict]:
     """Error records of a variant of the workflow's scene, solved here rather than by the workflow's
     solve rules: the scene with ``overrides`` and ``stabilization`` on every ``meshes`` = [(n, Mesh)]
     of ``family`` (``spec``: its ``build_mesh`` arguments) and on ``reference_mesh`` = (n, Mesh), the
@@ -237,8 +257,9 @@ def solved_error_records(family: str, spec: dict, stabilization: str, meshes, re
     from vemkit.studies.scene_solve import solve_scene
 
     def solve(mesh_spec, n, mesh):
-        scene = study_scene(scene_path, overrides, mesh_spec["family"], mesh_spec.get("options") or {}, n,
-                            stabilization)
+        scene = study_scene(
+            scene_path, overrides, mesh_spec["family"], mesh_spec.get("options") or {}, n, stabilization
+        )
         require_order1(scene, "the convergence study")
         problem, _, ds = solve_scene(scene, mesh=mesh)
         return problem.mesh, ds
@@ -261,11 +282,24 @@ def with_paper_variant(ds: xr.Dataset, records, suffix: str, comment: str) -> xr
             errors[fams.index(r["family"]), stabs.index(r["stabilization"]), ns.index(int(r["n"]))] = r["error_paper"]
     orders = np.apply_along_axis(lambda e: convergence_orders(ds["h"].values, e), -1, errors)
     dims = ("family", "stabilization", "h")
-    return ds.assign({
-        f"error_paper_{suffix}": (dims, errors, {"long_name": f"error_paper with {comment}", "units": "1",
-                                                 "comment": "undefined where the variant was not run"}),
-        f"order_paper_{suffix}": (dims, orders, {"long_name": f"observed order of error_paper_{suffix}", "units": "1"}),
-    })
+    return ds.assign(
+        {
+            f"error_paper_{suffix}": (
+                dims,
+                errors,
+                {
+                    "long_name": f"error_paper with {comment}",
+                    "units": "1",
+                    "comment": "undefined where the variant was not run",
+                },
+            ),
+            f"order_paper_{suffix}": (
+                dims,
+                orders,
+                {"long_name": f"observed order of error_paper_{suffix}", "units": "1"},
+            ),
+        }
+    )
 
 
 def write_records(records, path) -> Path:
@@ -296,8 +330,10 @@ def _checked(records) -> list:
             raise ValueError(f"error record {r!r} lacks {', '.join(missing)}")
         for key in ("error_h1", "error_h1_semi", "error_paper"):
             if key in r and not (np.isfinite(r[key]) and r[key] >= 0):
-                raise ValueError(f"error record {r['family']}/{r['stabilization']}/n{r['n']}: {key} = {r[key]}"
-                                 " is not a finite non-negative number")
+                raise ValueError(
+                    f"error record {r['family']}/{r['stabilization']}/n{r['n']}: {key} = {r[key]}"
+                    " is not a finite non-negative number"
+                )
     return records
 
 
@@ -346,18 +382,33 @@ def _add_variables(ds, data, seen, h, has_paper) -> None:
             ds[key] = (dims, data[key], {"long_name": long_name, "units": units})
     for name, (error, long_name) in _ORDERS.items():
         if error != "error_paper" or has_paper:
-            ds[name] = (dims, _orders(h, data[error]), {"long_name": long_name, "units": "1",
-                                                        "comment": _UNDEFINED_FIRST})
+            ds[name] = (
+                dims,
+                _orders(h, data[error]),
+                {"long_name": long_name, "units": "1", "comment": _UNDEFINED_FIRST},
+            )
     for key in ("n_dofs", "n_cells", "iterations"):
         long_name, units = RECORD_KEYS[key]
         values = np.where(np.isnan(data[key]), INT_FILL, data[key]).astype(np.int64)
         ds[key] = (dims, values, {"long_name": long_name, "units": units})
-    ds["defined"] = (dims, seen.astype(np.int8),
-                     {"long_name": "1 where the run exists, 0 where the family has no mesh at this h",
-                      "flag_values": np.array([0, 1], np.int8), "flag_meanings": "missing present"})
-    ds["order_defined"] = (dims, np.isfinite(ds["order"].values).astype(np.int8),
-                           {"long_name": "1 where order is defined", "flag_values": np.array([0, 1], np.int8),
-                            "flag_meanings": "undefined defined"})
+    ds["defined"] = (
+        dims,
+        seen.astype(np.int8),
+        {
+            "long_name": "1 where the run exists, 0 where the family has no mesh at this h",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "missing present",
+        },
+    )
+    ds["order_defined"] = (
+        dims,
+        np.isfinite(ds["order"].values).astype(np.int8),
+        {
+            "long_name": "1 where order is defined",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "undefined defined",
+        },
+    )
 
 
 def _provenance(title, scene_yaml, parameters, commit) -> dict:
@@ -366,13 +417,13 @@ def _provenance(title, scene_yaml, parameters, commit) -> dict:
         "title": title,
         "Conventions": "CF-1.8",
         "error_measure": "relative errors of Pi_1 u_h against Pi_1 u_ref in the broken norms over the "
-                         "reference mesh (SPEC 5); error_h1: full H1 norm, error_h1_semi: H1 seminorm; "
-                         "error_paper: the paper's own measure |Pi_1^ref(I_ref u_h - u_ref)|_H1 / "
-                         "|Pi_1^ref u_ref|_H1 (interpolation at the reference vertices, projection on the "
-                         "reference mesh, H1 seminorm), the one its Table 1 prints",
+        "reference mesh (SPEC 5); error_h1: full H1 norm, error_h1_semi: H1 seminorm; "
+        "error_paper: the paper's own measure |Pi_1^ref(I_ref u_h - u_ref)|_H1 / "
+        "|Pi_1^ref u_ref|_H1 (interpolation at the reference vertices, projection on the "
+        "reference mesh, H1 seminorm), the one its Table 1 prints",
         "missing_values": "order is undefined at the coarsest h; in the file, a float variable with "
-                          f"undefined entries has _FillValue = {FLOAT_FILL} there, an integer one {INT_FILL}; "
-                          "no NaN is stored; see the variables defined and order_defined",
+        f"undefined entries has _FillValue = {FLOAT_FILL} there, an integer one {INT_FILL}; "
+        "no NaN is stored; see the variables defined and order_defined",
         "scene": scene_yaml,
         "parameters": json.dumps(parameters or {}, sort_keys=True, default=str),
         "package_versions": json.dumps(versions, sort_keys=True),
@@ -381,9 +432,16 @@ def _provenance(title, scene_yaml, parameters, commit) -> dict:
     }
 
 
-def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, families=None,
-                        stabilizations=None, title: str = "vemkit convergence study",
-                        commit: str | None = None) -> xr.Dataset:
+def convergence_dataset(
+    records,
+    *,
+    scene_yaml: str = "",
+    parameters=None,
+    families=None,
+    stabilizations=None,
+    title: str = "vemkit convergence study",
+    commit: str | None = None,
+) -> xr.Dataset:
     """The convergence Dataset (dims ``family``, ``stabilization``, ``h``) of error records.
 
     ``families`` / ``stabilizations`` fix the order of the labels (default: first appearance).
@@ -392,18 +450,24 @@ def convergence_dataset(records, *, scene_yaml: str = "", parameters=None, famil
     """
     records = _checked(records)
     fams = list(families) if families is not None else list(dict.fromkeys(r["family"] for r in records))
-    stabs = list(stabilizations) if stabilizations is not None else \
-        list(dict.fromkeys(r["stabilization"] for r in records))
+    stabs = (
+        list(stabilizations) if stabilizations is not None else list(dict.fromkeys(r["stabilization"] for r in records))
+    )
     ns = sorted({int(r["n"]) for r in records})
     data, seen = _gridded(records, fams, stabs, ns)
     h = 1.0 / np.asarray(ns, dtype=float)  # n increasing: h runs from coarse to fine
-    ds = xr.Dataset(coords={
-        "family": ("family", np.array(fams, dtype=str), {"long_name": "mesh family label"}),
-        "stabilization": ("stabilization", np.array(stabs, dtype=str),
-                          {"long_name": "stabilization alpha_K of the dofi-dofi form (SPEC 3)"}),
-        "h": ("h", h, {"long_name": "nominal mesh size h = 1/n", "units": "mm"}),
-        "n": ("h", np.asarray(ns, dtype=np.int64), {"long_name": "cells per side n = 1/h"}),
-    })
+    ds = xr.Dataset(
+        coords={
+            "family": ("family", np.array(fams, dtype=str), {"long_name": "mesh family label"}),
+            "stabilization": (
+                "stabilization",
+                np.array(stabs, dtype=str),
+                {"long_name": "stabilization alpha_K of the dofi-dofi form (SPEC 3)"},
+            ),
+            "h": ("h", h, {"long_name": "nominal mesh size h = 1/n", "units": "mm"}),
+            "n": ("h", np.asarray(ns, dtype=np.int64), {"long_name": "cells per side n = 1/h"}),
+        }
+    )
     _add_variables(ds, data, seen, h, has_paper=any("error_paper" in r for r in records))
     ds.attrs.update(_provenance(title, scene_yaml, parameters, commit))
     return ds

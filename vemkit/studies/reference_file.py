@@ -70,8 +70,11 @@ def _node_values(path: Path, nc, n_vertices: int) -> dict:
         if variable is None:
             raise _refused(path, f"has no variable {name}; {FIX}")
         if variable.shape != (n_vertices,) or getattr(variable.dtype, "kind", "O") != "f":
-            raise _refused(path, f"variable {name} must hold one float per mesh node ({n_vertices:,}), not "
-                                 f"{variable.dtype} of shape {variable.shape}; {FIX}")
+            raise _refused(
+                path,
+                f"variable {name} must hold one float per mesh node ({n_vertices:,}), not "
+                f"{variable.dtype} of shape {variable.shape}; {FIX}",
+            )
         values[name] = np.asarray(variable[:], dtype=np.float64)
     return values
 
@@ -88,9 +91,12 @@ def read_reference_file(path) -> tuple:
         raise _refused(path, f"is not a netCDF (.nc) file; {FIX}")
     try:
         header = mesh_file_header(path)
-        check_resources(estimate_resources(header.cells, header.vertices), None,
-                        what=f"the reference ({header.vertices:,} vertices, {header.cells:,} cells)",
-                        fix="a reference on a coarser mesh")
+        check_resources(
+            estimate_resources(header.cells, header.vertices),
+            None,
+            what=f"the reference ({header.vertices:,} vertices, {header.cells:,} cells)",
+            fix="a reference on a coarser mesh",
+        )
         mesh = read_mesh(path)
     except InputError as error:
         raise _restated(path, error) from None
@@ -101,11 +107,16 @@ def read_reference_file(path) -> tuple:
         data = _scene_data(path, attrs.get("scene"))
         order = _order(data, attrs)
         if order != 1:
-            raise _refused(path, f"is an order-{order} solution (discretization.order = {order}); the true error "
-                                 "of vemkit adapt is a k = 1 measure: give a reference solved with "
-                                 "discretization.order = 1", kind=InputError)
+            raise _refused(
+                path,
+                f"is an order-{order} solution (discretization.order = {order}); the true error "
+                "of vemkit adapt is a k = 1 measure: give a reference solved with "
+                "discretization.order = 1",
+                kind=InputError,
+            )
         values = _node_values(path, nc, mesh.n_vertices)
-    dataset = xr.Dataset({name: ("mesh2d_nNodes", v) for name, v in values.items()},
-                         attrs={"scene": attrs["scene"], "order": 1,
-                                "stabilization": str(attrs.get("stabilization", ""))})
+    dataset = xr.Dataset(
+        {name: ("mesh2d_nNodes", v) for name, v in values.items()},
+        attrs={"scene": attrs["scene"], "order": 1, "stabilization": str(attrs.get("stabilization", ""))},
+    )
     return mesh, dataset, data

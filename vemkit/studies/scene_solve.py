@@ -31,8 +31,7 @@ CHECK_CAP = 1e-3
 def check_tolerance(solver_options: dict) -> float:
     """The accuracy the independent check must meet: min(max(CHECK_FACTOR * tol, CHECK_FLOOR),
     CHECK_CAP), tol the loosest of solver.tol, eps_u and eps_lambda (README "Input rules and limits")."""
-    loosest = max(float(solver_options[k]) for k in ("tol", "eps_u", "eps_lambda")
-                  if solver_options.get(k) is not None)
+    loosest = max(float(solver_options[k]) for k in ("tol", "eps_u", "eps_lambda") if solver_options.get(k) is not None)
     return min(max(CHECK_FACTOR * loosest, CHECK_FLOOR), CHECK_CAP)
 
 
@@ -46,8 +45,10 @@ def verified(problem, solution, solver_options, where: str = "", source: str = "
         raise VerificationError(
             f"{solution.method} stopped after {solution.iterations} iterations{where} but the independent "
             f"check fails: {worst} = {checks[worst]:.1e} > {tol:.1e}{source}; try "
-            "solver.method=ssn or a smaller solver.tol", solver=solution.method,
-            iterations=solution.iterations)
+            "solver.method=ssn or a smaller solver.tol",
+            solver=solution.method,
+            iterations=solution.iterations,
+        )
     return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
 
 
@@ -59,19 +60,28 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
     """
     problem = scene_problem(scene, mesh)
     if problem.mesh.n_cells == 0 or problem.n_dofs == 0:
-        raise MeshError(f"the mesh has {problem.mesh.n_cells} cells and {problem.n_dofs} free DOFs; "
-                        "nothing to solve: check discretization.mesh", key="discretization.mesh")
+        raise MeshError(
+            f"the mesh has {problem.mesh.n_cells} cells and {problem.n_dofs} free DOFs; "
+            "nothing to solve: check discretization.mesh",
+            key="discretization.mesh",
+        )
     solution = solve(problem, scene.solver_options, progress=progress)
-    attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": str(problem.mesh.meta.get("family", ""))}
+    attrs = {
+        "assembly_time": float(problem.info.get("assembly_time", 0.0)),
+        "mesh_family": str(problem.mesh.meta.get("family", "")),
+    }
     if verify:
         attrs.update(verified(problem, solution, scene.solver_options))
     if scene.exact_displacement is not None:  # SPEC §7: relative errors of Pi u_h against the exact field
-        attrs.update(relative_exact_errors(problem.mesh, problem.projected(solution.u),
-                                           vector_field(scene.exact_displacement)))
+        attrs.update(
+            relative_exact_errors(problem.mesh, problem.projected(solution.u), vector_field(scene.exact_displacement))
+        )
     try:
         with floating_point_errors_raise():
             ds = solution_dataset(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
     except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
-        raise ResultError(f"the stresses of the solution overflow double precision ({error}); "
-                          "rescale the units of the scene (E, k, tractions)") from None
+        raise ResultError(
+            f"the stresses of the solution overflow double precision ({error}); "
+            "rescale the units of the scene (E, k, tractions)"
+        ) from None
     return problem, solution, ds

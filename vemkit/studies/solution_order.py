@@ -17,9 +17,12 @@ def refuse_order2(ds, what: str) -> None:
     """InputError unless ``ds`` is a k = 1 solution: Pi_1 of vertex values and the paper's measure
     (SPEC 5) would mis-measure a k = 2 solution (its edge and cell means are ignored)."""
     if solution_order(ds) != 1:
-        raise InputError(f"{what} has discretization.order = {solution_order(ds)}: this error measure (Pi_1 of vertex "
-                         "values, SPEC 5) is for k = 1 only; use discretization.order=1 or the order2 study "
-                         "(snakemake -j2 order2)", key="discretization.order")
+        raise InputError(
+            f"{what} has discretization.order = {solution_order(ds)}: this error measure (Pi_1 of vertex "
+            "values, SPEC 5) is for k = 1 only; use discretization.order=1 or the order2 study "
+            "(snakemake -j2 order2)",
+            key="discretization.order",
+        )
 
 
 def require_order1(scene, what: str) -> None:
@@ -28,10 +31,12 @@ def require_order1(scene, what: str) -> None:
     from vemkit.exceptions import SceneError
 
     if scene.order != 1:
-        raise SceneError(f"{what} measures errors with Pi_1 of vertex values (k = 1 only) but the scene has "
-                         f"discretization.order = {scene.order}: drop the override or use the order2 study "
-                         "(snakemake -j2 order2) or the speed-accuracy study's `order: 2` families",
-                         key="discretization.order")
+        raise SceneError(
+            f"{what} measures errors with Pi_1 of vertex values (k = 1 only) but the scene has "
+            f"discretization.order = {scene.order}: drop the override or use the order2 study "
+            "(snakemake -j2 order2) or the speed-accuracy study's `order: 2` families",
+            key="discretization.order",
+        )
 
 
 def solution_space(mesh, ds):
@@ -50,7 +55,9 @@ def solution_node_values(space, ds) -> np.ndarray:
     parts = [np.stack([ds["u1"].values, ds["u2"].values], axis=1)]
     for entity in (e for e in space.element.layout if e != "vertex"):
         if entity == "edge" and not np.array_equal(ds["mesh2d_edge_nodes"].values.astype(np.int64), space.mesh.edges):
-            raise ResultError("the solution file's edges are not the mesh's edge order: the edge means cannot be placed")
+            raise ResultError(
+                "the solution file's edges are not the mesh's edge order: the edge means cannot be placed"
+            )
         suffix = ENTITY_VARIABLES[entity][1]
         parts.append(np.stack([ds[f"u1_{suffix}"].values, ds[f"u2_{suffix}"].values], axis=1))
     return np.concatenate(parts)

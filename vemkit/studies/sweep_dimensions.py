@@ -9,9 +9,16 @@ import re
 
 #: short dimension names of common scene keys (others: the key with "." -> "_")
 DIMENSION_NAMES = {
-    "contact.normal.k": "k_nu", "contact.normal.m": "m_nu", "contact.friction.k": "k_tau",
-    "contact.friction.m": "m_tau", "contact.gap": "g_a", "material.E": "E", "material.nu": "kappa",
-    "discretization.mesh.n": "n", "discretization.stabilization": "stabilization", "solver.method": "solver",
+    "contact.normal.k": "k_nu",
+    "contact.normal.m": "m_nu",
+    "contact.friction.k": "k_tau",
+    "contact.friction.m": "m_tau",
+    "contact.gap": "g_a",
+    "material.E": "E",
+    "material.nu": "kappa",
+    "discretization.mesh.n": "n",
+    "discretization.stabilization": "stabilization",
+    "solver.method": "solver",
     "solver.tol": "tol",
 }
 

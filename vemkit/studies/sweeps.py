@@ -34,10 +34,9 @@ from dataclasses import replace
 import numpy as np
 import xarray as xr
 
-from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outcome, failed, guarded_solve
-
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import package_versions
+from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outcome, failed, guarded_solve
 from vemkit.studies.sweep_dimensions import dimension_name
 
 SHARED_PREFIXES = ("contact.", "solver.")  # keys that leave K, the load and the mesh unchanged
@@ -46,8 +45,11 @@ QUANTITIES = {  # name: (long name, units)
     "contact_length": ("length of Gamma_C where u_nu - g_a > 0 (nodal weights)", "mm"),
     "stick_length": ("length of Gamma_C in contact and sticking (contact_state)", "mm"),
     "slip_length": ("length of Gamma_C in contact and slipping (contact_state)", "mm"),
-    "normal_force": ("resultant normal contact force: the integral of p_nu(u_nu - g_a) over Gamma_C with the "
-                     "scene's contact quadrature (nodal: sum_c w_c p_nu)", "daN/mm"),
+    "normal_force": (
+        "resultant normal contact force: the integral of p_nu(u_nu - g_a) over Gamma_C with the "
+        "scene's contact quadrature (nodal: sum_c w_c p_nu)",
+        "daN/mm",
+    ),
     "tangential_force": ("resultant tangential contact stress sum_c w_c sigma_tau (all Gamma_C vertices)", "daN/mm"),
     "residual": ("worst independent check of the discrete conditions (vemkit.studies.robustness)", "1"),
 }
@@ -126,8 +128,10 @@ def point_quantities(problem, outcome: Outcome):
     }
     order = np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))
     values = {"multiplier": np.asarray(sol.multiplier, dtype=float)}
-    profiles = {name: np.asarray(values.get(attr, getattr(st, attr, None)), dtype=float)[order]
-                for name, (attr, _, _) in PROFILES.items()}
+    profiles = {
+        name: np.asarray(values.get(attr, getattr(st, attr, None)), dtype=float)[order]
+        for name, (attr, _, _) in PROFILES.items()
+    }
     profiles["state"] = np.asarray(st.state, dtype=np.int8)[order]
     profiles["x"], profiles["y"], profiles["w"] = cb.coords[order, 0], cb.coords[order, 1], cb.weight[order]
     return q, profiles
@@ -150,8 +154,8 @@ def run_grid(scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CHE
     ``reuse=False`` builds mesh, problem and linear solver afresh for every point (for comparison).
     progress(index, values, point) after each point.
     """
-    from vemkit.mesh.families import scene_mesh
     from vemkit.contact.problem import scene_problem
+    from vemkit.mesh.families import scene_mesh
 
     grid = normalize_grid(grid)
     keys = list(grid)
@@ -204,7 +208,9 @@ def _solve_point(group, problem, shared, values, linear_cache, time_budget, chec
         if linear_cache is not None and prebuilt_linear_supported():
             key = (options.get("linear", "auto"), float(options["tol"]))
             if key not in linear_cache:
-                linear_cache[key] = linear_solver(problem.stiffness, key[0], near_nullspace=problem.near_nullspace, tol=key[1])
+                linear_cache[key] = linear_solver(
+                    problem.stiffness, key[0], near_nullspace=problem.near_nullspace, tol=key[1]
+                )
             linear = linear_cache[key]
         linear_setup = time.perf_counter() - t0
     except Exception as exc:  # noqa: BLE001
@@ -257,47 +263,79 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             for k in PROFILES:
                 profile_data[k][index] = point.profiles[k]
             state[index] = point.profiles["state"]
-    ds["status"] = (dims, status, {"long_name": "outcome of the point", "flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int8),
-                                   "flag_meanings": " ".join(STATUS_MEANINGS)})
-    ds["valid"] = (dims, (status == 0).astype(np.int8), {"long_name": "1 where the point converged and passed the check",
-                                                         "flag_values": np.array([0, 1], np.int8), "flag_meanings": "invalid valid"})
+    ds["status"] = (
+        dims,
+        status,
+        {
+            "long_name": "outcome of the point",
+            "flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int8),
+            "flag_meanings": " ".join(STATUS_MEANINGS),
+        },
+    )
+    ds["valid"] = (
+        dims,
+        (status == 0).astype(np.int8),
+        {
+            "long_name": "1 where the point converged and passed the check",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "invalid valid",
+        },
+    )
     for k, (long_name, units) in QUANTITIES.items():
         ds[k] = (dims, quantities[k], {"long_name": long_name, "units": units})
     ds["iterations"] = (dims, iterations, {"long_name": "nonlinear iterations (-1: unknown)"})
     ds["n_dofs"] = (dims, n_dofs, {"long_name": "free unknowns (-1: not assembled)"})
     ds["wall_time"] = (dims, wall, {"long_name": "wall time of the contact solve", "units": "s"})
-    ds["setup_time"] = (dims, setup, {"long_name": "mesh, assembly and linear solver set-up paid at this point "
-                                      "(0 where reused)", "units": "s"})
+    ds["setup_time"] = (
+        dims,
+        setup,
+        {"long_name": "mesh, assembly and linear solver set-up paid at this point (0 where reused)", "units": "s"},
+    )
     ds["message"] = (dims, messages, {"long_name": "failure message (empty when converged)"})
     if keep_profiles:
         first = profiles[0]
-        ds = ds.assign_coords(contact_x=("contact_node", first["x"], {"long_name": "x of the contact vertex", "units": "mm"}),
-                              contact_y=("contact_node", first["y"], {"long_name": "y of the contact vertex", "units": "mm"}),
-                              contact_weight=("contact_node", first["w"], {"long_name": "nodal quadrature weight", "units": "mm"}))
+        ds = ds.assign_coords(
+            contact_x=("contact_node", first["x"], {"long_name": "x of the contact vertex", "units": "mm"}),
+            contact_y=("contact_node", first["y"], {"long_name": "y of the contact vertex", "units": "mm"}),
+            contact_weight=("contact_node", first["w"], {"long_name": "nodal quadrature weight", "units": "mm"}),
+        )
         pdims = dims + ("contact_node",)
         for k, (_, long_name, units) in PROFILES.items():
             ds[f"profile_{k}"] = (pdims, profile_data[k], {"long_name": long_name, "units": units})
-        ds["profile_state"] = (pdims, state, {"long_name": "contact state along Gamma_C (-1: no solution)",
-                                              "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": "separated stick slip"})
-    ds.attrs.update({
-        "title": "vemkit parameter sweep",
-        "Conventions": "CF-1.8",
-        "scene": scene_yaml,
-        "grid": json.dumps({k: list(v) for k, v in grid.items()}),
-        "points": int(np.prod(shape)),
-        "converged_points": int(np.sum(status == 0)),
-        "profiles": "along Gamma_C (contact_node ordered by x, y)" if keep_profiles else
-                    "omitted: the grid changes the contact nodes (mesh)" if sizes else "omitted: no converged point",
-        "missing_values": f"not converged points (valid = 0): float _FillValue {FLOAT_FILL}, integer {INT_FILL}; no NaN stored",
-        "vemkit_version": vemkit.__version__,
-        "package_versions": json.dumps(package_versions(), sort_keys=True),
-    })
+        ds["profile_state"] = (
+            pdims,
+            state,
+            {
+                "long_name": "contact state along Gamma_C (-1: no solution)",
+                "flag_values": np.array([0, 1, 2], np.int8),
+                "flag_meanings": "separated stick slip",
+            },
+        )
+    ds.attrs.update(
+        {
+            "title": "vemkit parameter sweep",
+            "Conventions": "CF-1.8",
+            "scene": scene_yaml,
+            "grid": json.dumps({k: list(v) for k, v in grid.items()}),
+            "points": int(np.prod(shape)),
+            "converged_points": int(np.sum(status == 0)),
+            "profiles": "along Gamma_C (contact_node ordered by x, y)"
+            if keep_profiles
+            else "omitted: the grid changes the contact nodes (mesh)"
+            if sizes
+            else "omitted: no converged point",
+            "missing_values": f"not converged points (valid = 0): float _FillValue {FLOAT_FILL}, integer {INT_FILL}; no NaN stored",
+            "vemkit_version": vemkit.__version__,
+            "package_versions": json.dumps(package_versions(), sort_keys=True),
+        }
+    )
     ds.attrs.update(attrs or {})
     return ds
 
 
-def run_sweep(scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CHECK_TOL, progress=None,
-              attrs=None) -> xr.Dataset:
+def run_sweep(
+    scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CHECK_TOL, progress=None, attrs=None
+) -> xr.Dataset:
     """run_grid + sweep_dataset; the attributes record the solver options, reuse and timing."""
     from vemkit.solvers.verification import prebuilt_linear_supported
 
@@ -331,11 +369,25 @@ def combine_parts(parts) -> xr.Dataset:
     grids = [json.loads(p.attrs["grid"]) for p in parts]
     key = next(k for k in grids[0] if any(g[k] != grids[0][k] for g in grids))
     dim = dimension_name(key)
-    ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override", join="override",
-                   combine_attrs="override")
+    ds = xr.concat(
+        parts,
+        dim=dim,
+        data_vars="minimal",
+        coords="minimal",
+        compat="override",
+        join="override",
+        combine_attrs="override",
+    )
     grid = dict(grids[0])
     grid[key] = [v for g in grids for v in g[key]]
     status = ds["status"].values
-    ds.attrs.update({"grid": json.dumps(grid), "points": int(status.size), "converged_points": int(np.sum(status == 0)),
-                     "total_time": float(sum(p.attrs.get("total_time", 0.0) for p in parts)), "parts": len(parts)})
+    ds.attrs.update(
+        {
+            "grid": json.dumps(grid),
+            "points": int(status.size),
+            "converged_points": int(np.sum(status == 0)),
+            "total_time": float(sum(p.attrs.get("total_time", 0.0) for p in parts)),
+            "parts": len(parts),
+        }
+    )
     return ds

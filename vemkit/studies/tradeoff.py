@@ -41,8 +41,18 @@ from vemkit.exceptions import InputError
 from vemkit.solvers.verification import STATUS_MEANINGS, guarded_solve
 
 SCENE_SECTIONS = ("domain", "material", "body_force", "boundary", "contact")  # must match the reference's
-RECORD_FLOATS = ("tol", "error_h1", "error_h1_semi", "error_l2", "wall_time", "assembly_time", "mesh_time",
-                 "cost_time", "residual", "h_min")
+RECORD_FLOATS = (
+    "tol",
+    "error_h1",
+    "error_h1_semi",
+    "error_l2",
+    "wall_time",
+    "assembly_time",
+    "mesh_time",
+    "cost_time",
+    "residual",
+    "h_min",
+)
 RECORD_INTS = ("n", "n_dofs", "n_cells", "iterations", "status")
 #: integer keys a record may omit (k = 1 producers such as the adaptive configuration): their defaults
 RECORD_OPTIONAL_INTS = {"order": lambda r: 1, "n_unknowns": lambda r: r["n_dofs"]}
@@ -55,16 +65,23 @@ def check_reference_scene(scene, reference_scene) -> None:
     the safe loader, ``vemkit.config.safe_yaml``: a file's attribute is user input)."""
     from vemkit.config.safe_yaml import parse_yaml
 
-    reference = reference_scene if isinstance(reference_scene, dict) else \
-        parse_yaml(reference_scene or "", "the reference's scene attribute") or {}
+    reference = (
+        reference_scene
+        if isinstance(reference_scene, dict)
+        else parse_yaml(reference_scene or "", "the reference's scene attribute") or {}
+    )
     if not isinstance(reference, dict):
-        raise InputError("the reference's scene attribute is not a scene (a mapping); give a solution file "
-                         "written by vemkit solve", key="reference")
+        raise InputError(
+            "the reference's scene attribute is not a scene (a mapping); give a solution file written by vemkit solve",
+            key="reference",
+        )
     mine = scene.data
     for section in SCENE_SECTIONS:
         if section in reference and reference.get(section) != mine.get(section):
-            raise ValueError(f"the reference solution solves another problem: scene section {section!r} differs "
-                             f"({reference.get(section)!r} != {mine.get(section)!r})")
+            raise ValueError(
+                f"the reference solution solves another problem: scene section {section!r} differs "
+                f"({reference.get(section)!r} != {mine.get(section)!r})"
+            )
 
 
 def _finest_ok(spec: dict, n: int, reference_n: int) -> bool:
@@ -74,16 +91,30 @@ def _finest_ok(spec: dict, n: int, reference_n: int) -> bool:
     return n * refinement <= reference_n
 
 
-def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tolerances, stabilizations,
-               repeats: int = 1, time_budget=None, reference_n: int = 256, max_iterations=None, progress=None) -> list[dict]:
+def run_family(
+    scene,
+    label: str,
+    spec: dict,
+    reference,
+    *,
+    levels,
+    solvers,
+    tolerances,
+    stabilizations,
+    repeats: int = 1,
+    time_budget=None,
+    reference_n: int = 256,
+    max_iterations=None,
+    progress=None,
+) -> list[dict]:
     """Records of every run of one mesh family (``spec``: {family, options, order}); see the module docstring.
 
     ``reference``: a ``vemkit.studies.convergence.ReferenceSolution``. All-triangle k = 1 families are
     solved with the first stabilization only (the VEM space is P1 there, the stabilization vanishes;
     not so for k = 2: the space has a cell mean beyond P2). ``max_iterations``: {solver: limit}.
     """
-    from vemkit.mesh.families import build_mesh
     from vemkit.contact.problem import scene_problem
+    from vemkit.mesh.families import build_mesh
 
     order = family_order(spec)
     records = []
@@ -103,8 +134,10 @@ def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tol
         mesh_time = time.perf_counter() - t0
         for stab in stabs:
             mesh_section = {"family": spec["family"], "n": int(n), **(spec.get("options") or {})}
-            run_scene = scene.with_overrides(order_override + [f"discretization.stabilization={stab}",
-                                                               f"discretization.mesh={json.dumps(mesh_section)}"])
+            run_scene = scene.with_overrides(
+                order_override
+                + [f"discretization.stabilization={stab}", f"discretization.mesh={json.dumps(mesh_section)}"]
+            )
             t0 = time.perf_counter()
             problem = scene_problem(run_scene, mesh)
             assembly_time = time.perf_counter() - t0
@@ -116,17 +149,32 @@ def run_family(scene, label: str, spec: dict, reference, *, levels, solvers, tol
                     if solver == "uzawa":
                         options.update(eps_u=float(tol), eps_lambda=float(tol))
                     best = _best_solve(problem, options, repeats, time_budget)
-                    record = {"family": label, "family_name": spec["family"], "solver": solver, "tol": float(tol),
-                              "stabilization": stab, "n": int(n), "order": order,
-                              "n_dofs": int(getattr(problem, "n_space_dofs", problem.n_dofs)),
-                              "n_unknowns": int(problem.n_dofs), "n_cells": int(mesh.n_cells),
-                              "h_min": float(_smallest_edge(mesh)), "iterations": best.iterations,
-                              "status": best.code, "message": best.message, "wall_time": best.wall_time,
-                              "assembly_time": assembly_time, "mesh_time": mesh_time,
-                              "cost_time": assembly_time + best.wall_time,
-                              "residual": float(best.checks.get("worst", np.nan)) if best.checks else float("nan")}
-                    record.update(measure(problem, best) if best.converged else
-                                  {key: float("nan") for key in ("error_h1", "error_h1_semi", "error_l2")})
+                    record = {
+                        "family": label,
+                        "family_name": spec["family"],
+                        "solver": solver,
+                        "tol": float(tol),
+                        "stabilization": stab,
+                        "n": int(n),
+                        "order": order,
+                        "n_dofs": int(getattr(problem, "n_space_dofs", problem.n_dofs)),
+                        "n_unknowns": int(problem.n_dofs),
+                        "n_cells": int(mesh.n_cells),
+                        "h_min": float(_smallest_edge(mesh)),
+                        "iterations": best.iterations,
+                        "status": best.code,
+                        "message": best.message,
+                        "wall_time": best.wall_time,
+                        "assembly_time": assembly_time,
+                        "mesh_time": mesh_time,
+                        "cost_time": assembly_time + best.wall_time,
+                        "residual": float(best.checks.get("worst", np.nan)) if best.checks else float("nan"),
+                    }
+                    record.update(
+                        measure(problem, best)
+                        if best.converged
+                        else {key: float("nan") for key in ("error_h1", "error_h1_semi", "error_l2")}
+                    )
                     records.append(record)
                     if progress is not None:
                         progress(record)
@@ -177,8 +225,8 @@ class _ErrorMeasure:
 def _warm_up(scene, spec, stabilizations, solvers):
     """One untimed assembly and solve per stabilization and solver on a 2 x 2 mesh: the first call of
     a kernel in a process loads its compiled code, which is no cost of the configuration timed next."""
-    from vemkit.mesh.families import build_mesh
     from vemkit.contact.problem import scene_problem
+    from vemkit.mesh.families import build_mesh
 
     mesh = build_mesh(spec["family"], 2, **(spec.get("options") or {}))
     for stab in stabilizations:
@@ -211,8 +259,10 @@ def pareto_front(cost, error) -> np.ndarray:
 def describe(ds, i) -> str:
     """One run as "family[ (k = 2)], solver, tol, stabilization, n"."""
     order = int(ds["order"].values[i]) if "order" in ds else 1
-    return (f"{ds['family'].values[i]}{f' (k = {order})' if order != 1 else ''}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
-            f"{ds['stabilization'].values[i]}, n = {int(ds['n'].values[i])}")
+    return (
+        f"{ds['family'].values[i]}{f' (k = {order})' if order != 1 else ''}, {ds['solver'].values[i]} (tol {float(ds['tol'].values[i]):.0e}), "
+        f"{ds['stabilization'].values[i]}, n = {int(ds['n'].values[i])}"
+    )
 
 
 def cheapest_for_targets(ds, targets, error: str = "error_h1") -> list[dict]:
@@ -226,8 +276,13 @@ def cheapest_for_targets(ds, targets, error: str = "error_h1") -> list[dict]:
             if reach.any():
                 values = np.where(reach, ds[cost].values.astype(float), np.inf)
                 i = int(np.argmin(values))
-                row[cost] = {"run": i, "configuration": describe(ds, i), "cost_time": float(ds["cost_time"].values[i]),
-                             "n_dofs": int(ds["n_dofs"].values[i]), "error": float(ds[error].values[i])}
+                row[cost] = {
+                    "run": i,
+                    "configuration": describe(ds, i),
+                    "cost_time": float(ds["cost_time"].values[i]),
+                    "n_dofs": int(ds["n_dofs"].values[i]),
+                    "error": float(ds[error].values[i]),
+                }
         if not reach.any() and ok.any():
             i = int(np.argmin(np.where(ok, ds[error].values, np.inf)))
             row["closest"] = {"run": i, "configuration": describe(ds, i), "error": float(ds[error].values[i])}
@@ -240,25 +295,40 @@ def _loglog_interpolate(x_known, y_known, x):
     return np.exp(np.interp(np.log(x), np.log(np.asarray(x_known)[order]), np.log(np.asarray(y_known)[order])))
 
 
-def refinement_gain(ds, uniform: str, refined: str, *, solver: str, tol: float, stabilization: str,
-                    error: str = "error_h1") -> dict:
+def refinement_gain(
+    ds, uniform: str, refined: str, *, solver: str, tol: float, stabilization: str, error: str = "error_h1"
+) -> dict:
     """Refinement at Gamma_C (family ``refined``) against uniform refinement (``uniform``).
 
     error_ratio: e_uniform(d) / e_refined(d) at the refined runs' DOFs d inside both DOF ranges
     (> 1: refining at Gamma_C is more accurate at equal DOFs), with its geometric mean;
     dofs_ratio: d_uniform(e) / d_refined(e) at the refined runs' errors inside both error ranges.
     """
+
     def runs(label):
-        sel = ((ds["family"].values == label) & (ds["solver"].values == solver) & (ds["status"].values == 0)
-               & (ds["stabilization"].values == stabilization) & np.isclose(ds["tol"].values, tol)
-               & np.isfinite(ds[error].values))
+        sel = (
+            (ds["family"].values == label)
+            & (ds["solver"].values == solver)
+            & (ds["status"].values == 0)
+            & (ds["stabilization"].values == stabilization)
+            & np.isclose(ds["tol"].values, tol)
+            & np.isfinite(ds[error].values)
+        )
         d, e = ds["n_dofs"].values[sel].astype(float), ds[error].values[sel].astype(float)
         return d[np.argsort(d)], e[np.argsort(d)]
 
     du, eu = runs(uniform)
     dr, er = runs(refined)
-    result = {"uniform": uniform, "refined": refined, "solver": solver, "tol": tol, "stabilization": stabilization,
-              "error": error, "error_ratio": [], "dofs_ratio": []}
+    result = {
+        "uniform": uniform,
+        "refined": refined,
+        "solver": solver,
+        "tol": tol,
+        "stabilization": stabilization,
+        "error": error,
+        "error_ratio": [],
+        "dofs_ratio": [],
+    }
     if du.size < 2 or dr.size < 1:
         result["note"] = "not enough converged runs to interpolate"
         return result
@@ -267,15 +337,18 @@ def refinement_gain(ds, uniform: str, refined: str, *, solver: str, tol: float, 
     result["error_ratio"] = [{"n_dofs": int(d), "ratio": float(r)} for d, r in zip(dr[inside], ratios)]
     inside_e = (er >= eu.min()) & (er <= eu.max())
     d_needed = _loglog_interpolate(eu, du, er[inside_e])
-    result["dofs_ratio"] = [{"error": float(e), "ratio": float(r)} for e, r in zip(er[inside_e], d_needed / dr[inside_e])]
+    result["dofs_ratio"] = [
+        {"error": float(e), "ratio": float(r)} for e, r in zip(er[inside_e], d_needed / dr[inside_e])
+    ]
     for key in ("error_ratio", "dofs_ratio"):
         values = [r["ratio"] for r in result[key]]
         result[f"{key}_geometric_mean"] = float(np.exp(np.mean(np.log(values)))) if values else float("nan")
     return result
 
 
-def tradeoff_dataset(records, *, targets=(0.1, 0.05, 0.02, 0.01), gains=(), error: str = "error_h1",
-                     scene_yaml: str = "", settings=None) -> xr.Dataset:
+def tradeoff_dataset(
+    records, *, targets=(0.1, 0.05, 0.02, 0.01), gains=(), error: str = "error_h1", scene_yaml: str = "", settings=None
+) -> xr.Dataset:
     """Records -> Dataset (dim ``run``) with the Pareto masks, the cheapest-configuration answers
     (attribute ``cheapest``, JSON) and the refinement gains (``gains``: dicts of refinement_gain
     keyword arguments; attribute ``refinement_gain``, JSON). NaN where a run did not converge."""
@@ -296,30 +369,54 @@ def tradeoff_dataset(records, *, targets=(0.1, 0.05, 0.02, 0.01), gains=(), erro
     units = {"wall_time": "s", "assembly_time": "s", "mesh_time": "s", "cost_time": "s", "h_min": "mm"}
     long_names = {
         "error_h1": "||Pi_k u_h - Pi_1 u_ref||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm; Pi_k: the run's order)",
-        "error_h1_semi": "same, H1 seminorm", "order": "polynomial order k of the virtual elements",
+        "error_h1_semi": "same, H1 seminorm",
+        "order": "polynomial order k of the virtual elements",
         "n_dofs": "free DOFs of the discrete space (k = 2: vertex values, edge and cell means)",
         "n_unknowns": "unknowns of the solved system (k = 2: cell means condensed out)",
-        "error_l2": "same, L2 norm", "cost_time": "assembly + contact solve (linear solver set-up included)",
-        "wall_time": "contact solve, best of the repeats", "mesh_time": "mesh generation (not in cost_time)",
-        "residual": "worst independent check (vemkit.studies.robustness)", "tol": "solver tolerance", "h_min": "shortest edge",
-        "family": "mesh family label", "family_name": "build_mesh family",
+        "error_l2": "same, L2 norm",
+        "cost_time": "assembly + contact solve (linear solver set-up included)",
+        "wall_time": "contact solve, best of the repeats",
+        "mesh_time": "mesh generation (not in cost_time)",
+        "residual": "worst independent check (vemkit.studies.robustness)",
+        "tol": "solver tolerance",
+        "h_min": "shortest edge",
+        "family": "mesh family label",
+        "family_name": "build_mesh family",
     }
     for key in ds.data_vars:
         ds[key].attrs.update({k: v for k, v in (("units", units.get(key)), ("long_name", long_names.get(key))) if v})
-    ds["status"].attrs.update({"flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int64),
-                               "flag_meanings": " ".join(STATUS_MEANINGS)})
+    ds["status"].attrs.update(
+        {"flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int64), "flag_meanings": " ".join(STATUS_MEANINGS)}
+    )
     ok = ds["status"].values == 0
     for cost, name in (("cost_time", "pareto_time"), ("n_dofs", "pareto_dofs")):
-        front = pareto_front(np.where(ok, ds[cost].values.astype(float), np.nan), np.where(ok, ds[error].values, np.nan))
-        ds[name] = ("run", front.astype(np.int8), {"long_name": f"1 on the Pareto front of {error} against {cost}",
-                                                   "flag_values": np.array([0, 1], np.int8), "flag_meanings": "dominated front"})
+        front = pareto_front(
+            np.where(ok, ds[cost].values.astype(float), np.nan), np.where(ok, ds[error].values, np.nan)
+        )
+        ds[name] = (
+            "run",
+            front.astype(np.int8),
+            {
+                "long_name": f"1 on the Pareto front of {error} against {cost}",
+                "flag_values": np.array([0, 1], np.int8),
+                "flag_meanings": "dominated front",
+            },
+        )
     cheapest = cheapest_for_targets(ds, targets, error)
     gain_results = [refinement_gain(ds, error=error, **g) for g in gains]
-    ds.attrs.update({"title": "vemkit speed-accuracy study", "Conventions": "CF-1.8", "error": error, "scene": scene_yaml,
-                     "settings": json.dumps(settings or {}, sort_keys=True, default=str),
-                     "cheapest": json.dumps(cheapest), "refinement_gain": json.dumps(gain_results),
-                     "vemkit_version": vemkit.__version__,
-                     "missing_values": "errors of runs that did not converge (status != 0): _FillValue -9999.0"})
+    ds.attrs.update(
+        {
+            "title": "vemkit speed-accuracy study",
+            "Conventions": "CF-1.8",
+            "error": error,
+            "scene": scene_yaml,
+            "settings": json.dumps(settings or {}, sort_keys=True, default=str),
+            "cheapest": json.dumps(cheapest),
+            "refinement_gain": json.dumps(gain_results),
+            "vemkit_version": vemkit.__version__,
+            "missing_values": "errors of runs that did not converge (status != 0): _FillValue -9999.0",
+        }
+    )
     return ds
 
 
@@ -330,16 +427,23 @@ def order_comparison(ds, targets, error: str = "error_h1") -> list[str]:
     if not (np.any(orders == 1) and np.any(orders == 2)):
         return []
     best = {k: cheapest_for_targets(ds.isel(run=np.flatnonzero(orders == k)), targets, error) for k in (1, 2)}
-    lines = ["", "## First against second order (k = 1 against k = 2)", "",
-             "| target error | cheapest k = 1 | time [s] | DOFs | cheapest k = 2 | time [s] | DOFs | time k = 2 / k = 1 |",
-             "|---|---|---:|---:|---|---:|---:|---:|"]
+    lines = [
+        "",
+        "## First against second order (k = 1 against k = 2)",
+        "",
+        "| target error | cheapest k = 1 | time [s] | DOFs | cheapest k = 2 | time [s] | DOFs | time k = 2 / k = 1 |",
+        "|---|---|---:|---:|---|---:|---:|---:|",
+    ]
     for one, two in zip(best[1], best[2], strict=True):
         cells = []
         for row in (one, two):
             t = row.get("cost_time")
             cells.append(f"{t['configuration']} | {t['cost_time']:.3f} | {t['n_dofs']}" if t else "not reached | | ")
-        ratio = (f"{two['cost_time']['cost_time'] / one['cost_time']['cost_time']:.2f}"
-                 if one["reached"] and two["reached"] else "")
+        ratio = (
+            f"{two['cost_time']['cost_time'] / one['cost_time']['cost_time']:.2f}"
+            if one["reached"] and two["reached"]
+            else ""
+        )
         lines.append(f"| {_percent(one['target'])} | {cells[0]} | {cells[1]} | {ratio} |")
     return lines
 
@@ -352,52 +456,80 @@ def tradeoff_markdown(ds) -> str:
     """The Markdown answer: cheapest configuration per target error, the Pareto fronts, the Gamma_C gain."""
     error = ds.attrs.get("error", "error_h1")
     settings = json.loads(ds.attrs.get("settings", "{}"))
-    lines = ["# Speed against accuracy", "",
-             f"Error: `{error}`, relative to the reference {settings.get('reference', '')} (one reference for every "
-             "stabilization). Cost: wall time of assembly + contact solve (linear solver set-up included, mesh "
-             "generation excluded), and free unknowns (DOFs). "
-             f"{ds.sizes['run']} runs, {int(np.sum(ds['status'].values == 0))} converged.", "",
-             "| target error | cheapest in wall time | time [s] | DOFs | error | fewest DOFs | DOFs | time [s] | error |",
-             "|---|---|---:|---:|---:|---|---:|---:|---:|"]
+    lines = [
+        "# Speed against accuracy",
+        "",
+        f"Error: `{error}`, relative to the reference {settings.get('reference', '')} (one reference for every "
+        "stabilization). Cost: wall time of assembly + contact solve (linear solver set-up included, mesh "
+        "generation excluded), and free unknowns (DOFs). "
+        f"{ds.sizes['run']} runs, {int(np.sum(ds['status'].values == 0))} converged.",
+        "",
+        "| target error | cheapest in wall time | time [s] | DOFs | error | fewest DOFs | DOFs | time [s] | error |",
+        "|---|---|---:|---:|---:|---|---:|---:|---:|",
+    ]
     answers = json.loads(ds.attrs["cheapest"])
     for row in answers:
         if not row["reached"]:
             closest = row.get("closest")
-            lines.append(f"| {_percent(row['target'])} | not reached" + (
-                f" (best: {closest['configuration']}, {_percent(closest['error'])})" if closest else "") + " | | | | | | | |")
+            lines.append(
+                f"| {_percent(row['target'])} | not reached"
+                + (f" (best: {closest['configuration']}, {_percent(closest['error'])})" if closest else "")
+                + " | | | | | | | |"
+            )
             continue
         t, d = row["cost_time"], row["n_dofs"]
-        lines.append(f"| {_percent(row['target'])} | {t['configuration']} | {t['cost_time']:.3f} | {t['n_dofs']} | "
-                     f"{_percent(t['error'])} | {d['configuration']} | {d['n_dofs']} | {d['cost_time']:.3f} | {_percent(d['error'])} |")
+        lines.append(
+            f"| {_percent(row['target'])} | {t['configuration']} | {t['cost_time']:.3f} | {t['n_dofs']} | "
+            f"{_percent(t['error'])} | {d['configuration']} | {d['n_dofs']} | {d['cost_time']:.3f} | {_percent(d['error'])} |"
+        )
     lines.append("")
     for row in answers:
         if row["reached"]:
             t = row["cost_time"]
-            lines.append(f"**For {_percent(row['target'])} error the cheapest configuration is** {t['configuration']}: "
-                         f"{t['cost_time']:.3f} s, {t['n_dofs']} DOFs, error {_percent(t['error'])}.  ")
+            lines.append(
+                f"**For {_percent(row['target'])} error the cheapest configuration is** {t['configuration']}: "
+                f"{t['cost_time']:.3f} s, {t['n_dofs']} DOFs, error {_percent(t['error'])}.  "
+            )
     lines += order_comparison(ds, [row["target"] for row in answers], error)
     for cost, name, title in (("cost_time", "pareto_time", "wall time"), ("n_dofs", "pareto_dofs", "DOFs")):
         idx = np.flatnonzero(ds[name].values == 1)
         idx = idx[np.argsort(ds[cost].values[idx])]
-        lines += ["", f"## Pareto front: {error} against {title}", "", "| configuration | time [s] | DOFs | error |",
-                  "|---|---:|---:|---:|"]
-        lines += [f"| {describe(ds, i)} | {float(ds['cost_time'].values[i]):.3f} | {int(ds['n_dofs'].values[i])} | "
-                  f"{_percent(float(ds[error].values[i]))} |" for i in idx]
+        lines += [
+            "",
+            f"## Pareto front: {error} against {title}",
+            "",
+            "| configuration | time [s] | DOFs | error |",
+            "|---|---:|---:|---:|",
+        ]
+        lines += [
+            f"| {describe(ds, i)} | {float(ds['cost_time'].values[i]):.3f} | {int(ds['n_dofs'].values[i])} | "
+            f"{_percent(float(ds[error].values[i]))} |"
+            for i in idx
+        ]
     gains = json.loads(ds.attrs.get("refinement_gain", "[]"))
     if gains:
-        lines += ["", "## Refinement at Γ_C against uniform refinement, at equal DOFs", "",
-                  "error ratio = e_uniform / e_refined at the refined runs' DOFs (> 1: refining at Γ_C is more "
-                  "accurate); DOFs ratio = DOFs the uniform family needs for the refined run's error.", "",
-                  "| refined | uniform | settings | error ratio (geo. mean) | DOFs ratio (geo. mean) | per DOFs |",
-                  "|---|---|---|---:|---:|---|"]
+        lines += [
+            "",
+            "## Refinement at Γ_C against uniform refinement, at equal DOFs",
+            "",
+            "error ratio = e_uniform / e_refined at the refined runs' DOFs (> 1: refining at Γ_C is more "
+            "accurate); DOFs ratio = DOFs the uniform family needs for the refined run's error.",
+            "",
+            "| refined | uniform | settings | error ratio (geo. mean) | DOFs ratio (geo. mean) | per DOFs |",
+            "|---|---|---|---:|---:|---|",
+        ]
         for g in gains:
             per = ", ".join(f"{r['n_dofs']}: {r['ratio']:.3f}" for r in g["error_ratio"]) or g.get("note", "")
-            lines.append(f"| {g['refined']} | {g['uniform']} | {g['solver']}, tol {g['tol']:.0e}, {g['stabilization']} | "
-                         f"{g.get('error_ratio_geometric_mean', float('nan')):.3f} | "
-                         f"{g.get('dofs_ratio_geometric_mean', float('nan')):.3f} | {per} |")
+            lines.append(
+                f"| {g['refined']} | {g['uniform']} | {g['solver']}, tol {g['tol']:.0e}, {g['stabilization']} | "
+                f"{g.get('error_ratio_geometric_mean', float('nan')):.3f} | "
+                f"{g.get('dofs_ratio_geometric_mean', float('nan')):.3f} | {per} |"
+            )
     failed = np.flatnonzero(ds["status"].values != 0)
     if failed.size:
         lines += ["", "## Runs that did not converge", ""]
-        lines += [f"- {describe(ds, i)}: {STATUS_MEANINGS[int(ds['status'].values[i])]}: {ds['message'].values[i]}"
-                  for i in failed]
+        lines += [
+            f"- {describe(ds, i)}: {STATUS_MEANINGS[int(ds['status'].values[i])]}: {ds['message'].values[i]}"
+            for i in failed
+        ]
     return "\n".join(lines) + "\n"

@@ -88,9 +88,17 @@ def run_case(name: str, scene_path, family: str, sizes=None, overrides=(), on_so
     for level, h in enumerate(CASES[name].sizes if sizes is None else sizes):
         scene = case_scene(name, scene_path, family, h, overrides)
         problem, solution, ds = solve_scene(scene, verify=True)
-        record = {"scene": name, "family": family, "level": level, "h": float(h), "n_cells": problem.mesh.n_cells,
-                  "n_dofs": int(problem.n_dofs), "iterations": int(solution.iterations),
-                  "wall_time": float(solution.wall_time), "check_worst": float(ds.attrs["check_worst"])}
+        record = {
+            "scene": name,
+            "family": family,
+            "level": level,
+            "h": float(h),
+            "n_cells": problem.mesh.n_cells,
+            "n_dofs": int(problem.n_dofs),
+            "iterations": int(solution.iterations),
+            "wall_time": float(solution.wall_time),
+            "check_worst": float(ds.attrs["check_worst"]),
+        }
         record.update(MEASURES[name](scene, problem, ds, **CASES[name].parameters))
         records.append(record)
         if on_solution is not None:
@@ -108,8 +116,10 @@ def boundary_value(mesh, u: np.ndarray, point) -> np.ndarray:
     gap = np.linalg.norm(a + s[:, None] * d - point, axis=1)
     k = int(np.argmin(gap))
     if gap[k] > 1e-9 * np.ptp(mesh.vertices, axis=0).max():
-        raise InputError(f"point {tuple(point)} is not on the mesh boundary (nearest edge at {gap[k]:.3g}); "
-                         "give a point of a side", key="point")
+        raise InputError(
+            f"point {tuple(point)} is not on the mesh boundary (nearest edge at {gap[k]:.3g}); give a point of a side",
+            key="point",
+        )
     return (1.0 - s[k]) * u[edges[k, 0]] + s[k] * u[edges[k, 1]]
 
 
@@ -122,8 +132,10 @@ def free_boundary_stress(mesh, u: np.ndarray, side: str, point, window: float, E
     x = mesh.vertices[verts]
     near = np.flatnonzero(np.linalg.norm(x - point, axis=1) <= window)
     if near.size < 2:
-        raise InputError(f"fewer than 2 vertices of side {side!r} within {window:g} of {tuple(point)}; "
-                         "widen the window", key="window")
+        raise InputError(
+            f"fewer than 2 vertices of side {side!r} within {window:g} of {tuple(point)}; widen the window",
+            key="window",
+        )
     tangent = np.linalg.svd(x[near] - x[near].mean(axis=0))[2][0]
     along = (x[near] - point) @ tangent
     lo, hi = verts[near[np.argmin(along)]], verts[near[np.argmax(along)]]
@@ -139,8 +151,12 @@ def _displacement(ds) -> np.ndarray:
 def cook_quantities(scene, problem, ds, *, point, corner) -> dict:
     u = _displacement(ds)
     v_mid = float(boundary_value(problem.mesh, u, point)[1])
-    return {"v_mid": v_mid, "v_corner": float(boundary_value(problem.mesh, u, corner)[1]),
-            "v_mid_reference": COOK_REFERENCE, "v_mid_difference": v_mid / COOK_REFERENCE - 1.0}
+    return {
+        "v_mid": v_mid,
+        "v_corner": float(boundary_value(problem.mesh, u, corner)[1]),
+        "v_mid_reference": COOK_REFERENCE,
+        "v_mid_difference": v_mid / COOK_REFERENCE - 1.0,
+    }
 
 
 def kirsch_quantities(scene, problem, ds, *, hole_side, remote_stress) -> dict:
@@ -148,8 +164,9 @@ def kirsch_quantities(scene, problem, ds, *, hole_side, remote_stress) -> dict:
 
     hole = next(h for h in domain_from_spec(scene.domain).holes if isinstance(h, CircleHole) and h.side == hole_side)
     window = STRESS_WINDOW * float(scene.mesh_options["h"])
-    sigma = free_boundary_stress(problem.mesh, _displacement(ds), hole_side, np.array([hole.cx, hole.cy + hole.r]),
-                                 window, scene.E)
+    sigma = free_boundary_stress(
+        problem.mesh, _displacement(ds), hole_side, np.array([hole.cx, hole.cy + hole.r]), window, scene.E
+    )
     out = {key: float(ds.attrs[key]) for key in ("error_h1", "error_h1_semi", "error_l2")}
     out.update({"stress_concentration": sigma / remote_stress, "stress_concentration_reference": KIRSCH_CONCENTRATION})
     return out
@@ -160,8 +177,9 @@ def arc_radius(domain, side: str) -> float:
     for i, centre in enumerate(domain.arcs):
         if centre is not None and domain.sides[i] == side:
             return math.dist(domain.polygon[i], centre)
-    raise InputError(f"side {side!r} has no arc: the Hertz comparison needs a curved contact side "
-                     "(domain.arcs)", key="domain.arcs")
+    raise InputError(
+        f"side {side!r} has no arc: the Hertz comparison needs a curved contact side (domain.arcs)", key="domain.arcs"
+    )
 
 
 def contact_half_width(x: np.ndarray, penetration: np.ndarray, symmetry_x=None) -> float:
@@ -181,7 +199,7 @@ def contact_half_width(x: np.ndarray, penetration: np.ndarray, symmetry_x=None) 
         return 0.0
     ends = []
     away = 1 if symmetry_x is None or np.mean(x) >= symmetry_x else -1  # half a zone: walk off the axis only
-    for step in ((1, -1) if symmetry_x is None else (away,)):
+    for step in (1, -1) if symmetry_x is None else (away,):
         k = peak
         while 0 <= k + step < t.size and t[k + step] > 0:
             k += step
@@ -207,21 +225,36 @@ def hertz_quantities(scene, problem, ds, *, contact_side, symmetry_x) -> dict:
     a_hertz = 2.0 * math.sqrt(radius * force / (math.pi * scene.E))
     p0_hertz = 2.0 * force / (math.pi * a_hertz)
     p0 = float(pressure.max())
-    return {"contact_force": force, "radius": radius, "normal_k": float(scene.normal_compliance.k),
-            "half_width": a, "half_width_hertz": a_hertz, "half_width_difference": a / a_hertz - 1.0,
-            "peak_pressure": p0, "peak_pressure_hertz": p0_hertz, "peak_pressure_difference": p0 / p0_hertz - 1.0}
+    return {
+        "contact_force": force,
+        "radius": radius,
+        "normal_k": float(scene.normal_compliance.k),
+        "half_width": a,
+        "half_width_hertz": a_hertz,
+        "half_width_difference": a / a_hertz - 1.0,
+        "peak_pressure": p0,
+        "peak_pressure_hertz": p0_hertz,
+        "peak_pressure_difference": p0 / p0_hertz - 1.0,
+    }
 
 
 def bracket_quantities(scene, problem, ds) -> dict:
     pressure, weight = ds["normal_pressure"].values, ds["contact_weight"].values
     touching = ds["penetration"].values > 0
-    return {"contact_force": float(np.sum(weight * pressure)), "contact_length": float(np.sum(weight[touching])),
-            "max_penetration": float(max(0.0, ds["penetration"].values.max())),
-            "max_displacement": float(np.linalg.norm(_displacement(ds), axis=1).max())}
+    return {
+        "contact_force": float(np.sum(weight * pressure)),
+        "contact_length": float(np.sum(weight[touching])),
+        "max_penetration": float(max(0.0, ds["penetration"].values.max())),
+        "max_displacement": float(np.linalg.norm(_displacement(ds), axis=1).max()),
+    }
 
 
-MEASURES = {"cook": cook_quantities, "kirsch": kirsch_quantities, "hertz": hertz_quantities,
-            "lbracket": bracket_quantities}
+MEASURES = {
+    "cook": cook_quantities,
+    "kirsch": kirsch_quantities,
+    "hertz": hertz_quantities,
+    "lbracket": bracket_quantities,
+}
 
 
 # -- the dataset ----------------------------------------------------------------------------------
@@ -244,7 +277,10 @@ VARIABLES = {
     "contact_force": ("total normal contact force P (hertz: of the whole contact, per unit thickness)", "force/length"),
     "radius": ("hertz: radius R of the contact side", "length"),
     "normal_k": ("hertz: normal compliance coefficient k_nu of the foundation", "force/length^3"),
-    "half_width": ("hertz: contact half-width a (zone ends extrapolated with the square-root pressure decay)", "length"),
+    "half_width": (
+        "hertz: contact half-width a (zone ends extrapolated with the square-root pressure decay)",
+        "length",
+    ),
     "half_width_hertz": ("hertz: 2 sqrt(R P / (pi E*)), E* = E (plane stress)", "length"),
     "half_width_difference": ("hertz: half_width / half_width_hertz - 1", "1"),
     "peak_pressure": ("hertz: largest nodal contact pressure p0", "force/length^2"),
@@ -279,26 +315,46 @@ def verification_dataset(records, *, scenes=None, families=None, commit: str | N
         for key in set(r) - set(_IDENTITY):
             data[key][i, j, k] = float(r[key])
     dims = ("scene", "family", "level")
-    ds = xr.Dataset(coords={"scene": ("scene", np.array(scenes, dtype=str)),
-                            "family": ("family", np.array(families, dtype=str)),
-                            "level": ("level", np.arange(levels), {"long_name": "mesh size index, 0 the coarsest"}),
-                            "h": (("scene", "level"), h, {"long_name": "mesh size h of discretization.mesh",
-                                                          "units": "length of the scene"})})
+    ds = xr.Dataset(
+        coords={
+            "scene": ("scene", np.array(scenes, dtype=str)),
+            "family": ("family", np.array(families, dtype=str)),
+            "level": ("level", np.arange(levels), {"long_name": "mesh size index, 0 the coarsest"}),
+            "h": (
+                ("scene", "level"),
+                h,
+                {"long_name": "mesh size h of discretization.mesh", "units": "length of the scene"},
+            ),
+        }
+    )
     for key, (long_name, units) in VARIABLES.items():
         if np.isfinite(data[key]).any():
             ds[key] = (dims, data[key], {"long_name": long_name, "units": units})
     for name, error in ORDERS.items():
         if error in ds:
-            orders = np.array([[convergence_orders(h[i], data[error][i, j]) for j in range(len(families))]
-                               for i in range(len(scenes))])
-            ds[name] = (dims, orders, {"long_name": f"observed order of {error}: log(e_prev/e) / log(h_prev/h)",
-                                       "units": "1"})
+            orders = np.array(
+                [
+                    [convergence_orders(h[i], data[error][i, j]) for j in range(len(families))]
+                    for i in range(len(scenes))
+                ]
+            )
+            ds[name] = (
+                dims,
+                orders,
+                {"long_name": f"observed order of {error}: log(e_prev/e) / log(h_prev/h)", "units": "1"},
+            )
     versions = package_versions()
-    ds.attrs.update({"title": "vemkit verification of the shipped scenes", "Conventions": "CF-1.8",
-                     "family_options": json.dumps(FAMILY_OPTIONS), "git_commit": commit or git_commit(),
-                     "package_versions": json.dumps(versions, sort_keys=True),
-                     "missing_values": "a quantity that does not apply to a scene, or an order at the coarsest "
-                                       "level: NaN in memory, _FillValue -9999.0 in the file"})
+    ds.attrs.update(
+        {
+            "title": "vemkit verification of the shipped scenes",
+            "Conventions": "CF-1.8",
+            "family_options": json.dumps(FAMILY_OPTIONS),
+            "git_commit": commit or git_commit(),
+            "package_versions": json.dumps(versions, sort_keys=True),
+            "missing_values": "a quantity that does not apply to a scene, or an order at the coarsest "
+            "level: NaN in memory, _FillValue -9999.0 in the file",
+        }
+    )
     return ds
 
 

@@ -36,10 +36,16 @@ def specialized(template, element: Element, parallel: bool = False, **calls):
     are that element's. Cached on disk per element under the name ``<template>_<element>``."""
     key = (template.__module__, template.__name__, element.name)
     if key not in _SPECIALIZED:
-        namespace = dict(template.__globals__, workspace=element.workspace, cell_matrix=element.cell_matrix,
-                         DIM=element.dimension, **calls)
-        function = types.FunctionType(template.__code__, namespace, f"{template.__name__}_{element.name}",
-                                      template.__defaults__)
+        namespace = dict(
+            template.__globals__,
+            workspace=element.workspace,
+            cell_matrix=element.cell_matrix,
+            DIM=element.dimension,
+            **calls,
+        )
+        function = types.FunctionType(
+            template.__code__, namespace, f"{template.__name__}_{element.name}", template.__defaults__
+        )
         function.__qualname__ = function.__name__
         function.__module__ = template.__module__
         function.__doc__ = template.__doc__
@@ -129,8 +135,25 @@ def add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
             add_block(data, q, stride, K, i, j, dim)
 
 
-def scatter_rows(row_lo, row_hi, geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam,
-                 mu, stab, condense, max_nodes, data):
+def scatter_rows(
+    row_lo,
+    row_hi,
+    geometry,
+    offsets,
+    nodes,
+    free_index,
+    free_nodes,
+    nc_ptr,
+    nc,
+    indptr,
+    indices,
+    lam,
+    mu,
+    stab,
+    condense,
+    max_nodes,
+    data,
+):
     """*Template.* Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
     work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
     rows = np.empty(max_nodes, dtype=np.int64)
@@ -146,14 +169,32 @@ def scatter_rows(row_lo, row_hi, geometry, offsets, nodes, free_index, free_node
         add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)  # noqa: F821 (specialized)
 
 
-def scatter_stiffness(geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab,
-                      condense, data):
+def scatter_stiffness(
+    geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab, condense, data
+):
     """*Template* (parallel). Every element stiffness (3.9) added into the CSR ``data`` (zeroed)."""
     max_nodes = largest_cell(offsets)
     for chunk in numba.prange(ROW_CHUNKS):
         lo, hi = chunk_rows(chunk, free_nodes.shape[0])
-        scatter_rows(lo, hi, geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices,  # noqa: F821
-                     lam, mu, stab, condense, max_nodes, data)
+        scatter_rows(
+            lo,
+            hi,
+            geometry,
+            offsets,
+            nodes,
+            free_index,
+            free_nodes,
+            nc_ptr,
+            nc,
+            indptr,
+            indices,  # noqa: F821
+            lam,
+            mu,
+            stab,
+            condense,
+            max_nodes,
+            data,
+        )
 
 
 def scatter_kernel(element: Element):
@@ -183,9 +224,22 @@ def stiffness_matrix(space, lam: float, mu: float, stabilization: str, dofs=None
     indptr, indices = dof_pattern(offsets, nodes, nc_ptr, nc, dofs.free_nodes, dofs.free_index, dim)
     data = np.zeros(indices.shape[0])  # fresh zero pages from the system: no zeroing pass
     geometry = space.element.geometry(space.mesh)
-    scatter_kernel(space.element)(geometry, offsets, nodes, dofs.free_index, dofs.free_nodes, nc_ptr, nc,
-                                  indptr, indices, float(lam), float(mu), stabilization_code(stabilization),
-                                  dofs.condensed, data)
+    scatter_kernel(space.element)(
+        geometry,
+        offsets,
+        nodes,
+        dofs.free_index,
+        dofs.free_nodes,
+        nc_ptr,
+        nc,
+        indptr,
+        indices,
+        float(lam),
+        float(mu),
+        stabilization_code(stabilization),
+        dofs.condensed,
+        data,
+    )
     return sorted_csr(data, indices, indptr, dofs.n_free)
 
 
@@ -226,6 +280,16 @@ def dirichlet_lift(space, lam: float, mu: float, stabilization: str, dofs, value
     out = np.zeros(dofs.n_free)
     vals = np.ascontiguousarray(values, dtype=float).reshape(dofs.n_nodes, space.element.dimension)
     geometry = space.element.geometry(space.mesh)
-    specialized(lift, space.element)(geometry, offsets, nodes, dofs.free_index, vals, float(lam), float(mu),
-                                     stabilization_code(stabilization), dofs.condensed, out)
+    specialized(lift, space.element)(
+        geometry,
+        offsets,
+        nodes,
+        dofs.free_index,
+        vals,
+        float(lam),
+        float(mu),
+        stabilization_code(stabilization),
+        dofs.condensed,
+        out,
+    )
     return out

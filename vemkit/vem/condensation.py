@@ -86,9 +86,17 @@ def condense_load(space, lam: float, mu: float, stabilization: str, dofs, load_n
         raise ValueError("condense_load needs a condensed DofMap (VirtualElementSpace.numbering(condensed=True))")
     offsets, nodes = space.cell_nodes
     out = dofs.restrict(load_nodes)
-    specialized(condense, space.element)(space.mesh.vertices, offsets, nodes, dofs.free_index,
-                                         interior_load(space, load_nodes), float(lam), float(mu),
-                                         stabilization_code(stabilization), out)
+    specialized(condense, space.element)(
+        space.mesh.vertices,
+        offsets,
+        nodes,
+        dofs.free_index,
+        interior_load(space, load_nodes),
+        float(lam),
+        float(mu),
+        stabilization_code(stabilization),
+        out,
+    )
     return out
 
 
@@ -98,6 +106,13 @@ def recover_interior(space, lam: float, mu: float, stabilization: str, node_valu
     offsets, nodes = space.cell_nodes
     u = np.array(node_values, dtype=float).reshape(-1, 2)
     specialized(recover, space.element, parallel=True)(
-        space.mesh.vertices, offsets, nodes, u, np.ascontiguousarray(interior_loads, dtype=float).reshape(-1, 2),
-        float(lam), float(mu), stabilization_code(stabilization))
+        space.mesh.vertices,
+        offsets,
+        nodes,
+        u,
+        np.ascontiguousarray(interior_loads, dtype=float).reshape(-1, 2),
+        float(lam),
+        float(mu),
+        stabilization_code(stabilization),
+    )
     return u

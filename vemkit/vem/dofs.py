@@ -118,8 +118,9 @@ class DofMap:
         return np.ascontiguousarray(np.asarray(node_values)[self.free_nodes]).ravel()
 
     @classmethod
-    def numbered(cls, n_vertices: int, order: np.ndarray, free: np.ndarray, condensed: bool = False,
-                 dimension: int = 2) -> "DofMap":
+    def numbered(
+        cls, n_vertices: int, order: np.ndarray, free: np.ndarray, condensed: bool = False, dimension: int = 2
+    ) -> "DofMap":
         """The free nodes (mask ``free``, (n_nodes,)) numbered in ``order`` (every node, the numbering)."""
         free_nodes = order[free[order]]
         free_index = np.full(free.size, -1, dtype=np.int64)
@@ -130,8 +131,13 @@ class DofMap:
 def morton_order(mesh: Mesh) -> np.ndarray:
     """The cells sorted along a Z-order (Morton) curve of their vertex means: neighbours stay near."""
     count = np.maximum(mesh.cell_sizes, 1)
-    centre = np.stack([np.bincount(mesh.half_edge_cells, mesh.vertices[mesh.cell_vertices, k], mesh.n_cells) / count
-                       for k in range(2)], axis=1)
+    centre = np.stack(
+        [
+            np.bincount(mesh.half_edge_cells, mesh.vertices[mesh.cell_vertices, k], mesh.n_cells) / count
+            for k in range(2)
+        ],
+        axis=1,
+    )
     lo, hi = centre.min(axis=0), centre.max(axis=0)
     q = ((centre - lo) / np.maximum(hi - lo, 1e-300) * 65535).astype(np.uint64)
     code = np.zeros(mesh.n_cells, dtype=np.uint64)

@@ -104,12 +104,14 @@ def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, s
     """(a_h^K(u, u), a_K(Π u, Π u)) per cell, for any element (module docstring)."""
     mesh, u = space.mesh, np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, 2)
     if space.element.stress_degree == 0:  # constant strain: the k = 1 kernel (exact products)
-        return local_energies(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu,
-                              stabilization_code(stabilization))
+        return local_energies(
+            mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu, stabilization_code(stabilization)
+        )
     offsets, nodes = space.cell_nodes
     total = np.zeros(mesh.n_cells)
-    specialized(cell_energies, space.element)(mesh.vertices, offsets, nodes, u, float(lam), float(mu),
-                                              stabilization_code(stabilization), total)
+    specialized(cell_energies, space.element)(
+        mesh.vertices, offsets, nodes, u, float(lam), float(mu), stabilization_code(stabilization), total
+    )
     points, weights, cells = reference_quadrature(mesh, degree=2)
     strain = strain_of(projection.gradient_at(cells, points))
     sig = stress(strain, lam, mu)
@@ -132,8 +134,10 @@ def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarr
     for axis in (0, 1):
         shift = np.zeros_like(centre)
         shift[:, axis] = step[:, 0]
-        d[axis] = (stress_at(projection, cells, centre + shift, lam, mu)
-                   - stress_at(projection, cells, centre - shift, lam, mu)) / (2.0 * step)
+        d[axis] = (
+            stress_at(projection, cells, centre + shift, lam, mu)
+            - stress_at(projection, cells, centre - shift, lam, mu)
+        ) / (2.0 * step)
     return np.stack([d[0][:, 0] + d[1][:, 2], d[0][:, 2] + d[1][:, 1]], axis=1)
 
 
@@ -146,8 +150,10 @@ def _edge_normals(points_a, points_b):
 
 def _traction(sig: np.ndarray, normal: np.ndarray) -> np.ndarray:
     """σ n for Voigt rows (σ11, σ22, σ12) and unit normals, both (E, ...)."""
-    return np.stack([sig[:, 0] * normal[:, 0] + sig[:, 2] * normal[:, 1],
-                     sig[:, 2] * normal[:, 0] + sig[:, 1] * normal[:, 1]], axis=1)
+    return np.stack(
+        [sig[:, 0] * normal[:, 0] + sig[:, 2] * normal[:, 1], sig[:, 2] * normal[:, 0] + sig[:, 1] * normal[:, 1]],
+        axis=1,
+    )
 
 
 class _Stress:
@@ -190,7 +196,9 @@ def _jump_terms(mesh: Mesh, sig: _Stress) -> np.ndarray:
 
 def _boundary_cells(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     """The cell of every boundary edge (a, b) (as stored in ``mesh.boundary``)."""
-    key = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * mesh.n_vertices + np.maximum(mesh.edges[:, 0], mesh.edges[:, 1])
+    key = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * mesh.n_vertices + np.maximum(
+        mesh.edges[:, 0], mesh.edges[:, 1]
+    )
     order = np.argsort(key)
     wanted = np.minimum(edges[:, 0], edges[:, 1]) * mesh.n_vertices + np.maximum(edges[:, 0], edges[:, 1])
     return mesh.edge_cells[order[np.searchsorted(key[order], wanted)], 0]
@@ -215,8 +223,9 @@ def _boundary_terms(mesh: Mesh, sig: _Stress, edges: np.ndarray, datum) -> np.nd
     return out
 
 
-def error_indicators(space, u_nodes, lam: float, mu: float, stabilization: str, *,
-                     body_force=None, neumann=None, contact=None) -> dict:
+def error_indicators(
+    space, u_nodes, lam: float, mu: float, stabilization: str, *, body_force=None, neumann=None, contact=None
+) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
     space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a Mesh: k = 1); u_nodes its degrees
@@ -231,8 +240,12 @@ def error_indicators(space, u_nodes, lam: float, mu: float, stabilization: str, 
     projection = space.project(u, lam, mu)
     sig = _Stress(space, projection, lam, mu)
     total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
-    terms = {"volume": _volume_terms(mesh, sig, body_force), "jump": _jump_terms(mesh, sig),
-             "neumann": np.zeros(mesh.n_cells), "contact": np.zeros(mesh.n_cells)}
+    terms = {
+        "volume": _volume_terms(mesh, sig, body_force),
+        "jump": _jump_terms(mesh, sig),
+        "neumann": np.zeros(mesh.n_cells),
+        "contact": np.zeros(mesh.n_cells),
+    }
     for side, traction in (neumann or {}).items():
         terms["neumann"] += _boundary_terms(mesh, sig, mesh.boundary[side], _sampled(traction))
     for side, at_nodes in (contact or {}).items():
@@ -242,8 +255,12 @@ def error_indicators(space, u_nodes, lam: float, mu: float, stabilization: str, 
     terms["stabilization"] = np.maximum(total - consistency, 0.0)
     squared = residual + terms["stabilization"]
     energy = float(total.sum())
-    return {"indicator": np.sqrt(squared), **terms, "estimate": float(np.sqrt(squared.sum() / energy)) if energy > 0
-            else 0.0, "energy": energy}
+    return {
+        "indicator": np.sqrt(squared),
+        **terms,
+        "estimate": float(np.sqrt(squared.sum() / energy)) if energy > 0 else 0.0,
+        "energy": energy,
+    }
 
 
 def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
@@ -261,6 +278,7 @@ def _sampled(traction):
     def datum(points, _t):
         t1, t2 = traction(points[..., 0], points[..., 1])
         return np.stack(np.broadcast_arrays(t1, t2), axis=-1)
+
     return datum
 
 
@@ -273,11 +291,13 @@ def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
 
         def datum(_points, t):
             return ta[None] + t[:, None, None] * (tb - ta)[None]
+
         return datum
     values = at_nodes[nodes]  # (E, k + 1, 2)
 
     def datum(_points, t):
         return np.einsum("qn,enc->qec", space.element.edge_trace(t), values)
+
     return datum
 
 

@@ -55,8 +55,9 @@ def _cell_kinds(vertices, offsets, cell_vertices, tol, kinds):
         n = offsets[c + 1] - s
         kinds[c] = WACHSPRESS
         for i in range(n):
-            cross, scale, _ = turn(vertices, cell_vertices[s + (i - 1 + n) % n], cell_vertices[s + i],
-                                   cell_vertices[s + (i + 1) % n])
+            cross, scale, _ = turn(
+                vertices, cell_vertices[s + (i - 1 + n) % n], cell_vertices[s + i], cell_vertices[s + (i + 1) % n]
+            )
             if cross <= tol * scale:
                 kinds[c] = MEAN_VALUE
                 break
@@ -164,8 +165,9 @@ def coordinates(px, py, points, kind: int = WACHSPRESS) -> np.ndarray:
     return out
 
 
-def interpolate(mesh: Mesh, values: np.ndarray, points: np.ndarray, cells: np.ndarray | None = None,
-                kinds: np.ndarray | None = None) -> np.ndarray:
+def interpolate(
+    mesh: Mesh, values: np.ndarray, points: np.ndarray, cells: np.ndarray | None = None, kinds: np.ndarray | None = None
+) -> np.ndarray:
     """Values (P, k) at ``points`` of the generalized barycentric interpolant of the vertex
     ``values`` (N, k) or (N,) on ``mesh``. ``cells``: a cell containing each point (default:
     located with ``vemkit.mesh.locate.locate_points``); ``kinds``: from :func:`cell_kinds`."""

@@ -31,8 +31,17 @@ from vemkit.vem.elements.k1_fields import ProjectedSolution, projected_solution
 from vemkit.vem.interpolation import interpolate
 from vemkit.vem.quadrature import edge_quadrature, reference_quadrature
 
-__all__ = ["difference_gradient", "exact_errors", "nesting_subdivisions", "paper_error", "projection_error",
-           "relative_exact_errors", "seminorm_squared", "trace_error", "trace_errors"]
+__all__ = [
+    "difference_gradient",
+    "exact_errors",
+    "nesting_subdivisions",
+    "paper_error",
+    "projection_error",
+    "relative_exact_errors",
+    "seminorm_squared",
+    "trace_error",
+    "trace_errors",
+]
 
 
 def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=None, regions=None) -> dict:
@@ -56,8 +65,11 @@ def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=
     semi = np.sum(density)
     ref_l2 = np.sum(weights * np.sum(value_ref**2, axis=1))
     ref_semi = np.sum(weights * np.sum(grad_ref**2, axis=(1, 2)))
-    out = {"h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))), "h1_semi": float(np.sqrt(semi / ref_semi)),
-           "l2": float(np.sqrt(l2 / ref_l2))}
+    out = {
+        "h1": float(np.sqrt((l2 + semi) / (ref_l2 + ref_semi))),
+        "h1_semi": float(np.sqrt(semi / ref_semi)),
+        "l2": float(np.sqrt(l2 / ref_l2)),
+    }
     for name, mask in (regions or {}).items():
         out[f"share_{name}"] = float(np.sum(density[mask(points)]) / semi) if semi > 0 else 0.0
     return out
@@ -68,8 +80,14 @@ def seminorm_squared(areas: np.ndarray, gradient: np.ndarray) -> float:
     return float(np.sum(areas * np.sum(gradient**2, axis=(1, 2))))
 
 
-def paper_error(coarse_mesh: Mesh, u_coarse: np.ndarray, ref_mesh: Mesh, u_ref: np.ndarray,
-                ref_projected: ProjectedSolution | None = None, ref_areas: np.ndarray | None = None) -> float:
+def paper_error(
+    coarse_mesh: Mesh,
+    u_coarse: np.ndarray,
+    ref_mesh: Mesh,
+    u_ref: np.ndarray,
+    ref_projected: ProjectedSolution | None = None,
+    ref_areas: np.ndarray | None = None,
+) -> float:
     """The paper's measure |Pi_1^ref (I_ref u_h - u_ref)|_{H1} / |Pi_1^ref u_ref|_{H1} (SPEC §5).
 
     ``u_coarse`` (N_h, 2) and ``u_ref`` (N_ref, 2) are vertex values. ``ref_projected``
@@ -103,13 +121,17 @@ def exact_errors(mesh: Mesh, proj, u_exact, grad_exact, quadrature=None) -> dict
 def difference_gradient(field, step: float):
     """grad_exact for :func:`exact_errors` from field(x, y) -> (u1, u2) alone, by fourth-order
     central differences of width ``step`` (truncation O(step^4), rounding O(eps / step))."""
+
     def grad(x, y):
         out = np.empty((2, 2) + np.shape(x))
         for axis in (0, 1):
             shifted = [field(x + s * step, y) if axis == 0 else field(x, y + s * step) for s in (-2, -1, 1, 2)]
             for c in (0, 1):
-                out[c, axis] = (shifted[0][c] - 8.0 * shifted[1][c] + 8.0 * shifted[2][c] - shifted[3][c]) / (12.0 * step)
+                out[c, axis] = (shifted[0][c] - 8.0 * shifted[1][c] + 8.0 * shifted[2][c] - shifted[3][c]) / (
+                    12.0 * step
+                )
         return out
+
     return grad
 
 
@@ -125,9 +147,13 @@ def relative_exact_errors(mesh: Mesh, proj, u_exact) -> dict:
     absolute = exact_errors(mesh, proj, u_exact, grad, quadrature)
     zero = exact_errors(mesh, _Zero(), u_exact, grad, quadrature)
     tiny = np.finfo(float).tiny
-    return {"error_l2": absolute["l2"] / max(zero["l2"], tiny),
-            "error_h1_semi": absolute["h1_semi"] / max(zero["h1_semi"], tiny),
-            "error_h1": float(np.hypot(absolute["l2"], absolute["h1_semi"]) / max(np.hypot(zero["l2"], zero["h1_semi"]), tiny))}
+    return {
+        "error_l2": absolute["l2"] / max(zero["l2"], tiny),
+        "error_h1_semi": absolute["h1_semi"] / max(zero["h1_semi"], tiny),
+        "error_h1": float(
+            np.hypot(absolute["l2"], absolute["h1_semi"]) / max(np.hypot(zero["l2"], zero["h1_semi"]), tiny)
+        ),
+    }
 
 
 class _Zero:
@@ -201,13 +227,16 @@ def trace_errors(space, parts, node_values, field, subdivisions: int = 4, points
     interpolant = sum(trace_weights[None, :, k, None] * dof[:, None] for k, dof in enumerate(ends + means))
     dx = lengths[:, None] * weights[None, :]
     norm = np.sqrt(np.sum(dx * np.sum(exact**2, axis=2)))
-    return {"contact_l2": float(np.sqrt(np.sum(dx * np.sum((discrete - exact) ** 2, axis=2))) / norm),
-            "interpolation_contact_l2": float(np.sqrt(np.sum(dx * np.sum((interpolant - exact) ** 2, axis=2))) / norm)}
+    return {
+        "contact_l2": float(np.sqrt(np.sum(dx * np.sum((discrete - exact) ** 2, axis=2))) / norm),
+        "interpolation_contact_l2": float(np.sqrt(np.sum(dx * np.sum((interpolant - exact) ** 2, axis=2))) / norm),
+    }
 
 
 def nesting_subdivisions(mesh: Mesh, ref_mesh: Mesh, parts) -> int:
     """The power of two m such that 1/m of the longest edge of ``mesh`` on ``parts`` is at most the
     shortest reference edge there: with nested dyadic meshes, each piece then lies in one reference edge."""
+
     def lengths(m):
         edges = _part_edges(m, parts)
         return np.linalg.norm(m.vertices[edges[:, 1]] - m.vertices[edges[:, 0]], axis=1)

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 #: the strain and stress components of a 3D body, in the solution file's order (SPEC §10)
 COMPONENTS_3D = ("11", "22", "33", "12", "13", "23")
 _PAIRS_3D = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))

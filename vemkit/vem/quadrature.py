@@ -69,11 +69,15 @@ def pressure_traction(mesh: Mesh, edges: np.ndarray, pressure):
 def cell_averages(mesh: Mesh, field, triangles: np.ndarray, parent: np.ndarray) -> np.ndarray:
     """(M, 2) cell averages P_0 f of a vector field f(x, y) -> (fx, fy), from a cell triangulation."""
     p = mesh.vertices[triangles]  # (T, 3, 2)
-    area = 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    area = 0.5 * (
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1])
+    )
     x = np.einsum("qk,tkc->tqc", TRIANGLE_RULE[:, :3], p)
     fx, fy = field(x[..., 0], x[..., 1])
     w = TRIANGLE_RULE[:, 3][None, :] * area[:, None]
-    integral = np.stack([np.sum(w * np.broadcast_to(fx, w.shape), axis=1), np.sum(w * np.broadcast_to(fy, w.shape), axis=1)], axis=1)
+    integral = np.stack(
+        [np.sum(w * np.broadcast_to(fx, w.shape), axis=1), np.sum(w * np.broadcast_to(fy, w.shape), axis=1)], axis=1
+    )
     out = np.zeros((mesh.n_cells, 2))
     for comp in range(2):
         out[:, comp] = np.bincount(parent, integral[:, comp], mesh.n_cells)
@@ -95,7 +99,9 @@ def reference_quadrature(mesh: Mesh, degree: int = 2):
     bary, w = (_DEGREE2, _DEGREE2_WEIGHTS) if degree <= 2 else (TRIANGLE_RULE[:, :3], TRIANGLE_RULE[:, 3])
     tri, parent = triangulate_cells(mesh)
     p = mesh.vertices[tri]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    area = 0.5 * np.abs(
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1])
+    )
     points = np.einsum("qk,tkc->tqc", bary, p).reshape(-1, 2)
     weights = (area[:, None] * w[None, :]).ravel()
     cells = np.repeat(parent, bary.shape[0])

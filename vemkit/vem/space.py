@@ -82,8 +82,13 @@ class VirtualElementSpace:
         if condensed and self.element.condensed_nodes:
             free[self.node_range("cell")] = False
         order = np.arange(self.n_nodes, dtype=np.int64) if natural else self._numbering_order
-        return DofMap.numbered(self.mesh.n_vertices, order, free, condensed=bool(condensed and self.element.condensed_nodes),
-                               dimension=self.element.dimension)
+        return DofMap.numbered(
+            self.mesh.n_vertices,
+            order,
+            free,
+            condensed=bool(condensed and self.element.condensed_nodes),
+            dimension=self.element.dimension,
+        )
 
     def clamped_on(self, edges) -> np.ndarray:
         """(n_nodes,) mask of the trace nodes of the given boundary edges (vertex pairs (k, 2)): what
@@ -136,7 +141,7 @@ class VirtualElementSpace:
         values = np.asarray(node_values, dtype=float).reshape(-1, 2)[self.edge_nodes(edges)]  # (E, k + 1, 2)
         trace = weights[:, 0:1] * values[:, 0]
         for k in range(1, weights.shape[1]):  # node by node, in the trace's order
-            trace = trace + weights[:, k:k + 1] * values[:, k]
+            trace = trace + weights[:, k : k + 1] * values[:, k]
         return trace
 
     # -- loads and the stiffness matrix -----------------------------------------------------

@@ -25,10 +25,9 @@ import time
 from datetime import datetime
 from pathlib import Path
 
-import yaml
-
 import local_cluster as cluster
 import run_checks as checks
+import yaml
 
 PROFILE = checks.ROOT / "workflow" / "profiles" / "slurm" / "config.yaml"
 #: the first status check this many seconds after a submission (the plugin's default, 40 s, only slows a test)
@@ -67,14 +66,17 @@ def slurm_run(state: Path, run: Path, accounting: bool, timeout: float, say):
         raise checks.CheckError(f"the SLURM run failed ({code}); see {log}")
     say(f"snakemake --profile ({mode}): {seconds:.0f} s, log {log}")
     if accounting and "invalid option" in log.read_text():
-        raise checks.CheckError(f"the executor's account guess ran (sacct: invalid option) although "
-                                f"slurm_account is set; see {log}")
+        raise checks.CheckError(
+            f"the executor's account guess ran (sacct: invalid option) although slurm_account is set; see {log}"
+        )
     submitted, local = checks.run_rules(log)
     jobs = checks.sacct_jobs(run, since) if accounting else checks.scontrol_jobs(run)
     checks.check_jobs(jobs, submitted, local, profile, cluster.ACCOUNT if accounting else None)
     source = "sacct" if accounting else "scontrol (no accounting)"
-    say(f"{len(jobs)} SLURM jobs, all COMPLETED with the profile's mem_mb/runtime/cpus_per_task ({source}); "
-        f"local rules (not submitted): {dict(local)}\n\n{checks.jobs_table(jobs)}\n")
+    say(
+        f"{len(jobs)} SLURM jobs, all COMPLETED with the profile's mem_mb/runtime/cpus_per_task ({source}); "
+        f"local rules (not submitted): {dict(local)}\n\n{checks.jobs_table(jobs)}\n"
+    )
 
 
 def hang_without_squeue(state: Path, seconds: float, say):
@@ -88,11 +90,15 @@ def hang_without_squeue(state: Path, seconds: float, say):
     code, seconds_run = checks.snakemake(run, args, log, seconds, numba_cache=state / "numba-cache")
     made = (run / target).exists()
     if code is None:
-        say(f"default status command (sacct) without accounting: still waiting after {seconds_run:.0f} s although "
-            f"the job {'completed (its output exists)' if made else 'ran'}; stopped (the hang the README warns of)")
+        say(
+            f"default status command (sacct) without accounting: still waiting after {seconds_run:.0f} s although "
+            f"the job {'completed (its output exists)' if made else 'ran'}; stopped (the hang the README warns of)"
+        )
     else:
-        say(f"default status command (sacct) without accounting: exited {code} after {seconds_run:.0f} s "
-            f"(no hang: the executor has changed; see {log})")
+        say(
+            f"default status command (sacct) without accounting: exited {code} after {seconds_run:.0f} s "
+            f"(no hang: the executor has changed; see {log})"
+        )
 
 
 def local_run(state: Path, snapshot: Path, timeout: float, say) -> Path:
@@ -103,8 +109,13 @@ def local_run(state: Path, snapshot: Path, timeout: float, say) -> Path:
     if not stamp.exists() or stamp.read_text() != digest:
         checks.copy_tree(snapshot, run, fresh=True)
     log = state / "log" / "snakemake-local.log"
-    code, seconds = checks.snakemake(run, ["-j2", *checks.TARGETS, "--configfile", checks.CONFIGFILE], log, timeout,
-                                     numba_cache=state / "numba-cache")
+    code, seconds = checks.snakemake(
+        run,
+        ["-j2", *checks.TARGETS, "--configfile", checks.CONFIGFILE],
+        log,
+        timeout,
+        numba_cache=state / "numba-cache",
+    )
     if code != 0:
         raise checks.CheckError(f"the local run failed or timed out ({code}); see {log}")
     stamp.write_text(digest)
@@ -158,8 +169,9 @@ def _leftovers(stopped: list[str]) -> list[str]:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--mode", choices=["accounting", "no-accounting"], default="accounting")
-    parser.add_argument("--state", type=Path, default=Path(os.environ.get("VEMKIT_CLUSTER_STATE",
-                                                                         "/tmp/vemkit-cluster-test")))
+    parser.add_argument(
+        "--state", type=Path, default=Path(os.environ.get("VEMKIT_CLUSTER_STATE", "/tmp/vemkit-cluster-test"))
+    )
     parser.add_argument("--timeout", type=float, default=3600, help="seconds per snakemake run (default 3600)")
     args = parser.parse_args(argv)
     if os.geteuid() != 0:
@@ -198,8 +210,10 @@ def main(argv=None) -> int:
         left = _leftovers(stopped)
         say(f"stopped (by PID): {', '.join(stopped) or 'nothing'}; still running: {left or 'none'}")
         status = status or bool(left)
-    say(f"cluster-test ({args.mode}): {'PASSED' if status == 0 else 'FAILED'} in {time.monotonic() - start:.0f} s;"
-        f" report {report}")
+    say(
+        f"cluster-test ({args.mode}): {'PASSED' if status == 0 else 'FAILED'} in {time.monotonic() - start:.0f} s;"
+        f" report {report}"
+    )
     return status
 
 

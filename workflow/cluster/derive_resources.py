@@ -84,7 +84,8 @@ def read_benchmarks(results_dirs: list[Path], patterns) -> dict[str, list[dict]]
             with open(tsv) as handle:
                 for row in csv.DictReader(handle, delimiter="\t"):
                     rows.setdefault(rules[0], []).append(
-                        {k: _number(row.get(k)) for k in ("s", "max_rss", "cpu_time")} | {"file": name})
+                        {k: _number(row.get(k)) for k in ("s", "max_rss", "cpu_time")} | {"file": name}
+                    )
     return rows
 
 
@@ -109,7 +110,7 @@ def derive(rows: list[dict], threads: int) -> dict:
         "runtime": max(TIME_FLOOR, _round_up(TIME_FACTOR * longest_s / 60, 5)),
         "cpus_per_task": threads if threads > 1 else max(1, math.ceil(cpu_use - 0.2)),
         "measured": f"{len(rows)} run{'s' * (len(rows) != 1)}: peak {peak_mb:.0f} MB, longest {longest_s:.0f} s, "
-                    f"CPU use {cpu_use:.2f}",
+        f"CPU use {cpu_use:.2f}",
     }
 
 
@@ -117,9 +118,12 @@ def profile_block(derived: dict[str, dict]) -> str:
     """The set-resources entries, between the markers."""
     lines = [BEGIN + f" (memory x {MEM_FACTOR:g} + {JOBSTEP_MB} MB, time x {TIME_FACTOR:g}; see its docstring)"]
     for rule, res in sorted(derived.items()):
-        lines += [f"  {rule + ':':<18}# {res['measured']}",
-                  f"    mem_mb: {res['mem_mb']}", f"    runtime: {res['runtime']}",
-                  f"    cpus_per_task: {res['cpus_per_task']}"]
+        lines += [
+            f"  {rule + ':':<18}# {res['measured']}",
+            f"    mem_mb: {res['mem_mb']}",
+            f"    runtime: {res['runtime']}",
+            f"    cpus_per_task: {res['cpus_per_task']}",
+        ]
     return "\n".join(lines + [END])
 
 
@@ -127,8 +131,14 @@ def write_profile(derived: dict[str, dict], profile: Path = PROFILE):
     """Replace the block; a rule of the old block without a benchmark now keeps its old values."""
     text = profile.read_text()
     old = yaml.safe_load(text).get("set-resources") or {}
-    derived = {**{rule: {**res, "measured": "kept: no benchmark in the results given"} for rule, res in old.items()
-                  if rule not in derived}, **derived}
+    derived = {
+        **{
+            rule: {**res, "measured": "kept: no benchmark in the results given"}
+            for rule, res in old.items()
+            if rule not in derived
+        },
+        **derived,
+    }
     start, stop = text.find(BEGIN), text.find(END)
     if start < 0 or stop < start:
         raise SystemExit(f"{profile}: no '{BEGIN.strip()}' ... '{END.strip()}' block under set-resources")
@@ -138,8 +148,13 @@ def write_profile(derived: dict[str, dict], profile: Path = PROFILE):
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="SLURM resources per rule from the benchmark TSVs")
-    parser.add_argument("results", nargs="*", type=Path, default=[ROOT / "results"],
-                        help="results directories with a benchmarks/ folder (default: results/)")
+    parser.add_argument(
+        "results",
+        nargs="*",
+        type=Path,
+        default=[ROOT / "results"],
+        help="results directories with a benchmarks/ folder (default: results/)",
+    )
     parser.add_argument("--write", action="store_true", help=f"update the set-resources block of {PROFILE}")
     args = parser.parse_args(argv)
     patterns = benchmark_patterns()

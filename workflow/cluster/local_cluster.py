@@ -110,16 +110,23 @@ def _fill(template: str, values: dict) -> str:
 
 def _write_config(path: Path, text: str, mode: int):
     if path.exists() and MARKER not in path.read_text(errors="replace"):
-        raise ClusterError(f"{path} exists and was not written by make cluster-test: this host has its own "
-                           "SLURM configuration; run the test on a machine without one")
+        raise ClusterError(
+            f"{path} exists and was not written by make cluster-test: this host has its own "
+            "SLURM configuration; run the test on a machine without one"
+        )
     path.write_text(text)
     path.chmod(mode)
 
 
 def write_configuration(state: Path, accounting: bool) -> dict:
     """slurm.conf (and slurmdbd.conf with accounting) for this host; the values used."""
-    values = {**host_resources(), "STATE": str(state), "MARKER": MARKER, "DB_PORT": str(DB_PORT),
-              "ACCOUNTING": WITH_ACCOUNTING if accounting else WITHOUT_ACCOUNTING}
+    values = {
+        **host_resources(),
+        "STATE": str(state),
+        "MARKER": MARKER,
+        "DB_PORT": str(DB_PORT),
+        "ACCOUNTING": WITH_ACCOUNTING if accounting else WITHOUT_ACCOUNTING,
+    }
     for sub in ("slurmctld", "slurmd", "log", "pids"):
         (state / sub).mkdir(parents=True, exist_ok=True)
     SLURM_ETC.mkdir(exist_ok=True)
@@ -190,8 +197,15 @@ class Daemons:
         exe = os.path.realpath(shutil.which(argv[0]) or argv[0])
         log = self.state / "log" / f"{name}.out"
         with open(log, "ab") as out:
-            process = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, cwd=self.state / "log",
-                                       stdin=subprocess.DEVNULL, start_new_session=True, user=user)
+            process = subprocess.Popen(
+                argv,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                cwd=self.state / "log",
+                stdin=subprocess.DEVNULL,
+                start_new_session=True,
+                user=user,
+            )
         record = self.state / "pids" / f"{len(self.started) + 1:02d}-{name}.pid"
         record.write_text(f"{process.pid}\n{exe}\n")
         self.started.append((name, process, exe, record))
@@ -222,8 +236,10 @@ def _answers(argv, expect: str = "") -> bool:
 def _munge_answers() -> bool:
     try:
         cred = subprocess.run(["munge", "-n"], capture_output=True, timeout=10)
-        return cred.returncode == 0 and subprocess.run(["unmunge"], input=cred.stdout, capture_output=True,
-                                                       timeout=10).returncode == 0
+        return (
+            cred.returncode == 0
+            and subprocess.run(["unmunge"], input=cred.stdout, capture_output=True, timeout=10).returncode == 0
+        )
     except subprocess.TimeoutExpired:
         return False
 
@@ -247,29 +263,72 @@ def start_mariadb(daemons: Daemons, state: Path, password: str) -> str:
     if not (datadir / "mysql").is_dir():
         datadir.mkdir(parents=True, exist_ok=True)
         shutil.chown(datadir, "mysql", "mysql")
-        run(["mariadb-install-db", "--no-defaults", f"--datadir={datadir}", "--user=mysql", "--skip-test-db",
-             "--auth-root-authentication-method=socket"], timeout=300)
-    argv = ["mariadbd", "--no-defaults", f"--datadir={datadir}", f"--socket={sock}", f"--port={DB_PORT}",
-            "--bind-address=127.0.0.1", "--skip-name-resolve", "--user=mysql",
-            f"--pid-file={datadir / 'mariadbd.pid'}", f"--log-error={state / 'log' / 'mariadbd.log'}"]
+        run(
+            [
+                "mariadb-install-db",
+                "--no-defaults",
+                f"--datadir={datadir}",
+                "--user=mysql",
+                "--skip-test-db",
+                "--auth-root-authentication-method=socket",
+            ],
+            timeout=300,
+        )
+    argv = [
+        "mariadbd",
+        "--no-defaults",
+        f"--datadir={datadir}",
+        f"--socket={sock}",
+        f"--port={DB_PORT}",
+        "--bind-address=127.0.0.1",
+        "--skip-name-resolve",
+        "--user=mysql",
+        f"--pid-file={datadir / 'mariadbd.pid'}",
+        f"--log-error={state / 'log' / 'mariadbd.log'}",
+    ]
     ping = ["mariadb-admin", "--no-defaults", f"--socket={sock}", "-u", "root", "ping"]
     pid = daemons.start("mariadbd", argv, lambda: _answers(ping), timeout=120)
-    sql = (f"CREATE USER IF NOT EXISTS 'slurm'@'127.0.0.1' IDENTIFIED BY '{password}'; "
-           f"ALTER USER 'slurm'@'127.0.0.1' IDENTIFIED BY '{password}'; "
-           "GRANT ALL PRIVILEGES ON slurm_acct_db.* TO 'slurm'@'127.0.0.1'; FLUSH PRIVILEGES;")
+    sql = (
+        f"CREATE USER IF NOT EXISTS 'slurm'@'127.0.0.1' IDENTIFIED BY '{password}'; "
+        f"ALTER USER 'slurm'@'127.0.0.1' IDENTIFIED BY '{password}'; "
+        "GRANT ALL PRIVILEGES ON slurm_acct_db.* TO 'slurm'@'127.0.0.1'; FLUSH PRIVILEGES;"
+    )
     run(["mariadb", "--no-defaults", f"--socket={sock}", "-u", "root", "-e", sql])
     return f"mariadbd: started, pid {pid}"
 
 
 def start_slurmdbd(daemons: Daemons, cluster: str) -> str:
     """slurmdbd, then the cluster, the account ACCOUNT and root's association with it."""
-    pid = daemons.start("slurmdbd", ["slurmdbd", "-D"], lambda: _answers(["sacctmgr", "-n", "list", "cluster"]),
-                        timeout=120)
+    pid = daemons.start(
+        "slurmdbd", ["slurmdbd", "-D"], lambda: _answers(["sacctmgr", "-n", "list", "cluster"]), timeout=120
+    )
     run(["sacctmgr", "-i", "add", "cluster", cluster], check=False)
-    run(["sacctmgr", "-i", "add", "account", ACCOUNT, f"Cluster={cluster}", "Description=vemkit cluster test",
-         "Organization=vemkit"], check=False)
-    run(["sacctmgr", "-i", "add", "user", "root", f"Account={ACCOUNT}", f"DefaultAccount={ACCOUNT}",
-         f"Cluster={cluster}"], check=False)
+    run(
+        [
+            "sacctmgr",
+            "-i",
+            "add",
+            "account",
+            ACCOUNT,
+            f"Cluster={cluster}",
+            "Description=vemkit cluster test",
+            "Organization=vemkit",
+        ],
+        check=False,
+    )
+    run(
+        [
+            "sacctmgr",
+            "-i",
+            "add",
+            "user",
+            "root",
+            f"Account={ACCOUNT}",
+            f"DefaultAccount={ACCOUNT}",
+            f"Cluster={cluster}",
+        ],
+        check=False,
+    )
     assocs = run(["sacctmgr", "-n", "-P", "show", "assoc", "user=root", "format=account"]).stdout.split()
     if ACCOUNT not in assocs:
         raise ClusterError(f"sacctmgr: root has no association with account {ACCOUNT} (has {assocs})")
@@ -311,5 +370,7 @@ def host_is_free() -> None:
         with socket.socket() as probe:
             probe.settimeout(1)
             if probe.connect_ex(("127.0.0.1", port)) == 0:
-                raise ClusterError(f"port {port} ({name}) is in use: a daemon not started by this test runs "
-                                   "here; stop it (or run the test on another machine)")
+                raise ClusterError(
+                    f"port {port} ({name}) is in use: a daemon not started by this test runs "
+                    "here; stop it (or run the test on another machine)"
+                )

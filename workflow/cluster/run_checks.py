@@ -36,8 +36,14 @@ class CheckError(AssertionError):
 def tree_files(root: Path) -> list[str]:
     """The checkout's files (tracked and untracked, not ignored; no results/), relative to root."""
     if (root / ".git").exists() and shutil.which("git"):
-        listed = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=root, capture_output=True,
-                                text=True, check=True, timeout=60).stdout.splitlines()
+        listed = subprocess.run(
+            ["git", "ls-files", "-co", "--exclude-standard"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            check=True,
+            timeout=60,
+        ).stdout.splitlines()
         return [f for f in listed if not f.startswith("results/") and (root / f).is_file()]
     files = []
     for folder, dirs, names in os.walk(root):
@@ -58,8 +64,16 @@ def copy_tree(root: Path, dest: Path, fresh: bool) -> Path:
 
 
 #: what the results depend on: the package, the workflow, the configuration
-RESULT_SOURCES = ("vemkit/", "workflow/rules/", "workflow/scripts/", "workflow/schemas/", "workflow/report/",
-                  "config/", "Snakefile", CONFIGFILE)
+RESULT_SOURCES = (
+    "vemkit/",
+    "workflow/rules/",
+    "workflow/scripts/",
+    "workflow/schemas/",
+    "workflow/report/",
+    "config/",
+    "Snakefile",
+    CONFIGFILE,
+)
 
 
 def source_digest(tree: Path) -> str:
@@ -70,8 +84,9 @@ def source_digest(tree: Path) -> str:
     return digest.hexdigest()
 
 
-def snakemake(workdir: Path, args: list[str], log: Path, timeout: float,
-              numba_cache: Path | None = None) -> tuple[int | None, float]:
+def snakemake(
+    workdir: Path, args: list[str], log: Path, timeout: float, numba_cache: Path | None = None
+) -> tuple[int | None, float]:
     """Run snakemake in workdir, output to log; (exit code or None on timeout, seconds). The run, and its
     SLURM jobs (sbatch --export=ALL), import vemkit from workdir's copy (PYTHONPATH), so a run is not
     changed by edits of the checkout while it runs; numba's cache can be kept in numba_cache."""
@@ -80,8 +95,15 @@ def snakemake(workdir: Path, args: list[str], log: Path, timeout: float,
         env["NUMBA_CACHE_DIR"] = str(numba_cache)
     start = time.monotonic()
     with open(log, "w") as out:
-        process = subprocess.Popen([str(SNAKEMAKE), *args], cwd=workdir, stdout=out, stderr=subprocess.STDOUT,
-                                   stdin=subprocess.DEVNULL, start_new_session=True, env=env)
+        process = subprocess.Popen(
+            [str(SNAKEMAKE), *args],
+            cwd=workdir,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+            env=env,
+        )
         try:
             code = process.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -99,8 +121,7 @@ def snakemake(workdir: Path, args: list[str], log: Path, timeout: float,
 def run_rules(log: Path) -> tuple[Counter, Counter]:
     """(jobs submitted per rule, jobs run locally per rule) from a snakemake log."""
     text = log.read_text()
-    return (Counter(re.findall(r"^rule (\w+):$", text, re.M)),
-            Counter(re.findall(r"^localrule (\w+):$", text, re.M)))
+    return (Counter(re.findall(r"^rule (\w+):$", text, re.M)), Counter(re.findall(r"^localrule (\w+):$", text, re.M)))
 
 
 # -- what SLURM recorded ---------------------------------------------------------------------------
@@ -108,8 +129,11 @@ def expected_resources(profile: Path, rule: str, threads: int = 1) -> dict:
     """mem_mb, runtime (minutes) and cpus_per_task the profile asks for a rule."""
     settings = yaml.safe_load(profile.read_text())
     wanted = {**settings.get("default-resources", {}), **settings.get("set-resources", {}).get(rule, {})}
-    return {"mem_mb": int(wanted["mem_mb"]), "runtime": int(wanted["runtime"]),
-            "cpus_per_task": int(wanted.get("cpus_per_task", threads))}
+    return {
+        "mem_mb": int(wanted["mem_mb"]),
+        "runtime": int(wanted["runtime"]),
+        "cpus_per_task": int(wanted.get("cpus_per_task", threads)),
+    }
 
 
 def _minutes(limit: str) -> int:
@@ -121,23 +145,39 @@ def _minutes(limit: str) -> int:
 
 def _megabytes(mem: str) -> int:
     number, unit = re.fullmatch(r"([\d.]+)([KMGT]?)n?", mem).groups()
-    return round(float(number) * {"K": 1 / 1024, "M": 1, "G": 1024, "T": 1024 ** 2, "": 1}[unit])
+    return round(float(number) * {"K": 1 / 1024, "M": 1, "G": 1024, "T": 1024**2, "": 1}[unit])
 
 
 def _rule_of(comment: str) -> str:
     """The rule of a job from the executor's --comment 'rule_<name>[_wildcards_<...>]'."""
-    return comment[len("rule_"):].split("_wildcards_")[0] if comment.startswith("rule_") else ""
+    return comment[len("rule_") :].split("_wildcards_")[0] if comment.startswith("rule_") else ""
 
 
-SACCT_FIELDS = ["JobIDRaw", "JobID", "Comment", "State", "ReqMem", "Timelimit", "ReqCPUS", "Account", "Elapsed",
-                "TotalCPU", "MaxRSS", "WorkDir"]
+SACCT_FIELDS = [
+    "JobIDRaw",
+    "JobID",
+    "Comment",
+    "State",
+    "ReqMem",
+    "Timelimit",
+    "ReqCPUS",
+    "Account",
+    "Elapsed",
+    "TotalCPU",
+    "MaxRSS",
+    "WorkDir",
+]
 
 
 def sacct_jobs(workdir: Path, since: str) -> list[dict]:
     """The jobs of workdir since `since`, from sacct (job accounting): one dict per job."""
-    out = subprocess.run(["sacct", "-a", "-P", "-n", f"--starttime={since}",
-                          "--format=" + ",".join(f"{f}%400" for f in SACCT_FIELDS)],
-                         capture_output=True, text=True, timeout=60, check=True).stdout
+    out = subprocess.run(
+        ["sacct", "-a", "-P", "-n", f"--starttime={since}", "--format=" + ",".join(f"{f}%400" for f in SACCT_FIELDS)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    ).stdout
     jobs, max_rss = {}, Counter()
     for line in out.splitlines():
         row = dict(zip(SACCT_FIELDS, line.split("|")))
@@ -146,9 +186,21 @@ def sacct_jobs(workdir: Path, since: str) -> list[dict]:
             max_rss[row["JobIDRaw"].split(".")[0]] = max(max_rss[row["JobIDRaw"].split(".")[0]], _megabytes(rss))
         elif Path(row["WorkDir"]) == workdir:
             jobs[row["JobIDRaw"]] = row
-    return [{"id": i, "rule": _rule_of(r["Comment"]), "state": r["State"], "mem_mb": _megabytes(r["ReqMem"]),
-             "runtime": _minutes(r["Timelimit"]), "cpus_per_task": int(r["ReqCPUS"]), "account": r["Account"],
-             "elapsed": r["Elapsed"], "cpu_used": r["TotalCPU"], "max_rss_mb": max_rss[i]} for i, r in jobs.items()]
+    return [
+        {
+            "id": i,
+            "rule": _rule_of(r["Comment"]),
+            "state": r["State"],
+            "mem_mb": _megabytes(r["ReqMem"]),
+            "runtime": _minutes(r["Timelimit"]),
+            "cpus_per_task": int(r["ReqCPUS"]),
+            "account": r["Account"],
+            "elapsed": r["Elapsed"],
+            "cpu_used": r["TotalCPU"],
+            "max_rss_mb": max_rss[i],
+        }
+        for i, r in jobs.items()
+    ]
 
 
 def scontrol_jobs(workdir: Path) -> list[dict]:
@@ -160,11 +212,20 @@ def scontrol_jobs(workdir: Path) -> list[dict]:
         if Path(row.get("WorkDir", "")) != workdir:
             continue
         comment = re.search(r"Comment=(\S+)", line)
-        jobs.append({"id": row["JobId"], "rule": _rule_of(comment.group(1) if comment else ""),
-                     "state": row["JobState"], "mem_mb": _megabytes(row["MinMemoryNode"]),
-                     "runtime": _minutes(row["TimeLimit"]), "cpus_per_task": int(row.get("CPUs/Task", 1)),
-                     "account": row.get("Account", ""), "elapsed": row["RunTime"], "cpu_used": None,
-                     "max_rss_mb": None})
+        jobs.append(
+            {
+                "id": row["JobId"],
+                "rule": _rule_of(comment.group(1) if comment else ""),
+                "state": row["JobState"],
+                "mem_mb": _megabytes(row["MinMemoryNode"]),
+                "runtime": _minutes(row["TimeLimit"]),
+                "cpus_per_task": int(row.get("CPUs/Task", 1)),
+                "account": row.get("Account", ""),
+                "elapsed": row["RunTime"],
+                "cpu_used": None,
+                "max_rss_mb": None,
+            }
+        )
     return jobs
 
 
@@ -191,11 +252,15 @@ def check_jobs(jobs: list[dict], submitted: Counter, local: Counter, profile: Pa
 
 def jobs_table(jobs: list[dict]) -> str:
     """The per-job summary as a Markdown table."""
-    lines = ["| job | rule | state | mem_mb | runtime (min) | cpus | account | elapsed | CPU used | MaxRSS (MB) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| job | rule | state | mem_mb | runtime (min) | cpus | account | elapsed | CPU used | MaxRSS (MB) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for j in sorted(jobs, key=lambda j: int(j["id"])):
-        lines.append(f"| {j['id']} | {j['rule']} | {j['state']} | {j['mem_mb']} | {j['runtime']} | "
-                     f"{j['cpus_per_task']} | {j['account']} | {j['elapsed']} | {j['cpu_used']} | {j['max_rss_mb']} |")
+        lines.append(
+            f"| {j['id']} | {j['rule']} | {j['state']} | {j['mem_mb']} | {j['runtime']} | "
+            f"{j['cpus_per_task']} | {j['account']} | {j['elapsed']} | {j['cpu_used']} | {j['max_rss_mb']} |"
+        )
     return "\n".join(lines)
 
 

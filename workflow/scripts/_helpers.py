@@ -69,24 +69,46 @@ def write_solutions(smk):
         problem, solution, ds = solve_scene(scene, mesh=read_ugrid(mesh_path))
         ds.attrs["workflow_run"] = json.dumps({"family": label, "n": n, "stabilization": stab, "mesh_file": mesh_path})
         write_netcdf(ds, path)
-        print(f"{path}: {problem.n_dofs} dofs, {solution.method} {solution.iterations} iterations, "
-              f"solver {solution.wall_time:.3f} s, assembly {problem.info.get('assembly_time', 0.0):.3f} s", flush=True)
+        print(
+            f"{path}: {problem.n_dofs} dofs, {solution.method} {solution.iterations} iterations, "
+            f"solver {solution.wall_time:.3f} s, assembly {problem.info.get('assembly_time', 0.0):.3f} s",
+            flush=True,
+        )
 
 
 def write_convergence_file(smk):
     """Rules table1_dataset and convergence_dataset: error records -> one convergence netCDF (with
     error_paper_gauss when the Gauss-quadrature records of table1.gauss are given)."""
-    from vemkit.studies.convergence import (convergence_dataset, read_records, study_scene, with_paper_variant,
-                                            write_convergence)
+    from vemkit.studies.convergence import (
+        convergence_dataset,
+        read_records,
+        study_scene,
+        with_paper_variant,
+        write_convergence,
+    )
 
     p = smk.params
-    scene = study_scene(p.scene, p.parameters["overrides"] + [f"solver.{k}={v}" for k, v in p.parameters["solver"].items()])
-    ds = convergence_dataset(read_records(smk.input.errors), scene_yaml=scene.to_yaml(), parameters=p.parameters,
-                             families=p.families, stabilizations=p.stabilizations, title=p.title)
+    scene = study_scene(
+        p.scene, p.parameters["overrides"] + [f"solver.{k}={v}" for k, v in p.parameters["solver"].items()]
+    )
+    ds = convergence_dataset(
+        read_records(smk.input.errors),
+        scene_yaml=scene.to_yaml(),
+        parameters=p.parameters,
+        families=p.families,
+        stabilizations=p.stabilizations,
+        title=p.title,
+    )
     if smk.input.gauss:
-        ds = with_paper_variant(ds, read_records(smk.input.gauss), "gauss",
-                                f"contact_quadrature: gauss, {p.gauss['points']} Gauss points per Gamma_C edge")
-    ds.attrs["scene_comment"] = ("the scene file with the workflow's solver settings and overrides; every run "
-                                 "replaces discretization.mesh and discretization.stabilization (see parameters)")
+        ds = with_paper_variant(
+            ds,
+            read_records(smk.input.gauss),
+            "gauss",
+            f"contact_quadrature: gauss, {p.gauss['points']} Gauss points per Gamma_C edge",
+        )
+    ds.attrs["scene_comment"] = (
+        "the scene file with the workflow's solver settings and overrides; every run "
+        "replaces discretization.mesh and discretization.stabilization (see parameters)"
+    )
     write_convergence(ds, smk.output[0])
     print(ds)

@@ -16,12 +16,19 @@ with logged(smk):
     for mode in ("adaptive", "uniform"):
         with xr.open_dataset(getattr(smk.input, mode)) as ds:
             histories[mode] = history(ds)
-    save(adaptive_convergence_figure(histories, smk.params.error, title=f"{scene}: adaptive against uniform refinement"),
-         smk.output.convergence)
+    save(
+        adaptive_convergence_figure(histories, smk.params.error, title=f"{scene}: adaptive against uniform refinement"),
+        smk.output.convergence,
+    )
     panels = []
     for path in list(smk.input.snapshots) + [smk.input.adaptive]:
         with xr.open_dataset(path) as ds:
             step = int(ds.attrs.get("adapt_step", ds.sizes.get("adapt_step", 1) - 1))
-            panels.append((read_ugrid(path), ds["error_indicator"].values, f"step {step + 1}: {int(ds.attrs['n_dofs'])} DOFs"))
+            panels.append(
+                (read_ugrid(path), ds["error_indicator"].values, f"step {step + 1}: {int(ds.attrs['n_dofs'])} DOFs")
+            )
     unique = list({label: (mesh, eta, label) for mesh, eta, label in panels}.values())
-    save(mesh_sequence_figure(unique, title=f"{scene}: adapted meshes, cells coloured by the indicator"), smk.output.meshes)
+    save(
+        mesh_sequence_figure(unique, title=f"{scene}: adapted meshes, cells coloured by the indicator"),
+        smk.output.meshes,
+    )

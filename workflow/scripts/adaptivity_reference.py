@@ -11,8 +11,17 @@ with logged(smk):
 
     case = smk.params.case
     scene = load_scene(case["scene"], case["overrides"])
-    ds = reference_dataset(scene, case["reference"], case["theta"], progress=lambda step, r: print(
-        f"step {step + 1}: {r['n_dofs']} dofs, estimate {r['estimate']:.3e}, {r['wall_time']:.1f} s", flush=True))
-    print(f"{ds.attrs['reference_kind']}: {ds.attrs['n_dofs']} dofs, {ds.attrs['solver']} {ds.attrs['iterations']} "
-          f"iterations, {ds.attrs['wall_time']:.1f} s", flush=True)
+    ds = reference_dataset(
+        scene,
+        case["reference"],
+        case["theta"],
+        progress=lambda step, r: print(
+            f"step {step + 1}: {r['n_dofs']} dofs, estimate {r['estimate']:.3e}, {r['wall_time']:.1f} s", flush=True
+        ),
+    )
+    print(
+        f"{ds.attrs['reference_kind']}: {ds.attrs['n_dofs']} dofs, {ds.attrs['solver']} {ds.attrs['iterations']} "
+        f"iterations, {ds.attrs['wall_time']:.1f} s",
+        flush=True,
+    )
     write_netcdf(ds, smk.output[0])

@@ -27,13 +27,22 @@ with logged(smk):
     steps = []
 
     def observe(step, run):
-        steps.append((run.problem.mesh, run.indicators["indicator"], run.problem.dofs.expand(run.solution.u),
-                      dict(run.history[-1])))
+        steps.append(
+            (
+                run.problem.mesh,
+                run.indicators["indicator"],
+                run.problem.dofs.expand(run.solution.u),
+                dict(run.history[-1]),
+            )
+        )
 
     def progress(step, r):
         true = f", true error {r['true_error_h1']:.4e}" if "true_error_h1" in r else ""
-        print(f"step {step + 1}: {r['n_dofs']} dofs, {r['n_cells']} cells, estimate {r['estimate']:.4e}{true}, "
-              f"{r['iterations']} iterations, {r['wall_time']:.2f} s (+{r.get('error_time', 0.0):.2f} s error)", flush=True)
+        print(
+            f"step {step + 1}: {r['n_dofs']} dofs, {r['n_cells']} cells, estimate {r['estimate']:.4e}{true}, "
+            f"{r['iterations']} iterations, {r['wall_time']:.2f} s (+{r.get('error_time', 0.0):.2f} s error)",
+            flush=True,
+        )
 
     run = adapt(scene, settings, true_error=scene_true_error(scene), progress=progress, observe=observe)
     print(f"stopped: {run.reason}; loop wall time {sum(r['wall_time'] for r in run.history):.2f} s", flush=True)
@@ -42,8 +51,11 @@ with logged(smk):
     for path, k in zip(smk.output.snapshots, np.resize(chosen, len(smk.output.snapshots))):
         mesh, indicator, u, record = steps[k]
         ds = mesh_to_ugrid_dataset(mesh)
-        ds["error_indicator"] = ("mesh2d_nFaces", indicator, {"long_name": "a posteriori error indicator eta_K",
-                                                             "mesh": "mesh2d", "location": "face"})
+        ds["error_indicator"] = (
+            "mesh2d_nFaces",
+            indicator,
+            {"long_name": "a posteriori error indicator eta_K", "mesh": "mesh2d", "location": "face"},
+        )
         for name, values in (("u1", u[:, 0]), ("u2", u[:, 1])):
             ds[name] = ("mesh2d_nNodes", values, {"mesh": "mesh2d", "location": "node", "units": "mm"})
         ds.attrs.update({"adapt_step": int(k), "n_dofs": int(record["n_dofs"]), "estimate": float(record["estimate"])})

@@ -20,10 +20,21 @@ with logged(smk):
     tradeoff.check_reference_scene(scene, reference.dataset.attrs.get("scene", ""))
 
     def progress(r):
-        print(f"{r['family']} {r['solver']:<5} tol {r['tol']:.0e} {r['message']:<8} {r['n_dofs']:>6} dofs  "
-              f"error {r['error_h1']:.4e}  {r['cost_time']:.3f} s", flush=True)
+        print(
+            f"{r['family']} {r['solver']:<5} tol {r['tol']:.0e} {r['message']:<8} {r['n_dofs']:>6} dofs  "
+            f"error {r['error_h1']:.4e}  {r['cost_time']:.3f} s",
+            flush=True,
+        )
 
-    records = tradeoff_records(scene, reference, theta=a["theta"], max_dofs=a["max_dofs"], solvers=s["solvers"],
-                               tolerances=s["tolerances"], stabilization=s["reference"]["stabilization"],
-                               max_iterations=s["max_iterations"], progress=progress)
+    records = tradeoff_records(
+        scene,
+        reference,
+        theta=a["theta"],
+        max_dofs=a["max_dofs"],
+        solvers=s["solvers"],
+        tolerances=s["tolerances"],
+        stabilization=s["reference"]["stabilization"],
+        max_iterations=s["max_iterations"],
+        progress=progress,
+    )
     write_records(records, smk.output[0])

@@ -11,5 +11,7 @@ with logged(smk):
     records = family_error_records(smk.wildcards.label, runs, smk.params.references)
     write_records(records, smk.output[0])
     for r in records:
-        print(f"{r['stabilization']:>9} n={r['n']:<3}: paper {r['error_paper']:.6e}  H1 {r['error_h1']:.6e}  "
-              f"H1-semi {r['error_h1_semi']:.6e}  L2 {r['error_l2']:.6e}")
+        print(
+            f"{r['stabilization']:>9} n={r['n']:<3}: paper {r['error_paper']:.6e}  H1 {r['error_h1']:.6e}  "
+            f"H1-semi {r['error_h1_semi']:.6e}  L2 {r['error_l2']:.6e}"
+        )

@@ -10,9 +10,18 @@ with logged(smk):
 
     p = smk.params
     meshes = [(n, read_ugrid(path)) for n, path in zip(p.levels, smk.input.meshes, strict=True)]
-    records = solved_error_records(smk.wildcards.label, p.spec, p.stabilization, meshes,
-                                   (p.reference_n, read_ugrid(smk.input.reference)), p.scene, p.overrides)
+    records = solved_error_records(
+        smk.wildcards.label,
+        p.spec,
+        p.stabilization,
+        meshes,
+        (p.reference_n, read_ugrid(smk.input.reference)),
+        p.scene,
+        p.overrides,
+    )
     write_records(records, smk.output[0])
     for r in records:
-        print(f"{r['stabilization']:>9} n={r['n']:<3}: paper {r['error_paper']:.6e}  H1 {r['error_h1']:.6e}  "
-              f"({r['iterations']} iterations)")
+        print(
+            f"{r['stabilization']:>9} n={r['n']:<3}: paper {r['error_paper']:.6e}  H1 {r['error_h1']:.6e}  "
+            f"({r['iterations']} iterations)"
+        )

@@ -4,8 +4,8 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit.report import figures as plots
     from vemkit.io.solution_file import read_solution
+    from vemkit.report import figures as plots
 
     mesh, ds = read_solution(smk.input[0])
     spec = smk.params.spec

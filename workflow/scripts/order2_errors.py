@@ -21,15 +21,21 @@ def regions(mesh, ds, radius):
     import numpy as np
 
     lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
-    corners = {f"corner_{xn}_{yn}": (x, y) for xn, x in (("xmin", lo[0]), ("xmax", hi[0]))
-               for yn, y in (("ymin", lo[1]), ("ymax", hi[1]))}
+    corners = {
+        f"corner_{xn}_{yn}": (x, y)
+        for xn, x in (("xmin", lo[0]), ("xmax", hi[0]))
+        for yn, y in (("ymin", lo[1]), ("ymax", hi[1]))
+    }
     state, cx, cy = ds["contact_state"].values, ds["contact_x"].values, ds["contact_y"].values
     change = np.flatnonzero((state[1:] == 0) != (state[:-1] == 0))  # sorted along x (solution file order)
     boundary = np.stack([0.5 * (cx[change] + cx[change + 1]), 0.5 * (cy[change] + cy[change + 1])], axis=1)
     out = {name: (lambda p, c=c: np.hypot(p[:, 0] - c[0], p[:, 1] - c[1]) < radius) for name, c in corners.items()}
-    out["contact_zone_boundary"] = lambda p: np.min(np.hypot(p[:, None, 0] - boundary[None, :, 0],
-                                                             p[:, None, 1] - boundary[None, :, 1]), axis=1,
-                                                    initial=np.inf) < radius
+    out["contact_zone_boundary"] = lambda p: (
+        np.min(
+            np.hypot(p[:, None, 0] - boundary[None, :, 0], p[:, None, 1] - boundary[None, :, 1]), axis=1, initial=np.inf
+        )
+        < radius
+    )
     return out, boundary
 
 
@@ -37,8 +43,14 @@ with logged(smk):
     from vemkit.config.scene import scene_from_yaml
     from vemkit.io.solution_file import read_solution
     from vemkit.studies.solution_order import projected_solution_file, solution_node_values, solution_space
-    from vemkit.vem.norms import (boundary_trace, nesting_subdivisions, paper_error, projection_error, trace_error,
-                                  trace_errors)
+    from vemkit.vem.norms import (
+        boundary_trace,
+        nesting_subdivisions,
+        paper_error,
+        projection_error,
+        trace_error,
+        trace_errors,
+    )
     from vemkit.vem.quadrature import reference_quadrature
 
     s = smk.params.settings
@@ -61,17 +73,32 @@ with logged(smk):
         space = solution_space(mesh, ds)
         values = solution_node_values(space, ds)
         err = projection_error(mesh, projected_solution_file(mesh, ds), ref_mesh, ref_proj, quadrature, masks)
-        interpolation = trace_errors(space, contact_sides, values,
-                                     lambda p: boundary_trace(ref_space, contact_sides, ref_values, p),
-                                     nesting_subdivisions(mesh, ref_mesh, contact_sides))
-        record = {"study": "paper", "case": smk.wildcards.case, "family": case["family"], "order": case["order"], "n": n,
-                  "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])), "n_unknowns": int(ds.attrs["n_dofs"]),
-                  "n_cells": int(mesh.n_cells), "error_h1": err["h1"], "error_h1_semi": err["h1_semi"],
-                  "error_l2": err["l2"], "error_contact_l2": trace_error(space, values, ref_space, ref_values, contact_sides),
-                  "error_interpolation_contact_l2": interpolation["interpolation_contact_l2"],
-                  "error_paper": float(paper_error(mesh, values, paper_mesh, paper_values)) if paper_mesh else float("nan"),
-                  "iterations": int(ds.attrs["iterations"]), "wall_time": float(ds.attrs["wall_time"]),
-                  **{k: v for k, v in err.items() if k.startswith("share_")}}
+        interpolation = trace_errors(
+            space,
+            contact_sides,
+            values,
+            lambda p: boundary_trace(ref_space, contact_sides, ref_values, p),
+            nesting_subdivisions(mesh, ref_mesh, contact_sides),
+        )
+        record = {
+            "study": "paper",
+            "case": smk.wildcards.case,
+            "family": case["family"],
+            "order": case["order"],
+            "n": n,
+            "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])),
+            "n_unknowns": int(ds.attrs["n_dofs"]),
+            "n_cells": int(mesh.n_cells),
+            "error_h1": err["h1"],
+            "error_h1_semi": err["h1_semi"],
+            "error_l2": err["l2"],
+            "error_contact_l2": trace_error(space, values, ref_space, ref_values, contact_sides),
+            "error_interpolation_contact_l2": interpolation["interpolation_contact_l2"],
+            "error_paper": float(paper_error(mesh, values, paper_mesh, paper_values)) if paper_mesh else float("nan"),
+            "iterations": int(ds.attrs["iterations"]),
+            "wall_time": float(ds.attrs["wall_time"]),
+            **{k: v for k, v in err.items() if k.startswith("share_")},
+        }
         records.append(record)
         print(json.dumps(record), flush=True)
     with open(smk.output[0], "w", encoding="utf-8") as out:

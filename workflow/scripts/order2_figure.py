@@ -15,16 +15,29 @@ def draw(ax, ds, key, title):
     for number, case in enumerate(dict.fromkeys(ds["case"].values.tolist())):
         part = ds.where(ds["case"] == case, drop=True)
         order = int(part["order"].values[0])
-        line, = ax.loglog(part["n_dofs"], part[key], marker="o" if order == 2 else "s",
-                          linestyle="-" if "refined" not in case else "--", label=case, color=f"C{number}")
+        (line,) = ax.loglog(
+            part["n_dofs"],
+            part[key],
+            marker="o" if order == 2 else "s",
+            linestyle="-" if "refined" not in case else "--",
+            label=case,
+            color=f"C{number}",
+        )
         if key == "error_contact_l2" and "error_interpolation_contact_l2" in part:
-            ax.loglog(part["n_dofs"], part["error_interpolation_contact_l2"], linestyle=":", linewidth=0.9,
-                      color=line.get_color(), label=f"{case}: u - I_h u")
+            ax.loglog(
+                part["n_dofs"],
+                part["error_interpolation_contact_l2"],
+                linestyle=":",
+                linewidth=0.9,
+                color=line.get_color(),
+                label=f"{case}: u - I_h u",
+            )
     dofs = np.array([float(ds["n_dofs"].min()), float(ds["n_dofs"].max())])
     top = float(ds[key].max())
     for p, style in SLOPES:
-        ax.loglog(dofs, top * (dofs / dofs[0]) ** (-p / 2), color="grey", linestyle=style, linewidth=0.8,
-                  label=f"h^{p:g}")
+        ax.loglog(
+            dofs, top * (dofs / dofs[0]) ** (-p / 2), color="grey", linestyle=style, linewidth=0.8, label=f"h^{p:g}"
+        )
     ax.set_xlabel("degrees of freedom")
     ax.set_ylabel("relative error")
     ax.set_title(title)
@@ -41,8 +54,9 @@ with logged(smk):
 
     ds = read_dataset(smk.input[0])
     studies = list(dict.fromkeys(ds["study"].values.tolist())) if "study" in ds else ["paper"]
-    fig, axes = plt.subplots(len(studies), len(PANELS), figsize=(5 * len(PANELS), 4.2 * len(studies)),
-                             constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(
+        len(studies), len(PANELS), figsize=(5 * len(PANELS), 4.2 * len(studies)), constrained_layout=True, squeeze=False
+    )
     for row, study in zip(axes, studies, strict=True):
         part = ds.where(ds["study"] == study, drop=True) if "study" in ds else ds
         for ax, (key, title) in zip(row, PANELS, strict=True):

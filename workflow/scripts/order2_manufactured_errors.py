@@ -48,14 +48,24 @@ with logged(smk):
         scene = scene_from_yaml(ds.attrs["scene"])
         space = solution_space(mesh, ds)
         trace = trace_errors(space, scene.contact_sides, solution_node_values(space, ds), exact_trace(scene))
-        record = {"study": smk.wildcards.scene, "case": smk.wildcards.case, "family": case["family"],
-                  "order": case["order"], "n": n, "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])),
-                  "n_unknowns": int(ds.attrs["n_dofs"]), "n_cells": int(mesh.n_cells),
-                  "error_h1": float(ds.attrs["error_h1"]), "error_h1_semi": float(ds.attrs["error_h1_semi"]),
-                  "error_l2": float(ds.attrs["error_l2"]), "error_contact_l2": trace["contact_l2"],
-                  "error_interpolation_contact_l2": trace["interpolation_contact_l2"],
-                  "iterations": int(ds.attrs["iterations"]), "wall_time": float(ds.attrs["wall_time"]),
-                  "contact_zone_boundary": contact_zone_boundary(ds)}
+        record = {
+            "study": smk.wildcards.scene,
+            "case": smk.wildcards.case,
+            "family": case["family"],
+            "order": case["order"],
+            "n": n,
+            "n_dofs": int(ds.attrs.get("n_space_dofs", ds.attrs["n_dofs"])),
+            "n_unknowns": int(ds.attrs["n_dofs"]),
+            "n_cells": int(mesh.n_cells),
+            "error_h1": float(ds.attrs["error_h1"]),
+            "error_h1_semi": float(ds.attrs["error_h1_semi"]),
+            "error_l2": float(ds.attrs["error_l2"]),
+            "error_contact_l2": trace["contact_l2"],
+            "error_interpolation_contact_l2": trace["interpolation_contact_l2"],
+            "iterations": int(ds.attrs["iterations"]),
+            "wall_time": float(ds.attrs["wall_time"]),
+            "contact_zone_boundary": contact_zone_boundary(ds),
+        }
         records.append(record)
         print(json.dumps(record), flush=True)
     with open(smk.output[0], "w", encoding="utf-8") as out:

@@ -20,5 +20,8 @@ with logged(smk):
     problem, solution, ds = solve_scene(scene, mesh=build_mesh(ref["family"], ref["n"]), verify=True)
     ds.attrs["workflow_run"] = json.dumps({"case": "reference", "n": ref["n"], "order": 2})
     write_netcdf(ds, smk.output[0])
-    print(f"{smk.output[0]}: {ds.attrs['n_space_dofs']} dofs ({problem.n_dofs} unknowns), {solution.method} "
-          f"{solution.iterations} iterations, {solution.wall_time:.3f} s", flush=True)
+    print(
+        f"{smk.output[0]}: {ds.attrs['n_space_dofs']} dofs ({problem.n_dofs} unknowns), {solution.method} "
+        f"{solution.iterations} iterations, {solution.wall_time:.3f} s",
+        flush=True,
+    )

@@ -15,12 +15,21 @@ with logged(smk):
     s = smk.params.settings
     case = s["cases"][smk.wildcards.case]
     n, options = level(smk.wildcards.n), dict(case.get("options") or {})
-    scene = study_scene(s["scene"], s["overrides"] + [f"discretization.order={case['order']}"]
-                        + list(case.get("overrides", [])), case["family"], options, n)
+    scene = study_scene(
+        s["scene"],
+        s["overrides"] + [f"discretization.order={case['order']}"] + list(case.get("overrides", [])),
+        case["family"],
+        options,
+        n,
+    )
     problem, solution, ds = solve_scene(scene, mesh=build_mesh(case["family"], n, **options), verify=True)
-    ds.attrs["workflow_run"] = json.dumps({"study": s.get("study", "paper"), "case": smk.wildcards.case, "n": n,
-                                          "order": case["order"]})
+    ds.attrs["workflow_run"] = json.dumps(
+        {"study": s.get("study", "paper"), "case": smk.wildcards.case, "n": n, "order": case["order"]}
+    )
     write_netcdf(ds, smk.output[0])
-    print(f"{smk.output[0]}: k = {case['order']}, {ds.attrs.get('n_space_dofs', problem.n_dofs)} dofs "
-          f"({problem.n_dofs} unknowns), {solution.method} {solution.iterations} iterations, "
-          f"{solution.wall_time:.3f} s", flush=True)
+    print(
+        f"{smk.output[0]}: k = {case['order']}, {ds.attrs.get('n_space_dofs', problem.n_dofs)} dofs "
+        f"({problem.n_dofs} unknowns), {solution.method} {solution.iterations} iterations, "
+        f"{solution.wall_time:.3f} s",
+        flush=True,
+    )

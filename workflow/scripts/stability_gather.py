@@ -12,8 +12,11 @@ with logged(smk):
     from vemkit.studies.sweeps import read_dataset, write_dataset
 
     parts = [read_dataset(p) for p in smk.input]
-    ds = xr.concat(parts, dim="case", data_vars="minimal", coords="minimal", compat="override",
-                   combine_attrs="override") if len(parts) > 1 else parts[0]
+    ds = (
+        xr.concat(parts, dim="case", data_vars="minimal", coords="minimal", compat="override", combine_attrs="override")
+        if len(parts) > 1
+        else parts[0]
+    )
     ds = robustness.summarize(ds)
     write_dataset(ds, smk.output.nc)
     text = robustness.stability_markdown(ds)

@@ -18,9 +18,13 @@ with logged(smk):
 
     def progress(result):
         for method, o in result["outcomes"].items():
-            print(f"{result['case']['name']:<40} {method:<6} {o.status:<22} {o.iterations:>5} it "
-                  f"{o.wall_time:7.3f} s  {o.message}", flush=True)
+            print(
+                f"{result['case']['name']:<40} {method:<6} {o.status:<22} {o.iterations:>5} it "
+                f"{o.wall_time:7.3f} s  {o.message}",
+                flush=True,
+            )
 
-    results = robustness.run_matrix(scene, mine, s["solvers"], s["n"], time_budget=s["time_budget"],
-                                    check_tol=s["check_tol"], progress=progress)
+    results = robustness.run_matrix(
+        scene, mine, s["solvers"], s["n"], time_budget=s["time_budget"], check_tol=s["check_tol"], progress=progress
+    )
     write_dataset(robustness.stability_dataset(results, scene_yaml=scene.to_yaml(), settings=s), smk.output[0])

@@ -13,8 +13,9 @@ with logged(smk):
     if kind == "map":
         fig = study_figures.sweep_map_figure(ds, spec["x"], spec["y"], spec["quantities"], spec.get("select"), name)
     elif kind == "lines":
-        fig = study_figures.sweep_lines_figure(ds, spec["x"], spec.get("hue"), spec["quantities"], spec.get("select"),
-                                               name)
+        fig = study_figures.sweep_lines_figure(
+            ds, spec["x"], spec.get("hue"), spec["quantities"], spec.get("select"), name
+        )
     else:
         fig = study_figures.sweep_profiles_figure(ds, spec["across"], spec.get("select"), name)
     save(fig, smk.output[0])

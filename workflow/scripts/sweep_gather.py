@@ -9,5 +9,7 @@ with logged(smk):
     ds = sweeps.combine_parts([sweeps.read_dataset(p) for p in smk.input])
     ds.attrs.pop("part", None)
     sweeps.write_dataset(ds, smk.output[0])
-    print(f"{smk.output[0]}: {ds.attrs['converged_points']}/{ds.attrs['points']} converged, "
-          f"solve time of the parts {ds.attrs['total_time']:.2f} s")
+    print(
+        f"{smk.output[0]}: {ds.attrs['converged_points']}/{ds.attrs['points']} converged, "
+        f"solve time of the parts {ds.attrs['total_time']:.2f} s"
+    )

@@ -16,8 +16,16 @@ with logged(smk):
         o = point.outcome
         print(f"{values}: {o.status} {o.iterations} it {o.wall_time:.3f} s {o.message}", flush=True)
 
-    ds = sweeps.run_sweep(scene, grid, time_budget=s["time_budget"], check_tol=s["check_tol"], progress=progress,
-                          attrs={"sweep": smk.wildcards.sweep, "part": part, "workflow_settings": repr(s)})
+    ds = sweeps.run_sweep(
+        scene,
+        grid,
+        time_budget=s["time_budget"],
+        check_tol=s["check_tol"],
+        progress=progress,
+        attrs={"sweep": smk.wildcards.sweep, "part": part, "workflow_settings": repr(s)},
+    )
     sweeps.write_dataset(ds, smk.output[0])
-    print(f"{smk.output[0]}: {ds.attrs['converged_points']}/{ds.attrs['points']} converged, "
-          f"{ds.attrs['total_time']:.2f} s, reuse {ds.attrs['reuse']}")
+    print(
+        f"{smk.output[0]}: {ds.attrs['converged_points']}/{ds.attrs['points']} converged, "
+        f"{ds.attrs['total_time']:.2f} s, reuse {ds.attrs['reuse']}"
+    )

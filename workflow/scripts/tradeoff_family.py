@@ -18,13 +18,26 @@ with logged(smk):
     tradeoff.check_reference_scene(scene, reference.dataset.attrs.get("scene", ""))
 
     def progress(r):
-        print(f"{r['family']} {r['solver']:<5} tol {r['tol']:.0e} {r['stabilization']:<8} n={r['n']:<4} "
-              f"{r['n_dofs']:>6} dofs  error {r['error_h1']:.4e}  {r['cost_time']:.3f} s  status {r['status']} "
-              f"{r['message']}", flush=True)
+        print(
+            f"{r['family']} {r['solver']:<5} tol {r['tol']:.0e} {r['stabilization']:<8} n={r['n']:<4} "
+            f"{r['n_dofs']:>6} dofs  error {r['error_h1']:.4e}  {r['cost_time']:.3f} s  status {r['status']} "
+            f"{r['message']}",
+            flush=True,
+        )
 
     records = tradeoff.run_family(
-        scene, smk.wildcards.family, dict(smk.params.spec), reference, levels=s["levels"], solvers=s["solvers"],
-        tolerances=s["tolerances"], stabilizations=s["stabilizations"], repeats=s["repeats"],
-        time_budget=s["time_budget"], reference_n=s["reference"]["n"], max_iterations=s["max_iterations"],
-        progress=progress)
+        scene,
+        smk.wildcards.family,
+        dict(smk.params.spec),
+        reference,
+        levels=s["levels"],
+        solvers=s["solvers"],
+        tolerances=s["tolerances"],
+        stabilizations=s["stabilizations"],
+        repeats=s["repeats"],
+        time_budget=s["time_budget"],
+        reference_n=s["reference"]["n"],
+        max_iterations=s["max_iterations"],
+        progress=progress,
+    )
     write_records(records, smk.output[0])

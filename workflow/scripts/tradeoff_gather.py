@@ -15,8 +15,13 @@ with logged(smk):
 
     s = smk.params.settings
     scene = load_scene(s["scene"], s["overrides"])
-    ds = tradeoff.tradeoff_dataset(read_records(smk.input), targets=s["targets"], gains=s["refinement_gain"],
-                                   scene_yaml=scene.to_yaml(), settings=s)
+    ds = tradeoff.tradeoff_dataset(
+        read_records(smk.input),
+        targets=s["targets"],
+        gains=s["refinement_gain"],
+        scene_yaml=scene.to_yaml(),
+        settings=s,
+    )
     write_dataset(ds, smk.output.nc)
     text = tradeoff.tradeoff_markdown(ds)
     with open(smk.output.md, "w", encoding="utf-8") as stream:

@@ -12,8 +12,11 @@ with logged(smk):
     figure_h = CASES[scene].sizes[smk.params.figure_level]
 
     def keep(h, problem, ds):
-        print(f"{scene} {family} h = {h:g}: {problem.n_dofs} unknowns, {ds.attrs['solver']} "
-              f"{ds.attrs['iterations']} iterations, {ds.attrs['wall_time']:.3f} s", flush=True)
+        print(
+            f"{scene} {family} h = {h:g}: {problem.n_dofs} unknowns, {ds.attrs['solver']} "
+            f"{ds.attrs['iterations']} iterations, {ds.attrs['wall_time']:.3f} s",
+            flush=True,
+        )
         if h == figure_h:
             write_netcdf(ds, smk.output.solution)
 

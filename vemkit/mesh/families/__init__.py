@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import inspect
 
+from vemkit.config.domain import cells_per_length, domain_from_spec
+from vemkit.exceptions import MeshError
 from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.square import square, structured_triangle
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
-from vemkit.exceptions import MeshError
-from vemkit.config.domain import cells_per_length, domain_from_spec
 from vemkit.mesh.mesh import Mesh
 
 FAMILIES = ("square", "triangle", "voronoi", "hanging")
@@ -43,14 +43,14 @@ def family_builder(family: str, options: dict):
     """The builder of ``family`` for ``options`` (``kind`` removed from them); MeshError (an
     InputError) naming the family or the option that does not apply to it."""
     if family not in FAMILIES:
-        raise MeshError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}",
-                        key="family")
+        raise MeshError(f"mesh family {family!r} is unknown; valid families: {', '.join(FAMILIES)}", key="family")
     key = family
     if family == "triangle":
         kind = options.pop("kind", "delaunay")
         if kind not in TRIANGLE_KINDS:
-            raise MeshError(f"triangle mesh kind {kind!r} is unknown; valid kinds: {', '.join(TRIANGLE_KINDS)}",
-                            key="kind")
+            raise MeshError(
+                f"triangle mesh kind {kind!r} is unknown; valid kinds: {', '.join(TRIANGLE_KINDS)}", key="kind"
+            )
         key = (family, kind)
     builder = _BUILDERS[key]
     valid = [p for p in inspect.signature(builder).parameters if p not in ("n", "domain")]
@@ -58,13 +58,15 @@ def family_builder(family: str, options: dict):
     if unknown:
         name = family if family != "triangle" else f"triangle (kind={key[1]})"
         listing = ", ".join(valid + (["kind"] if family == "triangle" else [])) or "none"
-        raise MeshError(f"mesh option {unknown[0]!r} is not valid for family {name}; valid options: {listing}",
-                        key=unknown[0])
+        raise MeshError(
+            f"mesh option {unknown[0]!r} is not valid for family {name}; valid options: {listing}", key=unknown[0]
+        )
     return builder
 
 
-def build_mesh(family: str, n: float | None = None, *, domain=None, h: float | None = None,
-               cells: float | None = None, **options) -> Mesh:
+def build_mesh(
+    family: str, n: float | None = None, *, domain=None, h: float | None = None, cells: float | None = None, **options
+) -> Mesh:
     """The mesh of ``family`` on ``domain``, made with ``options``.
 
     ``domain``: a :class:`~vemkit.config.domain.Domain`, its SPEC §7 mapping or None (the unit
@@ -78,13 +80,25 @@ def build_mesh(family: str, n: float | None = None, *, domain=None, h: float | N
     if region.is_unit_square:
         return builder(n, **options)
     if builder is structured_triangle:
-        raise MeshError("triangle kind structured is a unit-square family; use kind delaunay on this domain",
-                        key="kind")
+        raise MeshError(
+            "triangle kind structured is a unit-square family; use kind delaunay on this domain", key="kind"
+        )
     return builder(n, domain=region, **options)
 
 
-__all__ = ["FAMILIES", "TRIANGLE_KINDS", "build_mesh", "checked_mesh", "scene_mesh", "family_builder", "square", "structured_triangle", "delaunay_triangle",
-           "voronoi", "hanging"]
+__all__ = [
+    "FAMILIES",
+    "TRIANGLE_KINDS",
+    "build_mesh",
+    "checked_mesh",
+    "scene_mesh",
+    "family_builder",
+    "square",
+    "structured_triangle",
+    "delaunay_triangle",
+    "voronoi",
+    "hanging",
+]
 
 
 def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
@@ -124,5 +138,8 @@ def scene_mesh(scene) -> Mesh:
         from vemkit.mesh.families3d import build_mesh3d as build
     else:
         build = build_mesh
-    return checked_mesh(build(family, domain=scene.domain, **sizes, **opts), f"the {family} mesh ({size})",
-                        "try another discretization.mesh size or family")
+    return checked_mesh(
+        build(family, domain=scene.domain, **sizes, **opts),
+        f"the {family} mesh ({size})",
+        "try another discretization.mesh size or family",
+    )

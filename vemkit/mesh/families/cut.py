@@ -41,8 +41,9 @@ def cut_squares(domain: Domain, n: float) -> Mesh:
     return Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, mesh.boundary, meta)
 
 
-def cut_hanging(domain: Domain, n: float, levels: int, rule: str, seed: int, fraction: float,
-                contact_side: str) -> Mesh:
+def cut_hanging(
+    domain: Domain, n: float, levels: int, rule: str, seed: int, fraction: float, contact_side: str
+) -> Mesh:
     """Squares of side 1/n refined ``levels`` times by ``rule``, clipped to ``domain``."""
     h = 1.0 / n
     unit = 1 << levels
@@ -122,14 +123,16 @@ def cut_mesh(polygonal: PolygonalDomain, squares: np.ndarray, fine: float) -> Me
     ring_sizes = np.bincount(ring, minlength=parts.size)
     keep = np.ones(coords.shape[0], dtype=bool)
     keep[np.cumsum(ring_sizes) - 1] = False  # the closing repeat of the first point
-    corners = np.stack([lo[full], np.stack([hi[full, 0], lo[full, 1]], 1), hi[full],
-                        np.stack([lo[full, 0], hi[full, 1]], 1)], axis=1).reshape(-1, 2)
+    corners = np.stack(
+        [lo[full], np.stack([hi[full, 0], lo[full, 1]], 1), hi[full], np.stack([lo[full, 0], hi[full, 1]], 1)], axis=1
+    ).reshape(-1, 2)
     pool = np.vstack([corners, coords[keep]])
     sizes = np.concatenate([np.full(full.size, 4), ring_sizes - 1])
     owner = np.concatenate([full, parent])
     kept = []
-    mesh = conforming_mesh(Pieces(pool, np.concatenate([[0], np.cumsum(sizes)]), np.arange(pool.shape[0])),
-                           _MERGE_TOL * fine, kept)
+    mesh = conforming_mesh(
+        Pieces(pool, np.concatenate([[0], np.cumsum(sizes)]), np.arange(pool.shape[0])), _MERGE_TOL * fine, kept
+    )
     square_area = (squares[owner[kept[0]], 2] * fine) ** 2
     mesh = merge_small_cells(mesh, MERGE_RATIO * square_area)
     return tag_sides(mesh, polygonal)

@@ -31,8 +31,15 @@ from vemkit.mesh.mesh import Mesh, tag_box_boundary
 RULES = ("contact", "random")
 
 
-def hanging(n: int, levels: int = 1, rule: str = "contact", seed: int = 0, fraction: float = 0.3,
-            contact_side: str = "bottom", domain=None) -> Mesh:
+def hanging(
+    n: int,
+    levels: int = 1,
+    rule: str = "contact",
+    seed: int = 0,
+    fraction: float = 0.3,
+    contact_side: str = "bottom",
+    domain=None,
+) -> Mesh:
     """n x n squares refined ``levels`` times by ``rule`` ("contact" or "random").
 
     On a :class:`~vemkit.config.domain.Domain` other than the unit square (or with n not an
@@ -85,9 +92,9 @@ def _touching(squares: np.ndarray, side: str, fine: int) -> np.ndarray:
 def _polygons(squares: np.ndarray, fine: int):
     """Vertices and CSR polygons: each square with every square corner lying on its boundary."""
     x0, y0, s = squares.T
-    corners = np.concatenate([
-        np.stack([x0, y0], 1), np.stack([x0 + s, y0], 1), np.stack([x0 + s, y0 + s], 1), np.stack([x0, y0 + s], 1)
-    ])
+    corners = np.concatenate(
+        [np.stack([x0, y0], 1), np.stack([x0 + s, y0], 1), np.stack([x0 + s, y0 + s], 1), np.stack([x0, y0 + s], 1)]
+    )
     keys = np.unique(corners[:, 1] * (fine + 1) + corners[:, 0])
     offsets = np.zeros(squares.shape[0] + 1, dtype=np.int64)
     pieces, owners = [], []

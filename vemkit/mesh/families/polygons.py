@@ -277,7 +277,9 @@ def without_holes(polygons: np.ndarray, parents: np.ndarray | None = None):
     for polygon, parent in zip(polygons[holed], index[holed]):
         x = shapely.Polygon(polygon.interiors[0]).point_on_surface().x
         x0, y0, x1, y1 = polygon.bounds
-        halves = shapely.intersection(polygon, [shapely.box(x0 - 1, y0 - 1, x, y1 + 1), shapely.box(x, y0 - 1, x1 + 1, y1 + 1)])
+        halves = shapely.intersection(
+            polygon, [shapely.box(x0 - 1, y0 - 1, x, y1 + 1), shapely.box(x, y0 - 1, x1 + 1, y1 + 1)]
+        )
         parts = shapely.get_parts(halves)
         parts = without_holes(parts[shapely.get_type_id(parts) == shapely.GeometryType.POLYGON])
         out.append(parts)

@@ -45,20 +45,35 @@ def delaunay_triangle(n: float, seed: int = 0, min_angle: float = 28.0, domain=N
         target = int(round(2 * n * n))
         pslg = {"vertices": np.vstack([_SQUARE, _seed_points(n, seed)]), "segments": _SIDES}
         mesh, meta = _quality_triangles(pslg, target, min_angle)
-        meta = {"family": "triangle", "kind": "delaunay", "n": n, "seed": int(seed), "min_angle": float(min_angle),
-                **meta}
+        meta = {
+            "family": "triangle",
+            "kind": "delaunay",
+            "n": n,
+            "seed": int(seed),
+            "min_angle": float(min_angle),
+            **meta,
+        }
         return tag_box_boundary(Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, {}, meta))
     if not n > 0:
         raise ValueError(f"mesh n = {n}: the number of cells per unit length must be > 0")
     polygonal = domain.discretize(1.0 / n)
     target = max(1, int(round(2 * n * n * polygonal.shape.area)))
-    pslg = {"vertices": np.vstack([polygonal.points, _domain_seed_points(polygonal.shape, n, seed)]),
-            "segments": polygonal.segments}
+    pslg = {
+        "vertices": np.vstack([polygonal.points, _domain_seed_points(polygonal.shape, n, seed)]),
+        "segments": polygonal.segments,
+    }
     if polygonal.hole_points.size:
         pslg["holes"] = polygonal.hole_points
     mesh, meta = _quality_triangles(pslg, target, min_angle, polygonal.shape.area)
-    meta = {"family": "triangle", "kind": "delaunay", "n": n, "seed": int(seed), "min_angle": float(min_angle),
-            **meta, "domain": domain.to_spec()}
+    meta = {
+        "family": "triangle",
+        "kind": "delaunay",
+        "n": n,
+        "seed": int(seed),
+        "min_angle": float(min_angle),
+        **meta,
+        "domain": domain.to_spec(),
+    }
     mesh = _drop_unused_vertices(mesh)
     return tag_sides(Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, {}, meta), polygonal)
 

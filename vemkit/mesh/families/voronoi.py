@@ -40,18 +40,19 @@ import numpy as np
 import shapely
 import triangle as shewchuk
 
-from vemkit.mesh.geometry import areas_centroids, counter_clockwise, ranges
 from vemkit.config.domain import Domain
 from vemkit.mesh.families.polygons import merged_mesh, tag_sides, without_holes
 from vemkit.mesh.families.voronoi_clip import DomainIndex, clipped_centroids, domain_index, side_of_boxes
 from vemkit.mesh.families.voronoi_kernels import all_vertices_in, argsort_fans, boxes_meet_segments, fan_cells, fans
+from vemkit.mesh.geometry import areas_centroids, counter_clockwise, ranges
 from vemkit.mesh.mesh import Mesh, tag_box_boundary
 
 UNIT_SQUARE = shapely.box(0.0, 0.0, 1.0, 1.0)
 
 
-def voronoi(n: float, seed: int = 0, lloyd_iterations: int = 30, domain=None, anisotropy: float = 1.0,
-            merge_tol: float = 1e-9) -> Mesh:
+def voronoi(
+    n: float, seed: int = 0, lloyd_iterations: int = 30, domain=None, anisotropy: float = 1.0, merge_tol: float = 1e-9
+) -> Mesh:
     """About ``n²`` centroidal Voronoi cells per unit area of ``domain``.
 
     ``domain``: a :class:`~vemkit.config.domain.Domain` (holes allowed; boundary parts named by its
@@ -73,8 +74,14 @@ def voronoi(n: float, seed: int = 0, lloyd_iterations: int = 30, domain=None, an
     points = _lloyd(points, index, anisotropy, lloyd_iterations, h)
     cells = _clipped_cells(points, index, anisotropy)
     mesh = merged_mesh(cells, merge_tol * h)
-    meta = {"family": "voronoi", "n": n, "seed": int(seed), "lloyd_iterations": int(lloyd_iterations),
-            "anisotropy": float(anisotropy), "merge_tol": float(merge_tol)}
+    meta = {
+        "family": "voronoi",
+        "n": n,
+        "seed": int(seed),
+        "lloyd_iterations": int(lloyd_iterations),
+        "anisotropy": float(anisotropy),
+        "merge_tol": float(merge_tol),
+    }
     if sides is not None:
         meta["domain"] = domain.to_spec()
         mesh = tag_sides(mesh, sides)
@@ -144,8 +151,9 @@ def _clipped_cells(points: np.ndarray, index: DomainIndex, anisotropy: float, ce
     span = max(x1 - x0, y1 - y0) * max(anisotropy, 1.0 / anisotropy)
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
     far = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float) * 10.0 * span + [cx * anisotropy, cy]
-    vertices, offsets, refs, area, centroid, lo, hi = _voronoi_cells(np.vstack([points * [anisotropy, 1.0], far]),
-                                                                     points.shape[0], anisotropy)
+    vertices, offsets, refs, area, centroid, lo, hi = _voronoi_cells(
+        np.vstack([points * [anisotropy, 1.0], far]), points.shape[0], anisotropy
+    )
     sizes = np.diff(offsets)
     inside, vertex_in = _inside(index, vertices, offsets, refs, lo, hi)
     cut = np.flatnonzero(~inside)
@@ -205,8 +213,21 @@ def _clipped_centroids(index: DomainIndex, vertices, offsets, refs, cut, sites, 
     bit), else by Green's theorem (``clipped_centroids``; the cells it cannot settle by shapely)."""
     if index.n_coordinates < 64:
         return shapely.get_coordinates(shapely.centroid(_clip(_polygons(vertices, offsets, refs, cut), index.shape)))
-    centroid, ok = clipped_centroids(vertices, offsets, refs, cut, sites, vertex_in, index.ends, index.ptr,
-                                     index.items, index.origin, index.inv, index.g, area)
+    centroid, ok = clipped_centroids(
+        vertices,
+        offsets,
+        refs,
+        cut,
+        sites,
+        vertex_in,
+        index.ends,
+        index.ptr,
+        index.items,
+        index.origin,
+        index.inv,
+        index.g,
+        area,
+    )
     if not ok.all():
         clipped = _clip(_polygons(vertices, offsets, refs, cut[~ok]), index.shape)
         centroid[~ok] = shapely.get_coordinates(shapely.centroid(clipped))
@@ -230,7 +251,9 @@ def _clip(cells: np.ndarray, domain) -> np.ndarray:
     tiles, which = np.unique(lo[alone], axis=0, return_inverse=True)
     which = which.ravel()
     corner = tiles * tile + [x0, y0]
-    pieces = shapely.intersection(domain, shapely.box(corner[:, 0], corner[:, 1], corner[:, 0] + tile, corner[:, 1] + tile))
+    pieces = shapely.intersection(
+        domain, shapely.box(corner[:, 0], corner[:, 1], corner[:, 0] + tile, corner[:, 1] + tile)
+    )
     out[alone] = shapely.intersection(cells[alone], pieces[which])
     return out
 
@@ -263,5 +286,3 @@ def _polygons(vertices, offsets, refs, cells):
     coords = vertices[refs[np.repeat(offsets[cells], sizes) + ranges(sizes)]]
     ring_offsets = np.concatenate([[0], np.cumsum(sizes)])
     return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords, (ring_offsets, np.arange(cells.size + 1)))
-
-

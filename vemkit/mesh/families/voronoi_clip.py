@@ -69,8 +69,21 @@ def domain_index(shape, count: int) -> DomainIndex:
     bin_side[np.diff(ptr) > 0] = -1
     convex = not shape.convex_hull.area > shape.area * (1 + 1e-12)
     segments = shapely.STRtree(shapely.linestrings(ends.reshape(-1, 2, 2)))
-    return DomainIndex(shape, ends, seg_lo, seg_hi, origin, inv, g, ptr, items, bin_side, convex, segments,
-                       len(shapely.get_coordinates(shape)))
+    return DomainIndex(
+        shape,
+        ends,
+        seg_lo,
+        seg_hi,
+        origin,
+        inv,
+        g,
+        ptr,
+        items,
+        bin_side,
+        convex,
+        segments,
+        len(shapely.get_coordinates(shape)),
+    )
 
 
 def side_of_boxes(index: DomainIndex, lo: np.ndarray, near: np.ndarray) -> np.ndarray:
@@ -120,8 +133,13 @@ def clipped_centroids(vertices, offsets, refs, cells, sites, vertex_in, ends, pt
             for i in range(grid_index(lx, origin[0], inv, g), grid_index(hx, origin[0], inv, g) + 1):
                 for t in range(ptr[j * g + i], ptr[j * g + i + 1]):
                     e = items[t]
-                    if seen[e] != c and min(ends[e, 0], ends[e, 2]) <= hx and lx <= max(ends[e, 0], ends[e, 2]) \
-                            and min(ends[e, 1], ends[e, 3]) <= hy and ly <= max(ends[e, 1], ends[e, 3]):
+                    if (
+                        seen[e] != c
+                        and min(ends[e, 0], ends[e, 2]) <= hx
+                        and lx <= max(ends[e, 0], ends[e, 2])
+                        and min(ends[e, 1], ends[e, 3]) <= hy
+                        and ly <= max(ends[e, 1], ends[e, 3])
+                    ):
                         seen[e] = c
                         local[n_near, 0], local[n_near, 1] = ends[e, 0] - ox, ends[e, 1] - oy
                         local[n_near, 2], local[n_near, 3] = ends[e, 2] - ox, ends[e, 3] - oy
@@ -130,8 +148,17 @@ def clipped_centroids(vertices, offsets, refs, cells, sites, vertex_in, ends, pt
         consistent = True
         for i in range(m):
             a, b = refs[s + i], refs[s + (i + 1) % m]
-            consistent &= _edge_inside(vertices[a, 0] - ox, vertices[a, 1] - oy, vertices[b, 0] - ox,
-                                       vertices[b, 1] - oy, vertex_in[a], vertex_in[b], local[:n_near], ts, sums)
+            consistent &= _edge_inside(
+                vertices[a, 0] - ox,
+                vertices[a, 1] - oy,
+                vertices[b, 0] - ox,
+                vertices[b, 1] - oy,
+                vertex_in[a],
+                vertex_in[b],
+                local[:n_near],
+                ts,
+                sums,
+            )
         for q in range(n_near):
             _segment_in_cell(vertices, refs, s, m, local[q], ox, oy, sums)
         area = 0.5 * sums[0]

@@ -148,8 +148,12 @@ def boxes_meet_segments(lo, hi, seg_lo, seg_hi, origin, inv, g):
             for i in range(i0, i1 + 1):
                 for t in range(ptr[j * g + i], ptr[j * g + i + 1]):
                     s = items[t]
-                    if seg_lo[s, 0] <= hi[c, 0] and lo[c, 0] <= seg_hi[s, 0] and \
-                            seg_lo[s, 1] <= hi[c, 1] and lo[c, 1] <= seg_hi[s, 1]:
+                    if (
+                        seg_lo[s, 0] <= hi[c, 0]
+                        and lo[c, 0] <= seg_hi[s, 0]
+                        and seg_lo[s, 1] <= hi[c, 1]
+                        and lo[c, 1] <= seg_hi[s, 1]
+                    ):
                         out[c] = True
     return out
 

@@ -20,12 +20,23 @@ every 2D family gives prisms over its 2D mesh of the base.
 sizes (n, h, cells): ``build_mesh3d`` (``families3d.build``).
 """
 
+from vemkit.mesh.families3d.build import BOX_FAMILIES, build_mesh3d
 from vemkit.mesh.families3d.extrude import extrude
 from vemkit.mesh.families3d.gmsh_tet import delaunay_tet, delaunay_tet_extruded
 from vemkit.mesh.families3d.grid import BOX_SIDES, UNIT_BOX, hex, tet
 from vemkit.mesh.families3d.octree import octree
 from vemkit.mesh.families3d.voronoi3d import voronoi
-from vemkit.mesh.families3d.build import BOX_FAMILIES, build_mesh3d
 
-__all__ = ["BOX_FAMILIES", "build_mesh3d", "BOX_SIDES", "UNIT_BOX", "delaunay_tet", "delaunay_tet_extruded", "extrude",
-           "hex", "octree", "tet", "voronoi"]
+__all__ = [
+    "BOX_FAMILIES",
+    "build_mesh3d",
+    "BOX_SIDES",
+    "UNIT_BOX",
+    "delaunay_tet",
+    "delaunay_tet_extruded",
+    "extrude",
+    "hex",
+    "octree",
+    "tet",
+    "voronoi",
+]

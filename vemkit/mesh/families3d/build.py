@@ -16,8 +16,15 @@ import inspect
 
 import numpy as np
 
-from vemkit.config.domain3d import BOX_FAMILIES as BOX_FAMILY_NAMES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, TET_KINDS, \
-    Box, cells_per_length3d, domain3d_from_spec
+from vemkit.config.domain3d import BOX_FAMILIES as BOX_FAMILY_NAMES
+from vemkit.config.domain3d import (
+    EXTRUDE_FAMILIES_3D,
+    FAMILIES_2D,
+    TET_KINDS,
+    Box,
+    cells_per_length3d,
+    domain3d_from_spec,
+)
 from vemkit.exceptions import SceneError
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.families3d.extrude import extrude
@@ -37,11 +44,15 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
         return _tet(body, n, h, cells, layers, options)
     if isinstance(body, Box):
         if family not in BOX_FAMILY_NAMES:
-            raise SceneError(f"mesh family {family!r} does not mesh a box; valid families: "
-                             f"{', '.join(BOX_FAMILY_NAMES)}", key="discretization.mesh.family")
+            raise SceneError(
+                f"mesh family {family!r} does not mesh a box; valid families: {', '.join(BOX_FAMILY_NAMES)}",
+                key="discretization.mesh.family",
+            )
         if layers is not None:
-            raise SceneError("discretization.mesh.layers applies to an extrude domain only; remove it",
-                             key="discretization.mesh.layers")
+            raise SceneError(
+                "discretization.mesh.layers applies to an extrude domain only; remove it",
+                key="discretization.mesh.layers",
+            )
         builder = BOX_FAMILIES[family][0]
         _check_options(family, builder, options)
         box = (body.lower, body.upper)
@@ -49,18 +60,21 @@ def build_mesh3d(family: str, domain, n=None, h=None, cells=None, layers=None, *
             return builder(box=box, sides=body.sides, cells=cells, **options)
         return builder(box_cells_per_length(family, body, n, h, cells, options), box=box, sides=body.sides, **options)
     if family not in FAMILIES_2D:
-        raise SceneError(f"mesh family {family!r} does not mesh an extrude domain; valid families: "
-                         f"{', '.join(FAMILIES_2D)} (prisms over the 2D mesh of the base), "
-                         f"{', '.join(EXTRUDE_FAMILIES_3D)} (tetrahedra of the body)",
-                         key="discretization.mesh.family")
+        raise SceneError(
+            f"mesh family {family!r} does not mesh an extrude domain; valid families: "
+            f"{', '.join(FAMILIES_2D)} (prisms over the 2D mesh of the base), "
+            f"{', '.join(EXTRUDE_FAMILIES_3D)} (tetrahedra of the body)",
+            key="discretization.mesh.family",
+        )
     size = cells_per_length3d(body, n, h, cells, 2.0 if family == "triangle" else 1.0)
     _check_options(family, None, {k: v for k, v in options.items()})
     base = build_mesh(family, **({"h": h} if h is not None else {"n": size}), domain=body.base, **options)
     if layers is None:
         layers = max(1, int(round(body.depth * size)))
     elif isinstance(layers, bool) or not float(layers).is_integer() or int(layers) < 1:
-        raise SceneError(f"discretization.mesh.layers = {layers!r}: give a whole number >= 1",
-                         key="discretization.mesh.layers")
+        raise SceneError(
+            f"discretization.mesh.layers = {layers!r}: give a whole number >= 1", key="discretization.mesh.layers"
+        )
     return extrude(base, int(layers), body.depth, ends=body.ends)
 
 
@@ -68,8 +82,9 @@ def tet_kind(options: dict) -> str:
     """The ``kind`` of a tet request (removed from ``options``); SceneError for an unknown one."""
     kind = options.pop("kind", "delaunay")
     if kind not in TET_KINDS:
-        raise SceneError(f"tet mesh kind {kind!r} is unknown; valid kinds: {', '.join(TET_KINDS)}",
-                         key="discretization.mesh.kind")
+        raise SceneError(
+            f"tet mesh kind {kind!r} is unknown; valid kinds: {', '.join(TET_KINDS)}", key="discretization.mesh.kind"
+        )
     return kind
 
 
@@ -86,11 +101,15 @@ def _tet(body, n, h, cells, layers, options: dict):
     options = dict(options)
     kind = tet_kind(options)
     if layers is not None:
-        raise SceneError("discretization.mesh.layers applies to the prism families on an extrude domain; "
-                         "remove it for family tet", key="discretization.mesh.layers")
+        raise SceneError(
+            "discretization.mesh.layers applies to the prism families on an extrude domain; remove it for family tet",
+            key="discretization.mesh.layers",
+        )
     if kind == "structured" and not isinstance(body, Box):
-        raise SceneError("tet kind structured (Kuhn tetrahedra of a grid) meshes a box only; use kind delaunay "
-                         "on an extrude domain", key="discretization.mesh.kind")
+        raise SceneError(
+            "tet kind structured (Kuhn tetrahedra of a grid) meshes a box only; use kind delaunay on an extrude domain",
+            key="discretization.mesh.kind",
+        )
     builder = tet if kind == "structured" else delaunay_tet if isinstance(body, Box) else delaunay_tet_extruded
     _check_options(f"tet (kind={kind})", builder, options, extra=["kind"])
     size = tet_cells_per_length(body, n, h, cells, kind)
@@ -103,12 +122,15 @@ def _check_options(family: str, builder, options: dict, extra=()) -> None:
     """SceneError naming an option the box family does not take (2D families: ``build_mesh`` checks)."""
     if builder is None:
         return
-    valid = [p for p in inspect.signature(builder).parameters
-             if p not in ("n", "box", "sides", "cells", "shape", "body")] + list(extra)
+    valid = [
+        p for p in inspect.signature(builder).parameters if p not in ("n", "box", "sides", "cells", "shape", "body")
+    ] + list(extra)
     unknown = sorted(set(options) - set(valid))
     if unknown:
-        raise SceneError(f"mesh option {unknown[0]!r} is not valid for family {family}; valid options: "
-                         f"{', '.join(valid) or 'none'}", key=f"discretization.mesh.{unknown[0]}")
+        raise SceneError(
+            f"mesh option {unknown[0]!r} is not valid for family {family}; valid options: {', '.join(valid) or 'none'}",
+            key=f"discretization.mesh.{unknown[0]}",
+        )
 
 
 def box_cells_per_length(family: str, body: Box, n=None, h=None, cells=None, options=None) -> float:

@@ -87,8 +87,21 @@ def extrude(mesh: Mesh, layers: int, depth: float, z0: float = 0.0, ends=DEFAULT
     table = np.concatenate(soup)
     z = z0 + depth * np.arange(layers + 1) / layers
     vertices = np.column_stack([np.tile(mesh.vertices, (layers + 1, 1)), np.repeat(z, n)])
-    meta = {"family": "extrude", "base": dict(mesh.meta), "layers": layers, "depth": float(depth), "z0": float(z0),
-            "ends": list(ends)}
+    meta = {
+        "family": "extrude",
+        "base": dict(mesh.meta),
+        "layers": layers,
+        "depth": float(depth),
+        "z0": float(z0),
+        "ends": list(ends),
+    }
     valid = table >= 0
-    return from_face_soup(vertices, np.tile(sizes + 2, layers), valid.sum(axis=1), table[valid],
-                          np.concatenate(labels), tuple(names), meta)
+    return from_face_soup(
+        vertices,
+        np.tile(sizes + 2, layers),
+        valid.sum(axis=1),
+        table[valid],
+        np.concatenate(labels),
+        tuple(names),
+        meta,
+    )

@@ -69,11 +69,16 @@ def import_gmsh():
         import gmsh
     except ImportError as error:  # OSError of a missing shared library surfaces as ImportError too
         reason = " ".join(str(error).split())[:160]
-        raise MeshError(f"mesh family tet (kind delaunay) needs the gmsh Python package: {reason}; {INSTALL_HINT} "
-                        "(kind structured needs no gmsh)", key="discretization.mesh.family") from None
+        raise MeshError(
+            f"mesh family tet (kind delaunay) needs the gmsh Python package: {reason}; {INSTALL_HINT} "
+            "(kind structured needs no gmsh)",
+            key="discretization.mesh.family",
+        ) from None
     except OSError as error:
-        raise MeshError(f"mesh family tet: the gmsh library cannot be loaded ({error}); {INSTALL_HINT}",
-                        key="discretization.mesh.family") from None
+        raise MeshError(
+            f"mesh family tet: the gmsh library cannot be loaded ({error}); {INSTALL_HINT}",
+            key="discretization.mesh.family",
+        ) from None
     return gmsh
 
 
@@ -82,12 +87,17 @@ SESSION_OPTIONS = {"General.Terminal": 0, "General.Verbosity": 1, "General.NumTh
 
 
 def _mesh_options(edge: float, optimize: bool = True) -> dict:
-    return {"Mesh.Optimize": int(bool(optimize)), "Mesh.MeshSizeMax": edge, "Mesh.MeshSizeMin": 0.0,
-            "Mesh.MeshSizeFromPoints": 0, "Mesh.MeshSizeExtendFromBoundary": 1,
-            "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
-            "Mesh.Algorithm": 6,  # Frontal-Delaunay surfaces
-            "Mesh.Algorithm3D": 1,  # Delaunay
-            "Mesh.ElementOrder": 1}
+    return {
+        "Mesh.Optimize": int(bool(optimize)),
+        "Mesh.MeshSizeMax": edge,
+        "Mesh.MeshSizeMin": 0.0,
+        "Mesh.MeshSizeFromPoints": 0,
+        "Mesh.MeshSizeExtendFromBoundary": 1,
+        "Mesh.MeshSizeFromCurvature": CURVATURE_ELEMENTS,
+        "Mesh.Algorithm": 6,  # Frontal-Delaunay surfaces
+        "Mesh.Algorithm3D": 1,  # Delaunay
+        "Mesh.ElementOrder": 1,
+    }
 
 
 @contextmanager
@@ -113,8 +123,9 @@ def gmsh_session(what: str, edge: float, optimize: bool = True):
         raise
     except Exception as error:
         reason = " ".join(str(error).split())[:200] or type(error).__name__
-        raise MeshError(f"{what}: gmsh failed ({reason}); try another mesh size, or check the domain",
-                        key="discretization.mesh") from None
+        raise MeshError(
+            f"{what}: gmsh failed ({reason}); try another mesh size, or check the domain", key="discretization.mesh"
+        ) from None
     finally:
         if gmsh.isInitialized():
             try:
@@ -173,8 +184,11 @@ def _collect(gmsh, surface_names: dict, meta: dict) -> PolyhedralMesh:
     blocks = [np.asarray(nd, np.int64).reshape(-1, 4) for t, nd in zip(types, nodes) if t == GMSH_TET]
     other = [t for t in types if t != GMSH_TET]
     if other or not blocks:
-        raise MeshError(f"gmsh made {'no tetrahedra' if not blocks else f'elements of type {other[0]}'}; "
-                        "expected linear tetrahedra only", key="discretization.mesh")
+        raise MeshError(
+            f"gmsh made {'no tetrahedra' if not blocks else f'elements of type {other[0]}'}; "
+            "expected linear tetrahedra only",
+            key="discretization.mesh",
+        )
     tets = index[np.concatenate(blocks)]
     used = np.unique(tets)
     renumber = np.full(points.shape[0], -1, dtype=np.int64)
@@ -196,15 +210,22 @@ def _collect(gmsh, surface_names: dict, meta: dict) -> PolyhedralMesh:
                 labels.append(np.full(tri.shape[0], names.index(name)))
     bf = mesh.boundary_faces
     faces = np.sort(csr_rows(mesh.face_offsets, mesh.face_vertices)[bf], axis=1)
-    label = _match_rows(faces, np.concatenate(keys) if keys else np.zeros((0, 3), np.int64),
-                        np.concatenate(labels) if labels else np.zeros(0, np.int64))
+    label = _match_rows(
+        faces,
+        np.concatenate(keys) if keys else np.zeros((0, 3), np.int64),
+        np.concatenate(labels) if labels else np.zeros(0, np.int64),
+    )
     if (label < 0).any():
         f = int(bf[np.flatnonzero(label < 0)[0]])
-        raise MeshError(f"gmsh's mesh has boundary face {f} on no surface of the body (a hole or a crack in its "
-                        "volume mesh); try another mesh size", key="discretization.mesh")
+        raise MeshError(
+            f"gmsh's mesh has boundary face {f} on no surface of the body (a hole or a crack in its "
+            "volume mesh); try another mesh size",
+            key="discretization.mesh",
+        )
     parts = {name: bf[label == k] for k, name in enumerate(names)}
-    return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          parts, meta)
+    return PolyhedralMesh(
+        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, meta
+    )
 
 
 def _match_rows(rows: np.ndarray, keys: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -223,14 +244,25 @@ def _match_rows(rows: np.ndarray, keys: np.ndarray, labels: np.ndarray) -> np.nd
     return out
 
 
-def delaunay_tet(n=None, box=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)),
-                 sides=("left", "right", "front", "back", "bottom", "top"), optimize: bool = True) -> PolyhedralMesh:
+def delaunay_tet(
+    n=None,
+    box=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)),
+    sides=("left", "right", "front", "back", "bottom", "top"),
+    optimize: bool = True,
+) -> PolyhedralMesh:
     """gmsh's quality Delaunay tetrahedra of the box, at edge length ``EDGE_PER_N / n`` (module doc)."""
     optimize = _flag(optimize)
     lower, upper = (np.asarray(b, dtype=float) for b in box)
     edge = edge_length(n)
-    meta = {"family": "tet", "kind": "delaunay", "n": n, "edge": edge, "box": [lower.tolist(), upper.tolist()],
-            "mesher": "gmsh", "optimize": optimize}
+    meta = {
+        "family": "tet",
+        "kind": "delaunay",
+        "n": n,
+        "edge": edge,
+        "box": [lower.tolist(), upper.tolist()],
+        "mesher": "gmsh",
+        "optimize": optimize,
+    }
     with gmsh_session("mesh family tet on the box", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         occ.addBox(*lower.tolist(), *(upper - lower).tolist())
@@ -258,8 +290,9 @@ def _box_snapped(mesh: PolyhedralMesh, lower, upper, sides) -> PolyhedralMesh:
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, k // 2] = (lower, upper)[k % 2][k // 2]
         parts[name] = np.sort(np.concatenate([parts[name], part]))
-    return PolyhedralMesh(vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          parts, mesh.meta)
+    return PolyhedralMesh(
+        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
+    )
 
 
 def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
@@ -269,8 +302,17 @@ def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
 
     base, depth, ends = body.base, float(body.depth), tuple(body.ends)
     edge = edge_length(n)
-    meta = {"family": "tet", "kind": "delaunay", "n": n, "edge": edge, "depth": depth, "ends": list(ends),
-            "base": base.to_spec(), "mesher": "gmsh", "optimize": optimize}
+    meta = {
+        "family": "tet",
+        "kind": "delaunay",
+        "n": n,
+        "edge": edge,
+        "depth": depth,
+        "ends": list(ends),
+        "base": base.to_spec(),
+        "mesher": "gmsh",
+        "optimize": optimize,
+    }
     with gmsh_session("mesh family tet on the extruded domain", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         curve_names = {}
@@ -310,8 +352,11 @@ def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
             bounding = [abs(c) for d, c in gmsh.model.getBoundary([(2, tag)], oriented=False) if d == 1]
             found = [curve_names[c] for c in bounding if c in curve_names]
             if not found:
-                raise MeshError("mesh family tet: a lateral face of the extruded body has no base curve (gmsh "
-                                "renumbered the geometry); report this domain", key="domain")
+                raise MeshError(
+                    "mesh family tet: a lateral face of the extruded body has no base curve (gmsh "
+                    "renumbered the geometry); report this domain",
+                    key="domain",
+                )
             names[tag] = found[0]
         gmsh.model.mesh.generate(3)
         mesh = _collect(gmsh, names, meta)
@@ -325,8 +370,9 @@ def _ends_snapped(mesh: PolyhedralMesh, depth: float, ends) -> PolyhedralMesh:
         part = mesh.boundary.get(name, np.zeros(0, np.int64))
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, 2] = z
-    return PolyhedralMesh(vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          mesh.boundary, mesh.meta)
+    return PolyhedralMesh(
+        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, mesh.boundary, mesh.meta
+    )
 
 
 def surface_area(body) -> float:
@@ -351,6 +397,7 @@ def surface_area(body) -> float:
         if isinstance(hole, CircleHole):
             perimeter += 2.0 * math.pi * hole.r
         else:
-            perimeter += sum(math.dist(hole.polygon[i], hole.polygon[(i + 1) % len(hole.polygon)])
-                             for i in range(len(hole.polygon)))
+            perimeter += sum(
+                math.dist(hole.polygon[i], hole.polygon[(i + 1) % len(hole.polygon)]) for i in range(len(hole.polygon))
+            )
     return float(2.0 * base.exact_area + body.depth * perimeter)

@@ -68,8 +68,15 @@ def hex(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     faces = ids[:, HEX_FACES].reshape(-1, 4)
     m = ids.shape[0]
     labels = np.tile(np.arange(6), m)
-    mesh = from_face_soup(vertices, np.full(m, 6), np.full(6 * m, 4), faces.ravel(), labels, tuple(sides),
-                          {"family": "hex", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()})
+    mesh = from_face_soup(
+        vertices,
+        np.full(m, 6),
+        np.full(6 * m, 4),
+        faces.ravel(),
+        labels,
+        tuple(sides),
+        {"family": "hex", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()},
+    )
     return _merge_repeated_names(mesh, sides)
 
 
@@ -83,14 +90,21 @@ def tet(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     tets[det < 0] = tets[det < 0][:, [0, 2, 1, 3]]
     m = tets.shape[0]
     faces = tets[:, TET_FACES].reshape(-1, 3)
-    mesh = from_face_soup(vertices, np.full(m, 4), np.full(4 * m, 3), faces.ravel(), None, (),
-                          {"family": "tet", "kind": "structured", "n": n, "shape": list(shape),
-                           "box": np.asarray(box, float).tolist()})
+    mesh = from_face_soup(
+        vertices,
+        np.full(m, 4),
+        np.full(4 * m, 3),
+        faces.ravel(),
+        None,
+        (),
+        {"family": "tet", "kind": "structured", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()},
+    )
     return tag_box_faces(mesh, *check_box(box), sides)
 
 
 def _merge_repeated_names(mesh: PolyhedralMesh, sides) -> PolyhedralMesh:
     """from_face_soup with a name given twice already joins the parts; keep the sides' order."""
     parts = {name: mesh.boundary.get(name, np.zeros(0, np.int64)) for name in dict.fromkeys(sides)}
-    return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          parts, mesh.meta)
+    return PolyhedralMesh(
+        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
+    )

@@ -37,8 +37,17 @@ def _chosen(shape, rule, contact_side, sides, fraction, seed) -> np.ndarray:
     return index == (count - 1 if high else 0)
 
 
-def octree(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None, rule: str = "contact", contact_side: str = "bottom",
-           fraction: float = 0.3, seed: int = 0, levels: int = 1) -> PolyhedralMesh:
+def octree(
+    n=None,
+    box=UNIT_BOX,
+    sides=BOX_SIDES,
+    shape=None,
+    rule: str = "contact",
+    contact_side: str = "bottom",
+    fraction: float = 0.3,
+    seed: int = 0,
+    levels: int = 1,
+) -> PolyhedralMesh:
     """The grid of the box with one level of refinement by ``rule`` (module doc)."""
     if int(levels) != 1:
         raise ValueError(f"levels = {levels}: the octree family refines one level (levels = 1)")
@@ -75,10 +84,18 @@ def octree(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None, rule: str = "conta
     kk, rest = np.divmod(used, dims[0] * dims[1])
     jj, ii = np.divmod(rest, dims[0])
     vertices = lower + np.stack([ii, jj, kk], axis=1) / (dims - 1) * (upper - lower)
-    meta = {"family": "octree", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist(), "rule": rule,
-            "levels": 1, "refined": int(refined.sum())}
-    meta.update({"fraction": float(fraction), "seed": int(seed)} if rule == "random"
-                else {"contact_side": contact_side})
+    meta = {
+        "family": "octree",
+        "n": n,
+        "shape": list(shape),
+        "box": np.asarray(box, float).tolist(),
+        "rule": rule,
+        "levels": 1,
+        "refined": int(refined.sum()),
+    }
+    meta.update(
+        {"fraction": float(fraction), "seed": int(seed)} if rule == "random" else {"contact_side": contact_side}
+    )
     mesh = from_face_soup(vertices, counts, valid.sum(axis=1), renumber[rows[valid]], None, (), meta)
     return tag_box_faces(mesh, lower, upper, sides)
 
@@ -94,10 +111,15 @@ def _coarse_faces(origin: np.ndarray, vid, active: np.ndarray):
     split = active[vid(centre)]  # the neighbour across is refined
     c = vid(centre)[..., None]
     r = ring_ids
-    quarters = np.stack([np.concatenate([r[..., [0, 1]], c, r[..., [7]]], axis=-1),
-                         np.concatenate([r[..., [1, 2, 3]], c], axis=-1),
-                         np.concatenate([c, r[..., [3, 4, 5]]], axis=-1),
-                         np.concatenate([r[..., [7]], c, r[..., [5, 6]]], axis=-1)], axis=2)  # (C, 6, 4, 4)
+    quarters = np.stack(
+        [
+            np.concatenate([r[..., [0, 1]], c, r[..., [7]]], axis=-1),
+            np.concatenate([r[..., [1, 2, 3]], c], axis=-1),
+            np.concatenate([c, r[..., [3, 4, 5]]], axis=-1),
+            np.concatenate([r[..., [7]], c, r[..., [5, 6]]], axis=-1),
+        ],
+        axis=2,
+    )  # (C, 6, 4, 4)
     whole = np.where(keep, ring_ids, -1)
     # compact every whole face to the left (keep its cyclic order)
     order = np.argsort(~keep, axis=-1, kind="stable")
@@ -107,8 +129,9 @@ def _coarse_faces(origin: np.ndarray, vid, active: np.ndarray):
     one_rows = whole[~split]
     one_key = np.stack([cells[~split], face[~split], np.zeros(one_rows.shape[0], int)], axis=1)
     four_rows = np.pad(quarters[split].reshape(-1, 4), ((0, 0), (0, 4)), constant_values=-1)
-    four_key = np.stack([np.repeat(cells[split], 4), np.repeat(face[split], 4),
-                         np.tile(np.arange(4), int(split.sum()))], axis=1)
+    four_key = np.stack(
+        [np.repeat(cells[split], 4), np.repeat(face[split], 4), np.tile(np.arange(4), int(split.sum()))], axis=1
+    )
     rows = np.concatenate([one_rows, four_rows])
     key = np.concatenate([one_key, four_key])
     order = np.lexsort((key[:, 2], key[:, 1], key[:, 0]))

@@ -66,11 +66,15 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
             c, v, f = tet_counts(tet_cells_per_length(body, n, h, cells), body.volume, surface_area(body))
             return Mesh3dEstimate(c, v, f, 3 * v, False)
         if not isinstance(body, Box):
-            raise SceneError("tet kind structured meshes a box only; use kind delaunay on an extrude domain",
-                             key="discretization.mesh.kind")
+            raise SceneError(
+                "tet kind structured meshes a box only; use kind delaunay on an extrude domain",
+                key="discretization.mesh.kind",
+            )
     if not isinstance(body, Box):
-        raise SceneError("estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh; "
-                         "family tet on both)", key="domain")
+        raise SceneError(
+            "estimate_mesh3d: give a box domain (an extruded body is estimated from its 2D mesh; family tet on both)",
+            key="domain",
+        )
     box = (body.lower, body.upper)
     if family == "voronoi":
         count = seed_count(cells_per_length3d(body, n, h, None) if cells is None else None, box, cells)
@@ -79,8 +83,10 @@ def estimate_mesh3d(family: str, domain, n=None, h=None, cells=None, **options) 
         faces = max(4, int(VORONOI_FACES_PER_CELL * count - deficit))
         return Mesh3dEstimate(count, vertices, faces, 3 * vertices, False)
     if family not in ("hex", "tet", "octree"):
-        raise SceneError(f"estimate_mesh3d: unknown box family {family!r}; valid: hex, tet, octree, voronoi",
-                         key="discretization.mesh.family")
+        raise SceneError(
+            f"estimate_mesh3d: unknown box family {family!r}; valid: hex, tet, octree, voronoi",
+            key="discretization.mesh.family",
+        )
     nx, ny, nz = grid_shape(box_cells_per_length(family, body, n, h, cells, {**options, "kind": "structured"}), box)
     c, v, f = _grid_counts(nx, ny, nz)
     if family == "hex":
@@ -131,6 +137,10 @@ def check_scene_resources3d(scene, max_dofs):
     if estimate is not None:
         options = scene.mesh_options
         size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
-        check_resources(estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})",
-                        fix="a coarser discretization.mesh")
+        check_resources(
+            estimate,
+            max_dofs,
+            what=f"the scene ({options['family']} mesh, {size})",
+            fix="a coarser discretization.mesh",
+        )
     return estimate

@@ -20,6 +20,7 @@ merged (Qhull may report a degenerate vertex twice).
 from __future__ import annotations
 
 import itertools
+
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -55,8 +56,16 @@ def jittered_seeds(count: int, lower, upper, rng, jitter: float) -> np.ndarray:
     return lower + (ijk + 0.5 + jitter * (rng.random((count, 3)) - 0.5)) * cell
 
 
-def voronoi(n=None, box=UNIT_BOX, sides=BOX_SIDES, cells=None, seed: int = 0, lloyd_iterations: int = 3,
-            jitter: float = 0.8, lloyd_samples: int = 3) -> PolyhedralMesh:
+def voronoi(
+    n=None,
+    box=UNIT_BOX,
+    sides=BOX_SIDES,
+    cells=None,
+    seed: int = 0,
+    lloyd_iterations: int = 3,
+    jitter: float = 0.8,
+    lloyd_samples: int = 3,
+) -> PolyhedralMesh:
     """The clipped centroidal Voronoi mesh of the box (module doc). ``lloyd_samples`` = k > 0: the
     Lloyd steps take every cell's centroid as the mean of the points of a regular grid of about k³
     points per cell that are nearer to its seed than to any other (a cKDTree query: no diagram per
@@ -72,10 +81,19 @@ def voronoi(n=None, box=UNIT_BOX, sides=BOX_SIDES, cells=None, seed: int = 0, ll
         else:
             points = sampled_centroids(points, samples)
     mesh = clipped_voronoi(points, lower, upper, sides)
-    meta = {"family": "voronoi", "n": n, "cells": count, "box": np.asarray(box, float).tolist(), "seed": int(seed),
-            "lloyd_iterations": int(lloyd_iterations), "jitter": float(jitter), "lloyd_samples": int(lloyd_samples)}
-    return PolyhedralMesh(mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces,
-                          mesh.boundary, meta)
+    meta = {
+        "family": "voronoi",
+        "n": n,
+        "cells": count,
+        "box": np.asarray(box, float).tolist(),
+        "seed": int(seed),
+        "lloyd_iterations": int(lloyd_iterations),
+        "jitter": float(jitter),
+        "lloyd_samples": int(lloyd_samples),
+    }
+    return PolyhedralMesh(
+        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, mesh.boundary, meta
+    )
 
 
 def sample_grid(count: int, lower, upper, k: int) -> np.ndarray:

@@ -52,9 +52,7 @@ def stabilization_code(name: str) -> int:
     try:
         return STABILIZATIONS.index(name)
     except ValueError:
-        raise ValueError(
-            f"stabilization {name!r} is unknown; use one of {', '.join(STABILIZATIONS)}"
-        ) from None
+        raise ValueError(f"stabilization {name!r} is unknown; use one of {', '.join(STABILIZATIONS)}") from None
 
 
 ENTITIES = ("vertex", "edge", "cell")  # the order of global node numbers
@@ -109,8 +107,11 @@ class Element:
     def entity_counts(self, mesh) -> dict:
         """{entity: how many the mesh has}, in node order (edges counted only where the element has
         nodes on them: a mesh's edge table is built on demand)."""
-        return {"vertex": mesh.n_vertices, "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
-                "cell": mesh.n_cells}
+        return {
+            "vertex": mesh.n_vertices,
+            "edge": mesh.edges.shape[0] if "edge" in self.layout else 0,
+            "cell": mesh.n_cells,
+        }
 
     def node_ranges(self, counts: dict) -> dict:
         """{entity: slice of the global node numbers on it} for entity ``counts`` (vertices, edges, cells)."""

@@ -56,4 +56,3 @@ class FirstOrder(Element):
 
 
 ELEMENT = FirstOrder()
-

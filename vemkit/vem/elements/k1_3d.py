@@ -18,7 +18,6 @@ import numpy as np
 from vemkit.vem.elements import k1_3d_fields, k1_3d_kernel
 from vemkit.vem.elements.base import Element
 
-
 _FACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mesh -> local_faces(mesh)
 
 
@@ -29,8 +28,9 @@ def local_faces(mesh):
     signed = mesh.cell_faces
     faces = np.where(signed >= 0, signed, -signed - 1)
     face_ptr = np.concatenate([[0], np.cumsum(np.diff(mesh.face_offsets)[faces])]).astype(np.int64)
-    face_local = _local_faces(mesh.cell_offsets, signed, mesh.face_offsets, mesh.face_vertices, offsets, ids,
-                              face_ptr, mesh.n_vertices)
+    face_local = _local_faces(
+        mesh.cell_offsets, signed, mesh.face_offsets, mesh.face_vertices, offsets, ids, face_ptr, mesh.n_vertices
+    )
     return mesh.cell_offsets.copy(), face_ptr, face_local
 
 

@@ -37,7 +37,7 @@ def cell_quadrature(mesh, points: int = 3):
     offsets, ids = mesh.cell_vertex_lists
     corners, cells = [], []
     for c in range(mesh.n_cells):
-        centre = mesh.vertices[ids[offsets[c]:offsets[c + 1]]].mean(axis=0)
+        centre = mesh.vertices[ids[offsets[c] : offsets[c + 1]]].mean(axis=0)
         for s in mesh.cell_face_list(c):
             face = mesh.face(s) if s >= 0 else mesh.face(-s - 1)[::-1]
             p = mesh.vertices[face]
@@ -58,7 +58,7 @@ def cell_projections(mesh, geometry):
     offsets, ids = mesh.cell_vertex_lists
     xbars, Ps, vols = np.zeros((mesh.n_cells, 3)), [], np.zeros(mesh.n_cells)
     for c in range(mesh.n_cells):
-        p = np.ascontiguousarray(vertices[ids[offsets[c]:offsets[c + 1]]])
+        p = np.ascontiguousarray(vertices[ids[offsets[c] : offsets[c + 1]]])
         n = p.shape[0]
         q, w, B, P = np.empty((n, 3)), np.empty(n), np.empty((6, 3 * n)), np.empty((12, 3 * n))
         vols[c] = boundary_vectors(p, face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], q, w)
@@ -111,7 +111,7 @@ def projected_solution(mesh, geometry, node_values) -> ProjectedSolution3D:
     xbar, Ps, _ = cell_projections(mesh, geometry)
     c, G = np.zeros((mesh.n_cells, 3)), np.zeros((mesh.n_cells, 3, 3))
     for k, P in enumerate(Ps):
-        v = u[ids[offsets[k]:offsets[k + 1]]].ravel()
+        v = u[ids[offsets[k] : offsets[k + 1]]].ravel()
         c[k] = P[:3] @ v
         G[k] = np.einsum("j,jab->ab", v, _gradients(P))
     return ProjectedSolution3D(xbar, c, G)
@@ -130,7 +130,7 @@ def body_force_load(mesh, geometry, field) -> np.ndarray:
     for k, P in enumerate(Ps):
         value = P[:3].T + _gradients(P) @ (centroid[k] - xbar[k])  # (3n, 3) Pi phi_j (x_K)
         load = volume[k] * value @ mean_f[k]
-        np.add.at(out, ids[offsets[k]:offsets[k + 1]], load.reshape(-1, 3))
+        np.add.at(out, ids[offsets[k] : offsets[k + 1]], load.reshape(-1, 3))
     return out
 
 

@@ -268,8 +268,15 @@ def element_stiffness(p, face_ptr, face_local, f_lo, f_hi, lam, mu, stab, K, B, 
 def workspace(max_nodes):
     """(K, B, P, R, p, q, w): the work arrays of ``cell_matrix`` for cells of up to max_nodes vertices."""
     m = 3 * max_nodes
-    return (np.empty((m, m)), np.empty((6, m)), np.empty((12, m)), np.empty((m, m)), np.empty((max_nodes, 3)),
-            np.empty((max_nodes, 3)), np.empty(max_nodes))
+    return (
+        np.empty((m, m)),
+        np.empty((6, m)),
+        np.empty((12, m)),
+        np.empty((m, m)),
+        np.empty((max_nodes, 3)),
+        np.empty((max_nodes, 3)),
+        np.empty(max_nodes),
+    )
 
 
 @numba.njit(cache=True)
@@ -284,6 +291,20 @@ def cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work):
         for k in range(3):
             p[i, k] = vertices[nodes[start + i], k]
     m = 3 * n
-    element_stiffness(p[:n], face_ptr, face_local, cell_face_ptr[c], cell_face_ptr[c + 1], lam, mu, stab,
-                      K[:m, :m], B[:, :m], P[:, :m], R[:m, :m], q[:n], w)
+    element_stiffness(
+        p[:n],
+        face_ptr,
+        face_local,
+        cell_face_ptr[c],
+        cell_face_ptr[c + 1],
+        lam,
+        mu,
+        stab,
+        K[:m, :m],
+        B[:, :m],
+        P[:, :m],
+        R[:m, :m],
+        q[:n],
+        w,
+    )
     return K

@@ -8,8 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-_SKEW = [np.array([[0, 0, 0], [0, 0, -1], [0, 1, 0]]), np.array([[0, 0, 1], [0, 0, 0], [-1, 0, 0]]),
-         np.array([[0, -1, 0], [1, 0, 0], [0, 0, 0]])]  # omega_k x d as a matrix
+_SKEW = [
+    np.array([[0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+    np.array([[0, 0, 1], [0, 0, 0], [-1, 0, 0]]),
+    np.array([[0, -1, 0], [1, 0, 0], [0, 0, 0]]),
+]  # omega_k x d as a matrix
 _STRAIN = []
 for a, b in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
     e = np.zeros((3, 3))

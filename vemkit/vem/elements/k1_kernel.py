@@ -25,6 +25,7 @@ import numpy as np
 
 from vemkit.mesh.geometry import polygon_area
 
+
 @numba.njit(cache=True)
 def polygon_coordinates(vertices, ids, start, n):
     """(px, py) of the n vertices ids[start:start + n]."""
@@ -175,8 +176,14 @@ def add_stabilization(R, alpha, K):
 def workspace(max_nodes):
     """(K, B, P, R, px, py): the work arrays of ``cell_matrix`` for cells of up to max_nodes vertices."""
     m = 2 * max_nodes
-    return (np.empty((m, m)), np.empty((3, m)), np.empty((6, m)), np.empty((m, m)), np.empty(max_nodes),
-            np.empty(max_nodes))
+    return (
+        np.empty((m, m)),
+        np.empty((3, m)),
+        np.empty((6, m)),
+        np.empty((m, m)),
+        np.empty(max_nodes),
+        np.empty(max_nodes),
+    )
 
 
 @numba.njit(cache=True)

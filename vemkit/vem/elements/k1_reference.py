@@ -45,6 +45,7 @@ def element_stiffness_reference(coords, lam, mu, stabilization="dofi-2mu"):
             for v in (a, b):
                 rhs_strain[beta, 2 * v : 2 * v + 2] += 0.5 * traction
     G = np.array([[area * np.tensordot(sym(mats[a]), stress[b]) for b in range(6)] for a in range(6)])
+
     # constraint rows: vertex means of the two components, vertex mean of x x q
     def vertex_values(alpha):
         return coords @ mats[alpha].T + consts[alpha]

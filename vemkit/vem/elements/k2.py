@@ -56,4 +56,3 @@ class SecondOrder(Element):
 
 
 ELEMENT = SecondOrder()
-

@@ -25,17 +25,23 @@ centroid and nine non-rigid fields in (xi, eta) = (x - x_K) / h_K).
 
 from __future__ import annotations
 
-import numba
-import numpy as np
-
 import weakref
 from dataclasses import dataclass
+
+import numba
+import numpy as np
 
 from vemkit.mesh.mesh import Mesh, edge_indices
 from vemkit.vem.elements.k1_fields import component_values
 from vemkit.vem.elements.k1_fields import dirichlet_components as vertex_dirichlet_components
-from vemkit.vem.elements.k2_kernel import (N_BASIS, cell_frame, cell_projection, cell_vertex_coordinates,
-                                           largest_cell, projection_workspace)
+from vemkit.vem.elements.k2_kernel import (
+    N_BASIS,
+    cell_frame,
+    cell_projection,
+    cell_vertex_coordinates,
+    largest_cell,
+    projection_workspace,
+)
 from vemkit.vem.projection import strain_of
 from vemkit.vem.quadrature import body_force_averages, edge_quadrature, reference_quadrature, traction_samples
 
@@ -236,6 +242,7 @@ def projected_solution_k2(mesh: Mesh, u_nodes: np.ndarray, lam: float, mu: float
 def interpolate_k2(mesh: Mesh, field, points: int = 5) -> np.ndarray:
     """(n_nodes, 2) degrees of freedom of a field(x, y) -> (f1, f2): vertex values, edge means
     (Gauss-Legendre, ``points`` per edge) and cell means (degree-5 rule on a cell triangulation)."""
+
     def stacked(x, y):
         f1, f2 = field(x, y)
         return np.stack([np.broadcast_to(f1, np.shape(x)), np.broadcast_to(f2, np.shape(x))], axis=-1)

@@ -117,8 +117,20 @@ def element_stiffness_k2_reference(coords, lam, mu, stabilization="dofi-2mu"):
 
 def basis_dofs(coords, center, h, qp, qw):
     """(m, 12): the degrees of freedom of the 12 monomial fields."""
-    return np.stack([field_dofs(coords, lambda x, y, f=f: _fields(np.stack([x, y], -1).reshape(-1, 2), center, h)[0]
-                                [:, f].reshape(np.shape(x) + (2,)), qp, qw) for f in range(12)], axis=1)
+    return np.stack(
+        [
+            field_dofs(
+                coords,
+                lambda x, y, f=f: _fields(np.stack([x, y], -1).reshape(-1, 2), center, h)[0][:, f].reshape(
+                    np.shape(x) + (2,)
+                ),
+                qp,
+                qw,
+            )
+            for f in range(12)
+        ],
+        axis=1,
+    )
 
 
 def field_dofs(coords, field, qp=None, qw=None):

@@ -189,8 +189,18 @@ def stiffness_workspace(nmax):
     padding stays zero)."""
     m = 4 * nmax + 2
     n_loc = 2 * nmax + 1
-    return (np.empty((9, m)), np.empty((9, 9)), np.empty((9, 3, 3)), np.zeros((m, N_ENERGY)), np.empty((m, 9)),
-            np.empty((m, 12)), np.empty((n_loc, 6)), np.empty((6, 6)), np.empty((n_loc, 6)), np.empty((n_loc, n_loc)))
+    return (
+        np.empty((9, m)),
+        np.empty((9, 9)),
+        np.empty((9, 3, 3)),
+        np.zeros((m, N_ENERGY)),
+        np.empty((m, 9)),
+        np.empty((m, 12)),
+        np.empty((n_loc, 6)),
+        np.empty((6, 6)),
+        np.empty((n_loc, 6)),
+        np.empty((n_loc, n_loc)),
+    )
 
 
 @numba.njit(cache=True)
@@ -219,8 +229,15 @@ def element_stiffness_k2_matrix(coords, lam, mu, stabilization="dofi-2mu"):
     n = c.shape[0]
     m = 4 * n + 2
     K = np.empty((m, m))
-    element_stiffness_k2(c[:, 0].copy(), c[:, 1].copy(), float(lam), float(mu), stabilization_code(stabilization),
-                         K, stiffness_workspace(n))
+    element_stiffness_k2(
+        c[:, 0].copy(),
+        c[:, 1].copy(),
+        float(lam),
+        float(mu),
+        stabilization_code(stabilization),
+        K,
+        stiffness_workspace(n),
+    )
     return K
 
 
