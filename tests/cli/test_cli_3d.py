@@ -121,7 +121,7 @@ def test_bad_3d_input_is_refused_in_one_line(tmp_path, override):
 @pytest.mark.parametrize(
     "extra, message",
     [
-        ("  contact: [top]\ncontact: {normal: {k: 1, m: 1}, friction: {k: 0, m: 0}}\n", "contact on 3D bodies"),
+        ("  contact: [top]\ncontact: {gap: -1, normal: {k: 1, m: 1}, friction: {k: 0, m: 0}}\n", "must be >= 0"),
         ("  neumann: {top: {traction: [0, 1]}}\n", "traction has 2 components"),
         ("body_force: [0, 0, '1/z']\n", "must be finite"),
     ],

@@ -189,6 +189,13 @@ def boundary_expressions(data: dict, domain: Domain | None, probes=None, dimensi
 
 def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
     """The foundation line's normal is not zero and every contact side lies on its body side."""
+    for key in ("point", "normal"):
+        if len(foundation[key]) != 2:
+            raise SceneError(
+                f"contact.foundation.{key} has {len(foundation[key])} components; a 2D scene's "
+                "foundation is a line: give 2",
+                key=f"contact.foundation.{key}",
+            )
     normal = np.asarray(foundation["normal"], dtype=float)
     if not np.hypot(*normal) > 0:
         raise SceneError(

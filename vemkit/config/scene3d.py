@@ -5,7 +5,9 @@ three components and its expressions take x, y and z. Before any mesh is built e
 test-evaluated on its side (:class:`BodyProbes`: a grid on each face of a box; on an extruded body the
 2D probes of a lateral side at several heights, the base's boundary on the end faces), the Dirichlet
 sides are tested for a free rigid motion (SPEC §10 names it), and what 3D does not have yet is refused
-in one line: contact (Gamma_C on polyhedral meshes), order 2, the k = 2 load options.
+in one line: order 2, the k = 2 load options, the gauss contact rule. Contact (SPEC §10): a foundation
+plane (a point and a non-zero normal of three components, every contact side on its body side) or a
+gap expression of x, y, z that is >= 0 on the contact sides (:func:`check_contact_3d`).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.config.boundary_conditions import (
+    MAX_NORMAL_K_OVER_E,
     PROBES,
     PlaneProbes,
     _dirichlet,
@@ -27,7 +30,7 @@ from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
 
-__all__ = ["BodyProbes", "check_model_domain", "semantic_checks_3d"]
+__all__ = ["BodyProbes", "check_contact_3d", "check_model_domain", "semantic_checks_3d"]
 
 DIMENSION = 3
 
@@ -115,11 +118,11 @@ def _refuse_2d_only(data: dict, given: dict) -> None:
             "discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean of f1; drop it",
             key="discretization.body_force_projection",
         )
-    if data["boundary"]["contact"] or "contact" in given:
+    if discretization.get("contact_quadrature", "nodal") != "nodal":
         raise SceneError(
-            "contact on 3D bodies is not available yet (SPEC §10, a coming release); drop "
-            "boundary.contact and the contact section",
-            key="boundary.contact",
+            f"discretization.contact_quadrature = {discretization['contact_quadrature']!r}: 3D bodies "
+            "have the nodal rule at the Gamma_C vertices only; set contact_quadrature: nodal",
+            key="discretization.contact_quadrature",
         )
 
 
@@ -176,6 +179,69 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
             key="body_force",
         )
     compiled["body_force"] = tuple(compile_checked(f"body_force[{i}]", force[i], DIMENSION) for i in range(3))
+    if "contact" in data:
+        check_contact_3d(data, given.get("contact", {}), probes, compiled)
     for expression in compiled["body_force"] if probes is not None else ():
         evaluate_checked(expression, probes.inside())
     return compiled
+
+
+def check_contact_3d(data: dict, given_contact: dict, probes: BodyProbes | None, compiled: dict) -> None:
+    """The contact section of a 3D scene (module docstring); ``probes`` None: a mesh file's body."""
+    contact, sides = data["contact"], data["boundary"]["contact"]
+    if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
+        raise SceneError(
+            f"contact.normal.k = {contact['normal']['k']:g}: must be at most {MAX_NORMAL_K_OVER_E:g} "
+            "material.E (stiffer is rigid contact, beyond double precision); fix the scene",
+            key="contact.normal.k",
+        )
+    s = np.linspace(0.0, 1.0, PROBES + 1)
+    if "foundation" in contact:
+        if "gap" in given_contact:
+            raise SceneError(
+                "contact: give either gap or foundation, not both (the foundation plane defines the gap)",
+                key="contact.foundation",
+            )
+        _check_plane(contact["foundation"], sides, probes, s)
+        return
+    gap = compiled["contact.gap"] = compile_checked("contact.gap", contact["gap"], DIMENSION)
+    for side in sides if probes is not None else ():
+        points = probes.side(side, s)
+        values = np.broadcast_to(evaluate_checked(gap, points), points[0].shape)
+        if not values.min() >= 0:
+            i = int(np.argmin(np.where(np.isnan(values), -np.inf, values)))
+            raise SceneError(
+                f"contact.gap = {contact['gap']!r}: is {values[i]:.6g} < 0 at x={points[0][i]:.6g}, "
+                f"y={points[1][i]:.6g}, z={points[2][i]:.6g} on {side} (the initial gap g_a must be "
+                ">= 0); fix the scene",
+                key="contact.gap",
+            )
+
+
+def _check_plane(foundation: dict, sides, probes, s) -> None:
+    for key in ("point", "normal"):
+        if len(foundation[key]) != DIMENSION:
+            raise SceneError(
+                f"contact.foundation.{key} has {len(foundation[key])} components; a 3D scene's "
+                "foundation is a plane: give 3",
+                key=f"contact.foundation.{key}",
+            )
+    normal = np.asarray(foundation["normal"], dtype=float)
+    if not np.linalg.norm(normal) > 0:
+        raise SceneError(
+            "contact.foundation.normal = [0, 0, 0]: give the plane's normal pointing towards the "
+            "body, e.g. [0, 0, 1] for a floor",
+            key="contact.foundation.normal",
+        )
+    point = np.asarray(foundation["point"], dtype=float)
+    for side in sides if probes is not None else ():
+        x = np.stack(probes.side(side, s), axis=1)
+        distance = (x - point) @ normal / np.linalg.norm(normal)
+        if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
+            i = int(np.argmin(distance))
+            raise SceneError(
+                f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation plane at "
+                f"x={x[i, 0]:.6g}, y={x[i, 1]:.6g}, z={x[i, 2]:.6g} (the body starts out penetrating "
+                "it); move contact.foundation.point or flip contact.foundation.normal",
+                key="contact.foundation",
+            )

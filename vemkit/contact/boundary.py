@@ -6,10 +6,18 @@ trace nodes with the element's nodal rule -- the trapezoid at the Gamma_C vertic
 the length of each adjacent contact edge as weight), Simpson's rule at the vertices and edge
 midpoints for k = 2. The outward normal of a vertex is the length-weighted mean of the outward
 normals of its contact edges (exact on straight parts), that of a midpoint its edge's normal; the
-tangent is tau = (-nu_2, nu_1) (on the bottom edge nu = (0, -1), tau = (1, 0)). Points with a
-Dirichlet condition (clamped, or a prescribed component) are dropped: they belong to the closure of
-Gamma_D, and their displacement is given. ``ContactBoundary.vertices`` holds node numbers of the
-space: a mesh vertex v, or n_vertices + e for the midpoint of edge e (k = 2).
+tangent is tau = (-nu_2, nu_1) (on the bottom edge nu = (0, -1), tau = (1, 0)). Clamped points and
+points with every component prescribed are dropped: they belong to the closure of Gamma_D, and their
+displacement is given. A point with only some components prescribed (a symmetry roller meeting
+Gamma_C) stays (nodal rule): its prescribed components are fixed dofs (``vemkit.vem.dofs``: decoupled
+rows K_ii u_i = K_ii g_i, so u_i = g_i is what the law reads), no contact force or Jacobian entry goes
+into their rows (the constraint's reaction takes it), and the free components carry the law. With
+the ``gauss`` rule such a point is still dropped (its edge end keeps its prescribed displacement).
+``ContactBoundary.vertices`` holds node numbers of the space: a mesh vertex v, or n_vertices + e for the
+midpoint of edge e (k = 2). One class for d = 2 and 3: dofs, normals and coordinates are (n_c, d);
+tangential quantities are (n_c,) in 2D and (n_c, 2) in 3D (components along ``tangent`` = t1 and
+``tangent2`` = t2, ``vemkit.contact.boundary3d``), the friction multiplier a scalar in [-1, 1] or a
+vector in the unit disk (``project``, ``direction``, ``magnitude``).
 
 ``gauss`` quadrature (``contact_gauss_points`` N per edge; for an element with linear traces, k = 1):
 the normal-compliance term of (3.16),
@@ -38,6 +46,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.contact.gaps import FoundationLine, _edge_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
 from vemkit.contact.trace_nodes import contact_edges, midpoint_edges, rule_weights
 from vemkit.exceptions import InputError, SceneError
 from vemkit.mesh.mesh import Mesh, edge_indices
@@ -58,12 +67,16 @@ def gauss_rule(points: int):
 
 
 def rank_one_blocks(cb, values, left, n, right=None):
-    """Sparse sum_c values_c left_c right_c^T on the contact dofs (right = left if not given)."""
+    """Sparse sum_c values_c left_c right_c^T on the contact dofs (right = left if not given), d x d
+    blocks; the rows and columns of prescribed components (``cb.fixed``) are left out."""
     right = left if right is None else right
-    rows = np.stack([cb.dofs[:, 0], cb.dofs[:, 0], cb.dofs[:, 1], cb.dofs[:, 1]], axis=1).ravel()
-    cols = np.stack([cb.dofs[:, 0], cb.dofs[:, 1], cb.dofs[:, 0], cb.dofs[:, 1]], axis=1).ravel()
-    a0, a1, b0, b1 = left[:, 0], left[:, 1], right[:, 0], right[:, 1]
-    vals = (values[:, None] * np.stack([a0 * b0, a0 * b1, a1 * b0, a1 * b1], axis=1)).ravel()
+    d = cb.dofs.shape[1]
+    if cb.fixed is not None:
+        left, right = np.where(cb.fixed, 0.0, left), np.where(cb.fixed, 0.0, right)
+    pairs = [(i, j) for i in range(d) for j in range(d)]
+    rows = np.stack([cb.dofs[:, i] for i, _ in pairs], axis=1).ravel()
+    cols = np.stack([cb.dofs[:, j] for _, j in pairs], axis=1).ravel()
+    vals = (values[:, None] * np.stack([left[:, i] * right[:, j] for i, j in pairs], axis=1)).ravel()
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
@@ -87,6 +100,11 @@ class ContactBoundary:
     gauss_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) summing to 1
     # (n_e, 2) prescribed u . nu_e at dropped (Dirichlet) edge ends, 0 at contact vertices
     edge_prescribed: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    # 3D: (n_c, 3) the second tangent t2 = nu x t1 (``tangent`` holds t1); (0, 2) in 2D
+    tangent2: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    # (n_c, d) bool: components with Dirichlet data (a roller meeting Gamma_C); None: none. No contact
+    # force enters their rows (the constraint takes it), and u there is the prescribed value
+    fixed: np.ndarray | None = None
 
     def __post_init__(self):
         if self.quadrature not in QUADRATURES:
@@ -107,20 +125,81 @@ class ContactBoundary:
     def size(self) -> int:
         return self.vertices.size
 
+    @property
+    def dimension(self) -> int:
+        return self.normal.shape[1]
+
+    @property
+    def tangents(self) -> list:
+        """The tangent basis per point: [tau] in 2D, [t1, t2] in 3D."""
+        return [self.tangent] if self.dimension == 2 else [self.tangent, self.tangent2]
+
+    def _along(self, u, direction):
+        """sum_i u[dofs_i] direction_i per contact point."""
+        return sum(u[self.dofs[:, i]] * direction[:, i] for i in range(self.dofs.shape[1]))
+
     def normal_displacement(self, u):
         """u_nu at the contact vertices from the free-dof vector u."""
-        return u[self.dofs[:, 0]] * self.normal[:, 0] + u[self.dofs[:, 1]] * self.normal[:, 1]
+        return self._along(u, self.normal)
 
     def tangential_displacement(self, u):
-        """u_tau (a scalar in 2D) at the contact vertices."""
-        return u[self.dofs[:, 0]] * self.tangent[:, 0] + u[self.dofs[:, 1]] * self.tangent[:, 1]
+        """u_tau at the contact vertices: a scalar in 2D, (n_c, 2) in the basis (t1, t2) in 3D."""
+        if self.dimension == 2:
+            return self._along(u, self.tangent)
+        return np.stack([self._along(u, t) for t in self.tangents], axis=1)
 
     def scatter(self, normal_part, tangential_part, n_dofs):
-        """Free-dof vector of sum_c (normal_part_c nu_c + tangential_part_c tau_c)."""
+        """Free-dof vector of sum_c (normal_part_c nu_c + tangential_part_c . (t1, t2)_c); nothing
+        into the prescribed components."""
         out = np.zeros(n_dofs)
-        np.add.at(out, self.dofs[:, 0], normal_part * self.normal[:, 0] + tangential_part * self.tangent[:, 0])
-        np.add.at(out, self.dofs[:, 1], normal_part * self.normal[:, 1] + tangential_part * self.tangent[:, 1])
+        tangential_part = np.asarray(tangential_part, dtype=float)
+        for i in range(self.dofs.shape[1]):
+            if self.dimension == 2:
+                value = normal_part * self.normal[:, i] + tangential_part * self.tangent[:, i]
+            else:
+                value = (
+                    normal_part * self.normal[:, i]
+                    + tangential_part[:, 0] * self.tangent[:, i]
+                    + tangential_part[:, 1] * self.tangent2[:, i]
+                )
+            if self.fixed is not None:
+                value = np.where(self.fixed[:, i], 0.0, value)
+            np.add.at(out, self.dofs[:, i], value)
         return out
+
+    # -- the friction multiplier: a scalar in [-1, 1] (2D), a vector in the unit disk (3D) ------------
+    def zero_multiplier(self) -> np.ndarray:
+        return np.zeros(self.size) if self.dimension == 2 else np.zeros((self.size, 2))
+
+    def project(self, lam) -> np.ndarray:
+        """P: the projection onto [-1, 1] (2D) or onto the unit disk (3D), point by point (5.5)."""
+        lam = np.asarray(lam, dtype=float)
+        if self.dimension == 2:
+            return np.clip(lam, -1.0, 1.0)
+        return lam / np.maximum(np.linalg.norm(lam, axis=1), 1.0)[:, None]
+
+    def magnitude(self, tangential) -> np.ndarray:
+        """|x| of tangential quantities: abs in 2D, the Euclidean norm of the two components in 3D."""
+        tangential = np.asarray(tangential, dtype=float)
+        return np.abs(tangential) if self.dimension == 2 else np.linalg.norm(tangential, axis=1)
+
+    def direction(self, tangential) -> np.ndarray:
+        """x / |x| (0 where x = 0): sign in 2D, the unit vector in the tangent plane in 3D."""
+        tangential = np.asarray(tangential, dtype=float)
+        if self.dimension == 2:
+            return np.sign(tangential)
+        size = np.linalg.norm(tangential, axis=1)
+        return np.where(size[:, None] > 0.0, tangential / np.where(size > 0.0, size, 1.0)[:, None], 0.0)
+
+    def dot(self, a, b) -> np.ndarray:
+        """a_c . b_c of two tangential quantities (a product in 2D)."""
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        return a * b if self.dimension == 2 else np.sum(a * b, axis=1)
+
+    def times(self, scalar, tangential) -> np.ndarray:
+        """scalar_c x_c for tangential quantities x (broadcast over the 3D components)."""
+        tangential = np.asarray(tangential, dtype=float)
+        return scalar * tangential if tangential.ndim == 1 else np.asarray(scalar)[:, None] * tangential
 
     def with_gap(self, gap) -> "ContactBoundary":
         """This boundary with another gap, gap(x, y) -> array or a FoundationLine (at the vertices and
@@ -132,7 +211,7 @@ class ContactBoundary:
     def contact_force(self, u, law, multiplier):
         """Free-dof vector of the contact forces: the normal-compliance term plus the nodal friction term."""
         penetration = self.normal_displacement(u) - self.gap
-        tangential = self.weight * law.friction_bound(penetration) * np.asarray(multiplier, dtype=float)
+        tangential = self.times(self.weight * law.friction_bound(penetration), multiplier)
         if self.quadrature == "nodal":
             return self.scatter(self.weight * law.normal_pressure(penetration), tangential, u.size)
         return self.normal_force(u, law) + self.scatter(np.zeros(self.size), tangential, u.size)
@@ -141,7 +220,7 @@ class ContactBoundary:
         """Free-dof vector of int p_nu(u_nu - g) phi_i nu ds (the normal-compliance term of (3.16))."""
         if self.quadrature == "nodal":
             t = self.normal_displacement(u) - self.gap
-            return self.scatter(self.weight * law.normal_pressure(t), np.zeros(self.size), u.size)
+            return self.scatter(self.weight * law.normal_pressure(t), self.zero_multiplier(), u.size)
         t = self._gauss_penetration(u)
         end_force = (self._gauss_weight() * law.normal_pressure(t)) @ self._shape()  # (n_e, 2)
         values = end_force[:, :, None] * self.edge_normal[:, None, :]  # (n_e, end, component)
@@ -199,56 +278,6 @@ class ContactBoundary:
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
 
-class FoundationLine:
-    """The foundation as a line (SPEC §7 ``contact.foundation``): the gap of a boundary point x with
-    outward normal nu is the distance from x along nu to the line, d / cos with d = (x - point) . n
-    (n the unit normal of the line towards the body) and cos = -nu . n; a surface turned away from
-    the line (cos below MIN_FACING) gets d / MIN_FACING, far enough never to touch."""
-
-    MIN_FACING = 1e-2
-
-    def __init__(self, point, normal):
-        self.point = np.asarray(point, dtype=float)
-        self.normal = np.asarray(normal, dtype=float) / np.hypot(*normal)
-
-    def along(self, coords: np.ndarray, normals: np.ndarray) -> np.ndarray:
-        distance = (coords - self.point) @ self.normal
-        facing = np.maximum(-(normals @ self.normal), self.MIN_FACING)
-        return distance / facing
-
-
-def _gap_values(gap, coords, normals, check=True):
-    if isinstance(gap, FoundationLine):
-        g = gap.along(coords, normals)
-    else:
-        g = np.broadcast_to(np.asarray(gap(coords[:, 0], coords[:, 1]), dtype=float), (coords.shape[0],)).copy()
-    if not np.all(np.isfinite(g)) or (check and np.any(g < 0)):
-        bad = int(np.flatnonzero(~np.isfinite(g) | (g < 0))[0])
-        where = f"{g[bad]:.6g} at x={coords[bad, 0]:.6g}, y={coords[bad, 1]:.6g}"
-        if isinstance(gap, FoundationLine):
-            raise SceneError(
-                f"contact.foundation: the contact side is beyond the foundation line (gap {where}: the body "
-                "starts out penetrating it); move contact.foundation.point or flip its normal",
-                key="contact.foundation",
-            )
-        raise SceneError(
-            f"contact.gap must be finite and >= 0 at every contact vertex (2.11): it is {where}", key="contact.gap"
-        )
-    return g
-
-
-def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap, edge_normal):
-    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at dropped ends (with
-    the edge's normal)."""
-    ends = np.zeros(edge_vertex.shape)
-    free = edge_vertex >= 0
-    ends[free] = vertex_gap[edge_vertex[free]]
-    if np.any(~free):
-        normals = np.broadcast_to(edge_normal[:, None, :], edge_coords.shape)
-        ends[~free] = _gap_values(gap, edge_coords[~free], normals[~free], check=False)
-    return ends
-
-
 def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
     """(|e|, |e| nu_e, vertex weights, vertex normal sums) of the contact ``edges`` (a, b), nu_e the
     outward normal (CCW boundary): each end of an edge gets ``end_weight`` |e| (trapezoid 1/2,
@@ -267,7 +296,7 @@ def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
 def check_quadrature(space, quadrature: str) -> None:
     """SceneError unless the quadrature suits the element: ``gauss`` needs linear traces (k = 1)."""
     if space.element.dimension != 2:
-        return  # no contact on 3D bodies yet (``_without_contact``)
+        return  # 3D: ``vemkit.contact.boundary3d`` (nodal only)
     if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
         raise SceneError(
             f"discretization.contact_quadrature = {quadrature!r} is not available with "
@@ -277,11 +306,27 @@ def check_quadrature(space, quadrature: str) -> None:
         )
 
 
-def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float):
+def contact_nodes(dofs, nodes, keep_partial: bool = True) -> np.ndarray:
+    """The ``nodes`` that are contact points: they carry unknowns and (``keep_partial``) at least one
+    component without Dirichlet data -- a roller meeting Gamma_C stays, its free components in the
+    law (issue 21); without ``keep_partial`` (the gauss rule) only nodes without any Dirichlet data."""
+    if not keep_partial:
+        return nodes[dofs.unconstrained_nodes()[nodes]]
+    d = dofs.dimension
+    count = np.bincount(dofs.free_nodes[dofs.fixed_dofs // d], minlength=dofs.n_nodes)
+    return nodes[(dofs.free_index[nodes] >= 0) & (count[nodes] < d)]
+
+
+def fixed_components(dofs, point_dofs: np.ndarray) -> np.ndarray | None:
+    """(n_c, d) bool: the contact dofs that are fixed dofs (a prescribed component); None if none."""
+    fixed = np.isin(point_dofs, dofs.fixed_dofs)
+    return fixed if fixed.any() else None
+
+
+def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float, keep_partial: bool):
     """(vertices, weights, normals, edge data) of the Gamma_C vertices that are contact points."""
     length, weighted_normal, weight, nsum = edge_ends(mesh, edges, end_weight)
-    verts = np.unique(edges)
-    verts = verts[dofs.unconstrained_nodes()[verts]]
+    verts = contact_nodes(dofs, np.unique(edges), keep_partial)
     normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)
     return verts, weight[verts], normal, (length, weighted_normal)
 
@@ -301,12 +346,14 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     must already carry the change of variables of the midpoints (``trace_nodes.midpoint_change``).
     gap(x, y) -> array, or a FoundationLine."""
     if space.element.dimension != 2:
-        return _without_contact(space, parts)
+        from vemkit.contact.boundary3d import contact_boundary_3d
+
+        return contact_boundary_3d(space, parts, dofs, gap, quadrature)
     check_quadrature(space, quadrature)
     mesh = space.mesh
     edges = contact_edges(mesh, parts)
     w_end, w_mid = rule_weights(space.element)
-    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end)
+    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end, quadrature == "nodal")
     coords = mesh.vertices[verts]
     if w_mid is not None:
         mid, mid_w, mid_normal, mid_coords = _midpoints(space, parts, edges, dofs, length, weighted_normal, w_mid)
@@ -316,21 +363,12 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
     free = dofs.free_index[verts]
     g = _gap_values(gap, coords, normal)
+    point_dofs = np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2)
+    fixed = fixed_components(dofs, point_dofs)
     if w_mid is not None:  # the Gauss option needs linear traces: no edge data
-        return ContactBoundary(
-            verts,
-            np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2),
-            weight,
-            normal,
-            tangent,
-            g,
-            coords,
-            quadrature,
-        )
+        return ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed)
     return _with_edges(
-        ContactBoundary(
-            verts, np.stack([2 * free, 2 * free + 1], axis=1), weight, normal, tangent, g, coords, quadrature
-        ),
+        ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed),
         mesh,
         edges,
         dofs,
@@ -338,22 +376,6 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
         length,
         weighted_normal,
         gauss_points,
-    )
-
-
-def _without_contact(space, parts) -> ContactBoundary:
-    """The empty contact boundary of a 3D body (its d-component arrays); contact on polyhedral meshes
-    is not implemented, so a Gamma_C there is a SceneError."""
-    if len(parts):
-        raise SceneError(
-            f"boundary.contact = {list(parts)}: contact on 3D bodies is not available yet; "
-            "drop boundary.contact (and the contact section) for a 3D body",
-            key="boundary.contact",
-        )
-    d = space.element.dimension
-    empty = np.zeros((0, d))
-    return ContactBoundary(
-        np.zeros(0, np.int64), np.zeros((0, d), np.int64), np.zeros(0), empty, empty, np.zeros(0), empty.copy()
     )
 
 

@@ -134,7 +134,7 @@ def discrete_problem(
     neumann=None,
     pressure=None,
     contact=(),
-    gap=lambda x, y: np.zeros_like(x),
+    gap=lambda x, *_: np.zeros_like(x),
     law: ContactLaw | None = None,
     body_force=None,
     stabilization: str = "dofi-2mu",
@@ -167,7 +167,8 @@ def discrete_problem(
         interior = interior_load(space, full_load)
     else:
         f, interior = dofs.restrict(full_load), None
-    dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
+    if space.element.dimension == 2:  # the k = 2 Gamma_C midpoints (3D bodies: k = 1 only)
+        dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
     K, f = change_variables(K, f, dofs.change)
     K, f = apply_fixed_dofs(K, f, dofs)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
@@ -181,7 +182,7 @@ def _scene_gap(scene):
     if scene.foundation is not None:
         return FoundationLine(*scene.foundation)
     gap = scene.gap_expression
-    return gap if gap is not None else (lambda x, y: np.zeros_like(x))
+    return gap if gap is not None else (lambda x, *_: np.zeros_like(x))
 
 
 def scene_problem_data(scene) -> dict:

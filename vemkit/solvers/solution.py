@@ -25,7 +25,7 @@ STATE_NAMES = {SEPARATED: "separated", STICK: "stick", SLIP: "slip"}
 @dataclass
 class ContactSolution:
     u: np.ndarray  # free-dof displacement vector
-    multiplier: np.ndarray  # (n_c,) friction multiplier lambda, |lambda| <= 1
+    multiplier: np.ndarray  # (n_c,) friction multiplier lambda, |lambda| <= 1 (3D: (n_c, 2), in the unit disk)
     iterations: int  # nonlinear iterations (0: the plain linear solve was the solution)
     converged: bool
     method: str  # "uzawa" or "ssn"
@@ -72,7 +72,9 @@ def contact_residual(problem, u, multiplier) -> dict:
 
     equilibrium      ||K u + contact forces - f|| / ||f||  (||f|| + ||contact forces|| if f = 0)
     multiplier_bound max_c (|lambda_c| - 1)_+                      (|sigma_tau| <= p_tau, (2.7))
-    complementarity  max_c |lambda_c u_tau,c - |u_tau,c|| / max|u| (sigma_tau opposes slip, (2.8))
+    complementarity  max_c |lambda_c . u_tau,c - |u_tau,c|| / max|u| (sigma_tau opposes slip, (2.8))
+    (3D: lambda_c and u_tau,c vectors of the tangent plane, |.| the Euclidean norm; with |lambda| <= 1,
+    lambda . u_tau = |u_tau| is lambda = u_tau / |u_tau| wherever u_tau != 0)
     max of the three under ``worst``; non-finite input gives inf everywhere.
     """
     u = np.asarray(u, dtype=float)
@@ -87,8 +89,8 @@ def contact_residual(problem, u, multiplier) -> dict:
     if cb.size:
         slip = cb.tangential_displacement(u)
         umax = float(np.max(np.abs(u))) if u.size else 0.0
-        bound = float(np.max(np.maximum(np.abs(lam) - 1.0, 0.0)))
-        compl = float(np.max(np.abs(lam * slip - np.abs(slip)))) / (umax if umax > 0.0 else 1.0)
+        bound = float(np.max(np.maximum(cb.magnitude(lam) - 1.0, 0.0)))
+        compl = float(np.max(np.abs(cb.dot(lam, slip) - cb.magnitude(slip)))) / (umax if umax > 0.0 else 1.0)
     else:
         bound = compl = 0.0
     return {
@@ -127,11 +129,11 @@ def contact_state(problem, u, multiplier, tol: float = 1e-8) -> ContactState:
     slip = cb.tangential_displacement(u)
     bound = law.friction_bound(penetration)
     scale = float(np.max(np.abs(u))) if u.size else 0.0
-    state = np.where(penetration <= 0.0, SEPARATED, np.where(np.abs(slip) <= tol * scale, STICK, SLIP))
+    state = np.where(penetration <= 0.0, SEPARATED, np.where(cb.magnitude(slip) <= tol * scale, STICK, SLIP))
     return ContactState(
         state.astype(np.int8),
         law.normal_pressure(penetration),
-        -bound * np.asarray(multiplier, dtype=float),
+        cb.times(-bound, multiplier),
         bound,
         slip,
         penetration,

@@ -5,6 +5,9 @@ Unknowns u (free dofs) and the friction multiplier lambda (one per contact verte
     R(u, lambda) = K u + sum_c w_c [p_nu(t_c) nu_c + b_c lambda_c tau_c] - f = 0,  t = u_nu - g, b = p_tau(t)
     C(u, lambda) = lambda - P(lambda + gamma u_tau) = 0,   P: projection onto [-1, 1].
 
+On a 3D body (SPEC §10) lambda and u_tau have two components in the vertex basis (t1, t2), P is the
+projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk.
+
 C = 0 is |lambda| <= 1, lambda u_tau = |u_tau| for any gamma > 0. The choice only steers the active
 sets: gamma_c = GAMMA_FACTOR kd_c / (|Gamma_C| b_ref), kd_c the stiffness diagonal in the tangential
 direction, |Gamma_C| = sum_c w_c, b_ref = k_tau for the reduced law (the largest friction bound of
@@ -74,7 +77,7 @@ from vemkit.solvers.solution import (
     young_modulus,
 )
 from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
-from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis
+from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 GAMMA_FACTOR = 0.5  # gamma = GAMMA_FACTOR kd / (|Gamma_C| b_ref), see the module docstring
@@ -117,6 +120,10 @@ class _Newton:
     def zero(self):
         return np.zeros(self.problem.contact.size)
 
+    @property
+    def zero_tangential(self):
+        return self.problem.contact.zero_multiplier()
+
 
 @dataclass
 class _Point:
@@ -149,10 +156,13 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
         return _plain_solution(newton, u)
     _prepare(newton, t)
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
-    trial = newton.kd_tau * cb.tangential_displacement(u) / (cb.weight * newton.b_ref)
-    point = _evaluate(newton, u, np.clip(trial, -1.0, 1.0))
+    if cb.dimension == 2:
+        trial = newton.kd_tau * cb.tangential_displacement(u) / (cb.weight * newton.b_ref)
+    else:
+        trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), cb.tangential_displacement(u))
+    point = _evaluate(newton, u, cb.project(trial))
     if initial is not None:
-        warm = _evaluate(newton, np.asarray(initial[0], float), np.clip(np.asarray(initial[1], float), -1.0, 1.0))
+        warm = _evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
         newton.info["warm_start"] = bool(warm.theta < point.theta)
         point = warm if warm.theta < point.theta else point
     newton.theta_previous = point.theta
@@ -203,8 +213,8 @@ def _plain_solution(newton, u):
     if base.method == "amg" and INITIAL_TOL > tol:
         u = base.solve(newton.problem.load, x0=u, tol=tol)
         newton.linear_total += base.iterations
-    lam = np.sign(newton.problem.contact.tangential_displacement(u))
-    return _finish(newton, u, lam, 0)
+    cb = newton.problem.contact
+    return _finish(newton, u, cb.direction(cb.tangential_displacement(u)), 0)
 
 
 def _finish(newton, u, lam, iterations):
@@ -228,7 +238,7 @@ def _prepare(newton, t):
     """The scalings of the module docstring at the plain solution (penetration t): gamma, b_ref, caps."""
     problem = newton.problem
     K, cb, law, n = problem.stiffness, problem.contact, problem.law, problem.n_dofs
-    newton.kd_tau = direction_diagonal(K, cb, cb.tangent)
+    newton.kd_tau = tangential_diagonal(K, cb)
     kd_nu = direction_diagonal(K, cb, cb.normal)
     newton.reduced = ReducedSolver(problem, newton.base, newton.baseline)
     # p_nu' is unbounded at 0 only for m_nu < 1: cap it there (a modified Newton step)
@@ -254,15 +264,15 @@ def _evaluate(newton, u, lam) -> _Point:
     slip = cb.tangential_displacement(u)
     Ku = K @ u
     normal_force = cb.normal_force(u, law)
-    friction_force = cb.scatter(zero, cb.weight * law.friction_bound(t) * lam, n)
+    friction_force = cb.scatter(zero, cb.times(cb.weight * law.friction_bound(t), lam), n)
     gradient = Ku + normal_force - f
     R = gradient + friction_force
-    q = lam + newton.gamma * slip
-    C = cb.weight * newton.b_ref * (lam - np.clip(q, -1.0, 1.0))
+    q = lam + cb.times(newton.gamma, slip)
+    C = cb.times(cb.weight * newton.b_ref, lam - cb.project(q))
     scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
-    point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + C @ C), scale)
+    point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
     if newton.energy_merit:
-        friction = law.k_friction * (cb.weight @ np.abs(slip))
+        friction = law.k_friction * (cb.weight @ cb.magnitude(slip))
         point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
     return point
 
@@ -270,6 +280,10 @@ def _evaluate(newton, u, lam) -> _Point:
 def _converged(newton, point) -> bool:
     """Relative residual <= tol, or at the rounding floor of its own evaluation (ill-conditioned cases)."""
     residual = np.sqrt(point.theta) / point.scale
+    if newton.problem.contact.dimension == 3:  # and the slip direction resolved (vemkit.solvers.ssn_disk)
+        from vemkit.solvers.ssn_disk import disk_alignment
+
+        residual = max(residual, disk_alignment(newton, point))
     if residual <= newton.tol:
         return True
     problem = newton.problem
@@ -278,7 +292,7 @@ def _converged(newton, point) -> bool:
     size = (
         abs_matvec(problem.stiffness, np.abs(point.u))
         + np.abs(problem.load)
-        + cb.scatter(stiff, newton.zero, problem.n_dofs)
+        + cb.scatter(stiff, newton.zero_tangential, problem.n_dofs)
     )
     point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
     return residual <= point.floor
@@ -287,7 +301,7 @@ def _converged(newton, point) -> bool:
 def _slope(newton, point, du_tau, du) -> float:
     """Directional derivative of the energy at ``point`` along du (one-sided for |u_tau|)."""
     cb, law = newton.problem.contact, newton.problem.law
-    friction = np.where(point.slip != 0.0, np.sign(point.slip) * du_tau, np.abs(du_tau))
+    friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau), cb.magnitude(du_tau))
     return float(point.gradient @ du + law.k_friction * (cb.weight @ friction))
 
 
@@ -323,7 +337,7 @@ def _newton_iteration(newton, point, k) -> _Point:
     record = {
         "residual": np.sqrt(new.theta) / new.scale,
         "du": float(alpha * np.linalg.norm(du) / max(np.linalg.norm(new.u), np.finfo(float).tiny)),
-        "dlambda": float(np.max(np.abs(new.lam - lam))),
+        "dlambda": float(np.max(cb.magnitude(new.lam - lam))),
         "step": alpha,
         "active_changes": changes,
         "linear_iterations": its,
@@ -339,7 +353,7 @@ def _active_sets(newton, point):
     cb, law = newton.problem.contact, newton.problem.law
     bound = law.friction_bound(point.t)
     frictional = bound > 0.0
-    slip = frictional & (np.abs(point.q) > 1.0)
+    slip = frictional & (cb.magnitude(point.q) > 1.0)
     stick = frictional & ~slip
     state = np.where(point.t > 0.0, 3, 0) + np.where(slip, 1, np.where(stick, 2, 0))
     changes = cb.size if newton.previous_state is None else int(np.sum(state != newton.previous_state))
@@ -353,7 +367,11 @@ def _newton_direction(newton, point, k):
     K, cb, law, n = problem.stiffness, problem.contact, problem.law, problem.n_dofs
     zero = newton.zero
     lam = point.lam
-    bound, frictional, slip, stick, changes = _active_sets(newton, point)
+    bound, frictional, slip, stick, changes = sets = _active_sets(newton, point)
+    if cb.dimension == 3:  # Coulomb in the unit disk (vemkit.solvers.ssn_disk)
+        from vemkit.solvers.ssn_disk import disk_direction
+
+        return disk_direction(newton, point, k, sets, _solve_newton_system)
     sign = np.sign(point.q)
     stick_shift = cb.scatter(zero, np.where(stick, -point.slip, 0.0), n)
     friction_now = cb.scatter(zero, cb.weight * bound * lam, n)

@@ -27,6 +27,12 @@ EXPAND_SLOPE = 0.1  # ... "steeply": the slope at the full step is still this fr
 
 def direction_diagonal(K, cb, direction):
     """d_c^T K_cc d_c at each contact vertex (the stiffness diagonal in direction d)."""
+    if cb.dimension == 3:
+        return sum(
+            direction[:, a] * direction[:, b] * np.asarray(K[cb.dofs[:, a], cb.dofs[:, b]]).ravel()
+            for a in range(3)
+            for b in range(3)
+        )
     i, j = cb.dofs[:, 0], cb.dofs[:, 1]
     Kii = np.asarray(K[i, i]).ravel()
     Kjj = np.asarray(K[j, j]).ravel()
@@ -34,8 +40,16 @@ def direction_diagonal(K, cb, direction):
     return direction[:, 0] ** 2 * Kii + 2 * direction[:, 0] * direction[:, 1] * Kij + direction[:, 1] ** 2 * Kjj
 
 
+def tangential_diagonal(K, cb):
+    """The stiffness diagonal in the tangent plane: along tau (2D), the mean over t1 and t2 (3D)."""
+    return sum(direction_diagonal(K, cb, t) for t in cb.tangents) / len(cb.tangents)
+
+
 def stick_basis(cb, stick, n):
-    """Orthonormal Z (n x (n - |stick|)) spanning {v : tau_c . v_c = 0 for stick c}: v_c = a nu_c there."""
+    """Orthonormal Z (n x (n - (d - 1)|stick|)) spanning {v : t . v_c = 0 for every tangent t of the
+    stick vertices c}: v_c = a nu_c there (the column of the vertex's first dof)."""
+    if cb.dimension == 3:
+        return _stick_basis_3d(cb, stick, n)
     first, second = cb.dofs[stick, 0], cb.dofs[stick, 1]
     keep = np.ones(n, dtype=bool)
     keep[second] = False
@@ -47,6 +61,38 @@ def stick_basis(cb, stick, n):
     cols = np.concatenate([np.arange(vals.size), column[first]])
     vals = np.concatenate([vals, cb.normal[stick, 1]])
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, int(keep.sum())))
+
+
+def _stick_basis_3d(cb, stick, n):
+    first, others = cb.dofs[stick, 0], cb.dofs[stick, 1:]
+    keep = np.ones(n, dtype=bool)
+    keep[others.ravel()] = False
+    column = np.cumsum(keep) - 1
+    rows = np.flatnonzero(keep)
+    vals = np.ones(rows.size)
+    vals[column[first]] = cb.normal[stick, 0]
+    rows = np.concatenate([rows, others.ravel()])
+    cols = np.concatenate([np.arange(vals.size), np.repeat(column[first], 2)])
+    vals = np.concatenate([vals, cb.normal[stick, 1:].ravel()])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, int(keep.sum())))
+
+
+def disk_slip_step(q, lam, gamma):
+    """The Newton step of C = lambda - P(q) at the 3D slip vertices (|q| > 1, q = lambda + gamma u_tau,
+    P the projection on the unit disk): with n = q/|q|, P' = (I - n n^T)/|q|, solving the linearized
+    C = 0 for the new multiplier gives
+
+        lambda_new = n + (I - n n^T)(gamma du_tau - lambda) / (|q| - 1),
+
+    so (returned) lambda_new = base + slope e (e . du_tau): base = n - (e . lambda) e / (|q| - 1),
+    slope = gamma / (|q| - 1), e = the unit vector perpendicular to n in the tangent plane
+    (I - n n^T = e e^T in 2D coordinates). In 2D, I - n n^T = 0: lambda_new = sign(q)."""
+    size = np.linalg.norm(q, axis=1)
+    unit = q / size[:, None]
+    e = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    excess = size - 1.0
+    base = unit - (np.sum(e * lam, axis=1) / excess)[:, None] * e
+    return base, gamma / excess, e
 
 
 class ReducedSolver:

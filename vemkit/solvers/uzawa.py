@@ -7,7 +7,8 @@ Step 1  lambda^0 = 0, u^0 = 0 (or a warm start ``initial = (u^0, lambda^0)``, e.
         new smallest residual also counts as progress for the stagnation test below.
 Step 2  K u^n = f - sum_c w_c [p_nu(t_c^{n-1}) nu_c + p_tau(t_c^{n-1}) lambda_c^{n-1} tau_c],
         t^{n-1} = u_nu^{n-1} - g   (normal compliance and friction bound lagged: explicit in u^{n-1});
-        lambda^n = P(lambda^{n-1} + rho k_tau u_tau^n),  P = projection onto [-1, 1].
+        lambda^n = P(lambda^{n-1} + rho k_tau u_tau^n),  P = projection onto [-1, 1] (3D: onto the unit
+        disk of the tangent plane, lambda and u_tau two components in the vertex basis (t1, t2)).
 Step 3  stop when ||u^n - u^{n-1}|| < eps_u ||u^n||  or  max|lambda^n - lambda^{n-1}| < eps_lambda
         (``stop="either"``, the paper's rule; ``stop="both"`` asks for both). The tests start at n = 2
         (n = 1 compares with the arbitrary initial guess); for a frictionless law lambda is no unknown
@@ -206,9 +207,9 @@ def _start(problem, linear, options, initial=None) -> _Uzawa:
     cb, law = problem.contact, problem.law
     solver = linear_solver(problem.stiffness, linear, near_nullspace=problem.near_nullspace, tol=options["tol"])
     u0, lam0 = (
-        (np.zeros(problem.n_dofs), np.zeros(cb.size))
+        (np.zeros(problem.n_dofs), cb.zero_multiplier())
         if initial is None
-        else (np.asarray(initial[0], float), np.clip(np.asarray(initial[1], float), -1.0, 1.0))
+        else (np.asarray(initial[0], float), cb.project(initial[1]))
     )
     state = _Uzawa(
         problem,
@@ -230,7 +231,7 @@ def _start(problem, linear, options, initial=None) -> _Uzawa:
         and not np.any(rhs - problem.load)
     ):
         state.u = u_first
-        state.lam = np.sign(cb.tangential_displacement(u_first)) if cb.size else state.lam
+        state.lam = cb.direction(cb.tangential_displacement(u_first)) if cb.size else state.lam
         state.info["rho"] = float("nan") if options["rho"] is None else float(options["rho"])
         return state
     if options["rho"] is None and not law.frictionless:
@@ -301,11 +302,11 @@ def _uzawa_iteration(state):
             x0 = _extrapolated_start(u, state.step, rhs - state.previous_rhs, state.previous_rhs_change)
         u_new, lin_its = _solve_step(state, rhs, x0, lin_tol)
     while True:
-        lam_new = np.clip(lam + state.rho * law.k_friction * cb.tangential_displacement(u_new), -1.0, 1.0)
+        lam_new = cb.project(lam + state.rho * law.k_friction * cb.tangential_displacement(u_new))  # (5.5)
         if not (np.all(np.isfinite(u_new)) and np.all(np.isfinite(lam_new))):
             fail(state, "non-finite values", "diverged")
         state.du = _relative_change(u_new, u)
-        dlam = float(np.max(np.abs(lam_new - lam))) if cb.size else 0.0
+        dlam = float(np.max(cb.magnitude(lam_new - lam))) if cb.size else 0.0
         small_u = state.du < options["eps_u"]
         small_lam = dlam < options["eps_lambda"] and not law.frictionless
         both = small_u and (small_lam or law.frictionless)
@@ -378,7 +379,7 @@ def _stop_check(state, stopped_by):
     problem, n = state.problem, state.n
     lam = state.lam
     if problem.law.frictionless:  # lambda carries no force: the one consistent with the slip
-        lam = np.sign(problem.contact.tangential_displacement(state.u))
+        lam = problem.contact.direction(problem.contact.tangential_displacement(state.u))
     check = contact_residual(problem, state.u, lam)
     level = acceptable_residual(problem, state.u, state.forces, state.options["tol"], state.K_abs)
     if check["worst"] <= level:

@@ -32,6 +32,10 @@ R_c . tau_c = -w_c sigma_tau,c:
     stick           (2.9)  where |R_c . tau_c| < w_c p_tau - tol F: |u_tau| / max|u|
 
 F = ||f|| (||f|| + ||contact forces|| without load), the scale of ``contact_residual``.
+In 3D (SPEC §10) R_c . tau_c, u_tau and sign(u_tau) are vectors of the tangent plane in the vertex
+basis (t1, t2): |.| is their norm, sign(u_tau) = u_tau / |u_tau| (the slip direction, which the
+tangential force R_c . tau_c = w_c p_tau lambda_c must follow). The prescribed components of a
+contact vertex (a roller meeting Gamma_C) are left out of R_c: the constraint takes their force.
 """
 
 from __future__ import annotations
@@ -110,20 +114,27 @@ def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL) -> d
         f = problem.load
         # the reaction left for friction: f - K u - (normal-compliance force, nodal or gauss)
         reaction = f - problem.stiffness @ u - cb.normal_force(u, law)
-        r = reaction[cb.dofs]  # (n_c, 2)
+        r = reaction[cb.dofs]  # (n_c, d)
+        if cb.fixed is not None:  # a prescribed component's reaction is the constraint's
+            r = np.where(cb.fixed, 0.0, r)
         r_nu = np.sum(r * cb.normal, axis=1)
-        r_tau = np.sum(r * cb.tangent, axis=1)
+        r_tau = (
+            np.sum(r * cb.tangent, axis=1)
+            if cb.dimension == 2
+            else np.stack([np.sum(r * t, axis=1) for t in cb.tangents], axis=1)
+        )
         scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(contact_force_vector(problem, u, lam))))
         t = cb.normal_displacement(u) - cb.gap
         slip = cb.tangential_displacement(u)
         bound = cb.weight * law.friction_bound(t)
         umax = float(np.max(np.abs(u))) or 1.0
-        slipping = (np.abs(slip) > tol * umax) & (bound > 0.0)
-        inside = np.abs(r_tau) < bound - tol * scale
+        slipping = (cb.magnitude(slip) > tol * umax) & (bound > 0.0)
+        inside = cb.magnitude(r_tau) < bound - tol * scale
         out["normal_law"] = float(np.max(np.abs(r_nu))) / scale
-        out["friction_bound"] = float(np.max(np.maximum(np.abs(r_tau) - bound, 0.0))) / scale
-        out["slip_direction"] = float(np.max(np.abs(r_tau - bound * np.sign(slip))[slipping], initial=0.0)) / scale
-        out["stick"] = float(np.max(np.abs(slip[inside]), initial=0.0)) / umax
+        out["friction_bound"] = float(np.max(np.maximum(cb.magnitude(r_tau) - bound, 0.0))) / scale
+        slide = cb.magnitude(r_tau - cb.times(bound, cb.direction(slip)))
+        out["slip_direction"] = float(np.max(slide[slipping], initial=0.0)) / scale
+        out["stick"] = float(np.max(cb.magnitude(slip)[inside], initial=0.0)) / umax
     out["worst"] = max(out[k] for k in CHECK_KEYS)
     out["passed"] = bool(out["worst"] <= tol)
     return out

@@ -1,0 +1,90 @@
+"""The semismooth Newton step of vemkit.solvers.ssn on a 3D body: Coulomb friction in the unit disk.
+
+The complementarity function is that of 2D, C = lambda - P(q), q = lambda + gamma u_tau, with P the
+projection onto the unit disk of the tangent plane (lambda, u_tau: two components in the vertex
+basis (t1, t2), ``vemkit.contact.boundary3d``); the contact problem (5.2)-(5.3) with the reduced law
+(m_tau = 0 or k_tau = 0, the friction bound b = p_tau independent of u; for m_tau > 0 the Jacobian
+also holds w p_tau'(t) (t1, t2) lambda_hat nu^T, lambda_hat the new multiplier's part that does not
+depend on du, and is unsymmetric, as in 2D). Generalized Newton on
+C = 0 with the derivative P'(q) = 0 (stick, |q| <= 1) or (I - n n^T)/|q| (slip, n = q/|q|):
+
+- stick A = {|q| <= 1}: u_tau,new = 0 (both tangents; eliminated by Z, v_c = a nu_c), the stick
+  multiplier from the tangential equilibrium, as in 2D;
+- slip S = {|q| > 1}: lambda_new = base + slope e (e . du_tau) (``ssn_steps.disk_slip_step``), so the
+  friction force w b (t1, t2) lambda_new adds the symmetric PSD rank-one Jacobian
+  w b slope (e1 t1 + e2 t2)(e1 t1 + e2 t2)^T per slip vertex: the Newton system Z^T (K + J) Z stays
+  SPD (CG with AMG, or direct). This is the semismooth Newton method of the primal-dual active set
+  family for 3D Coulomb (Hueber, Stadler, Wohlmuth, SIAM J. Sci. Comput. 30, 2008), here on the
+  projection form of the complementarity function; in 2D, I - n n^T = 0 and it is the 2D step.
+
+A stick vertex with a prescribed component (a symmetry roller meeting Gamma_C) keeps it exactly when
+that component is orthogonal to nu (a symmetry plane crosses Gamma_C at right angles: the extruded
+body's end faces, a quarter model's planes), since the column nu_c of Z has no entry there; otherwise
+the step moves it and only the converged residual (which holds its row) restores it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vemkit.contact.boundary import rank_one_blocks
+from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis
+
+STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
+
+
+def disk_direction(newton, point, k, sets, solve):
+    """(du, lambda_new, linear iterations, active-set changes) of the 3D Newton step at ``point``;
+    ``sets``: ssn._active_sets at the point, ``solve``: ssn._solve_newton_system."""
+    problem = newton.problem
+    K, cb, law, n = problem.stiffness, problem.contact, problem.law, problem.n_dofs
+    zero, lam = newton.zero, point.lam
+    bound, frictional, slip, stick, changes = sets
+    base, slope, e = disk_slip_step(point.q[slip], lam[slip], newton.gamma[slip])
+    slip_base = np.zeros_like(lam)
+    slip_base[slip] = base
+    e_full = np.zeros_like(lam)
+    e_full[slip] = e
+    direction = cb.tangent * e_full[:, :1] + cb.tangent2 * e_full[:, 1:]  # e in space, (n_c, 3)
+    coefficient = np.zeros(cb.size)
+    coefficient[slip] = cb.weight[slip] * bound[slip] * slope
+    stick_shift = cb.scatter(zero, np.where(stick[:, None], -point.slip, 0.0), n)
+    friction_now = cb.scatter(zero, cb.times(cb.weight * bound, lam), n)
+    slip_force = cb.scatter(zero, cb.times(cb.weight * bound, slip_base), n)
+    Z = stick_basis(cb, np.flatnonzero(stick), n) if np.any(stick) else None
+
+    def penalty():  # for a rebuilt AMG hierarchy: stick tangents nearly clamped
+        weight = np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0)
+        return rank_one_blocks(cb, weight, cb.tangent, n) + rank_one_blocks(cb, weight, cb.tangent2, n)
+
+    A = K + cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n)
+    if not law.reduced:  # the friction bound's derivative w p_tau'(t) (t1, t2) lambda_hat nu^T (unsymmetric)
+        lam_hat = np.where(slip[:, None], slip_base, np.where(stick[:, None], lam, 0.0))
+        along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
+        A = A + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
+    A = A.tocsr()
+    rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
+    correction, its = solve(newton, point, k, A, Z, rhs, penalty)
+    du = stick_shift + correction
+    du_tau = cb.tangential_displacement(du)
+    lam_new = lam.copy()
+    lam_new[slip] = base + (slope * np.sum(e * du_tau[slip], axis=1))[:, None] * e
+    stick_force = cb.tangential_displacement(rhs - A @ correction)
+    lam_new[stick] = stick_force[stick] / (cb.weight[stick] * bound[stick])[:, None]
+    slip_new = point.slip + du_tau
+    moving = ~frictional & (cb.magnitude(slip_new) > 0.0)
+    lam_new[moving] = cb.direction(slip_new[moving])
+    return du, lam_new, its, changes
+
+
+def disk_alignment(newton, point) -> float:
+    """||w b_ref (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, u_tau != 0).
+
+    Part of the convergence test in 3D: there C = lambda - P(q) measures the direction of lambda only
+    through q = lambda + gamma u_tau, i.e. damped by gamma |u_tau| / (1 + gamma |u_tau|), which is tiny
+    at a vertex that barely slides (measured: C ~ 1e-3 x the direction error on a Voronoi box); the
+    slip direction (2.8) itself is asked for to tol, as the independent check does."""
+    cb = newton.problem.contact
+    sliding = (cb.magnitude(point.q) > 1.0) & (cb.magnitude(point.slip) > 0.0)
+    miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
+    return float(np.linalg.norm(cb.weight[sliding] * newton.b_ref * miss)) / point.scale
