@@ -258,11 +258,21 @@ def _branch_names(branches) -> str:
     return " or ".join(names)
 
 
+def _took_branch(value, branch: dict) -> bool:
+    """Whether a mapping has every key a oneOf branch requires (and no key it does not know)."""
+    branch = _resolve(branch)
+    if not isinstance(value, dict) or "properties" not in branch:
+        return False
+    return set(branch.get("required", ())) <= set(value) and set(value) <= set(branch["properties"])
+
+
 def _schema_error_message(error, fix=_scene_fix) -> str:
     path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
     key, value = _key(path), error.instance
     if keyword == "oneOf":  # the value took one branch when the problem lies inside it: report that
         deeper = [e for e in error.context or () if len(e.absolute_path) > len(path)]
+        taken = [e for e in deeper if _took_branch(value, error.validator_value[e.relative_schema_path[0]])]
+        deeper = taken or deeper  # a mapping with a branch's required keys took that branch (domain: polygon, box)
         if deeper:
             return _schema_error_message(jsonschema.exceptions.best_match(deeper), fix)
         title = f" ({schema['title']})" if "title" in schema else ""
