@@ -40,7 +40,6 @@ from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.geometry import counter_clockwise
-from vemkit.mesh.gmsh_errors import gmsh_read_error, meshio_warnings
 from vemkit.mesh.mesh import Mesh
 
 TOPOLOGY = "mesh2d"

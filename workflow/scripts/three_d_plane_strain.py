@@ -34,9 +34,9 @@ with logged(smk):
     text = (
         "# Extruded paper body against 2D plane strain\n\n"
         "max_difference: max |u_3D - u_2D| (u1, u2, every vertex of every layer) / max |u_2D|. SPEC §10 asks "
-        "for equality; it holds on prisms over triangles only: the 3D dofi-dofi scaling alpha_K = 2 mu h_K "
-        "(k1_3d_kernel.element_stiffness) is not the (d/2) 2 mu that plane strain needs on a prism of depth d "
-        "(tests/vem3d/test_plane_models.py).\n\n"
+        "for equality: the 3D consistency and stabilization of a right prism of height t are t times the 2D "
+        "ones for z-independent fields (the stabilization length t / 2, k1_3d.stabilization_lengths; "
+        "tests/vem3d/test_plane_models.py).\n\n"
         + markdown_table(
             records,
             ["family", "n", "layers", "cells_3d", "dofs_3d", "max_difference", "rms_difference"],

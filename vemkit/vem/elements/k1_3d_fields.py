@@ -25,7 +25,6 @@ from vemkit.vem.elements.k1_3d_fields_kernel import (
     projected_fields,
     projection_table,
 )
-
 from vemkit.vem.projection import strain_of
 
 QUADRATURE_CHUNK = 2**22  # points of the body force's fan rule evaluated at a time (~0.2 GiB of work arrays)

@@ -244,7 +244,7 @@ def face_trace_scatter(vertices, face_offsets, face_vertices, faces, points_per_
             e = vertices[face_vertices[lo + (i + 1) % m]] - vertices[face_vertices[lo + (i - 1 + m) % m]]
             g0, g1, g2 = cross(e[0], e[1], e[2], n[0], n[1], n[2])
             grad[i, 0], grad[i, 1], grad[i, 2] = g0 / (2 * area), g1 / (2 * area), g2 / (2 * area)
-        for s in range(m * points_per_face_vertex):
+        for _point in range(m * points_per_face_vertex):
             for i in range(m):
                 phi = 1.0 / m + (
                     (x[k, 0] - xb[0]) * grad[i, 0] + (x[k, 1] - xb[1]) * grad[i, 1] + (x[k, 2] - xb[2]) * grad[i, 2]
