@@ -147,5 +147,5 @@ DOCS_SHOTS ?= docs/_build/screenshots
 chromium:
 	@bash docs/tools/install_chromium.sh
 
-docs-check: chromium
+docs-check: docs chromium
 	$(PYTHON) docs/tools/docs_check.py $(DOCS_HTML) --out $(DOCS_SHOTS)
