@@ -74,7 +74,7 @@ with logged(smk):
             ],
             formats={k: ".2f" for k in ("rate_h1", "rate_l2", "rate_h1_dofs", "rate_l2_dofs")},
         )
-        + "\nOrders between the two finest levels:\n\n"
+        + "\nOrders between the two finest levels, in the mean cell size (cells^(-1/3)):\n\n"
         + markdown_table(summary, ["case", "order_h1", "order_l2"], formats={"order_h1": ".2f", "order_l2": ".2f"})
     )
     open(smk.output.md, "w", encoding="utf-8").write(text)
