@@ -408,3 +408,17 @@ def test_a_broken_body_is_refused_in_one_line(domain, says):
     with pytest.raises(InputError) as caught:
         scene_from_dict(data)
     assert says in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_a_scene_with_a_foundation_reads_back_and_takes_overrides():
+    """contact.foundation defines the gap: no default gap is filled in beside it, so the scene's own
+    YAML (stored in every solution file) and with_overrides give the same scene again."""
+    from pathlib import Path
+
+    from vemkit.config.scene import load_scene, scene_from_yaml
+
+    hertz = load_scene(Path(__file__).resolve().parents[2] / "config" / "scenes" / "hertz.yaml")
+    assert "gap" not in hertz.data["contact"] and hertz.foundation is not None
+    assert scene_from_yaml(hertz.to_yaml()) == hertz
+    coarse = hertz.with_overrides(["discretization.mesh.h=0.2"])
+    assert coarse.mesh_options["h"] == 0.2 and coarse.foundation == hertz.foundation

@@ -572,6 +572,9 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
         _apply_override(data, override)
     _validate(data)
     normalized = _normalized(data, _schema())
+    contact = normalized.get("contact")
+    if contact and "foundation" in contact and "gap" not in data.get("contact", {}):
+        del contact["gap"]  # the foundation defines the gap: no default beside it (the scene reads back)
     expressions = _semantic_checks(normalized, data)
     return Scene(normalized, expressions, source)
 
