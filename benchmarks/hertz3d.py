@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/hertz3d.py [--quick] [--mindlin]
 
 The lower half of a sphere of radius R = 1 centred at the origin, and of that the quarter x >= 0,
-z >= 0 (config/scenes/3d/hertz_sphere.yaml): symmetry rollers u1 = 0 on x = 0 (``sym_x``) and
+z >= 0 (benchmarks/hertz_sphere.yaml): symmetry rollers u1 = 0 on x = 0 (``sym_x``) and
 u3 = 0 on z = 0 (``sym_z``); the flat cut y = 0 (``top``) is moved down by delta = 0.01 as a
 frictionless platen (u2 = -delta, u1, u3 free); the curved surface (``sphere``) is Gamma_C, on the
 foundation plane y = -R. E = 1, nu = 0.3, normal compliance p = k t (m = 1), frictionless.
@@ -47,7 +47,7 @@ import yaml
 from _common import MACHINE, quick_parser, write_report
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENE = ROOT / "config" / "scenes" / "3d" / "hertz_sphere.yaml"
+SCENE = Path(__file__).resolve().parent / "hertz_sphere.yaml"  # its mesh file is made by sphere_msh()
 R, E, NU = 1.0, 1.0, 0.3
 E_STAR = E / (1 - NU**2)
 A_REF = 0.1  # about the contact radius at delta = 0.01: the refined zone is 1.5 a_ref around the point
