@@ -57,16 +57,17 @@ def rigid_modes(basis):
     return modes
 
 
-def linear_solve(stiffness, load, fixed, basis, p):
-    """spsolve, or pyamg SA-preconditioned CG on the condensed system."""
+def linear_solve(stiffness, load, fixed, modes, p, maxiter=1000):
+    """spsolve, or pyamg SA-preconditioned CG on the condensed system (``modes``: the rigid-body
+    modes in the basis' dof numbering, the near-nullspace; also the 3D peer's, skfem3d_solve.py)."""
     if p["solver"] == "direct":
         return skfem.solve(*skfem.condense(stiffness, load, D=fixed))
     import pyamg
     from scipy.sparse.linalg import cg
 
     A, b, x, interior = skfem.condense(stiffness, load, D=fixed)
-    ml = pyamg.smoothed_aggregation_solver(A, B=rigid_modes(basis)[interior], symmetry="symmetric")
-    solution, status = cg(A, b, M=ml.aspreconditioner(), rtol=p["cg_rtol"], atol=0.0, maxiter=1000)
+    ml = pyamg.smoothed_aggregation_solver(A, B=modes[interior], symmetry="symmetric")
+    solution, status = cg(A, b, M=ml.aspreconditioner(), rtol=p["cg_rtol"], atol=0.0, maxiter=maxiter)
     assert status == 0, f"CG did not converge ({status})"
     return skfem.solve(A, b, x=x, I=interior, solver=lambda *_: solution)
 
@@ -77,7 +78,7 @@ def main(case_path, out_path):
     p = json.loads(str(case["params"]))
     mesh, basis, stiffness, load, fixed = assemble(case, p)
     assembled = time.perf_counter()
-    u = linear_solve(stiffness, load, fixed, basis, p)
+    u = linear_solve(stiffness, load, fixed, rigid_modes(basis), p)
     solved = time.perf_counter()
     u = np.stack([u[basis.nodal_dofs[0]], u[basis.nodal_dofs[1]]], axis=1)
     info = {

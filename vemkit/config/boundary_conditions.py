@@ -368,11 +368,7 @@ def check_expressions_on_mesh(scene, mesh) -> None:
         if side not in mesh.boundary:
             continue  # the problem names the missing side
         parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
-        on_side = np.unique(
-            parts
-            if mesh.vertices.shape[1] == 2
-            else np.concatenate([mesh.face(f) for f in parts] or [np.zeros(0, np.int64)])
-        )
+        on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else mesh.face_vertex_ids(parts))
         pressure = scene.pressure(side)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))

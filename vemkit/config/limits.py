@@ -38,6 +38,7 @@ __all__ = [
     "Resources",
     "available_memory",
     "check_resources",
+    "check_scene_estimate",
     "check_scene_resources",
     "domain_area",
     "estimate_mesh",
@@ -257,8 +258,12 @@ def check_scene_resources(
     """The prediction of :func:`scene_resources` (``layout``: the element's nodes per entity);
     ResourceLimitError beyond ``max_dofs`` or the machine's memory."""
     estimate = scene_resources(scene, layout)
-    if estimate is None:
-        return None
+    return None if estimate is None else check_scene_estimate(scene, estimate, max_dofs)
+
+
+def check_scene_estimate(scene, estimate: Resources, max_dofs: int | None, dimension: int = 2) -> Resources:
+    """ResourceLimitError if the scene's predicted ``estimate`` is beyond ``max_dofs`` or the machine's
+    memory; a mesh file's sides checked against the scene (its header, ``dimension`` 3: a 3D file)."""
     options = scene.mesh_options
     if "file" in options:
         check_resources(
@@ -267,9 +272,9 @@ def check_scene_resources(
             what=f"the mesh file {options['file']} ({estimate.vertices:,} vertices)",
             fix="a coarser mesh",
         )
-        check_file_sides(scene, mesh_file_header(scene.mesh_file))
+        check_file_sides(scene, mesh_file_header(scene.mesh_file, dimension))
         return estimate
-    size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells"))
+    size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
     check_resources(
         estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})", fix="a coarser discretization.mesh"
     )

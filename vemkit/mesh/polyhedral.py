@@ -59,6 +59,13 @@ class PolyhedralMesh:
     def face(self, f: int) -> np.ndarray:
         return self.face_vertices[self.face_offsets[f] : self.face_offsets[f + 1]]
 
+    def face_vertex_ids(self, faces) -> np.ndarray:
+        """The vertices of ``faces`` (face numbers), face after face (with repeats)."""
+        faces = np.asarray(faces, dtype=np.int64).ravel()
+        sizes = self.face_offsets[faces + 1] - self.face_offsets[faces]
+        start = np.repeat(self.face_offsets[faces] - np.cumsum(sizes) + sizes, sizes)
+        return self.face_vertices[start + np.arange(int(sizes.sum()), dtype=np.int64)]
+
     def cell_face_list(self, c: int) -> np.ndarray:
         """The signed faces of cell c."""
         return self.cell_faces[self.cell_offsets[c] : self.cell_offsets[c + 1]]

@@ -95,9 +95,7 @@ class VirtualElementSpace:
         ``dirichlet: [side]`` clamps. In 3D ``edges`` are boundary faces (face numbers): their vertices."""
         mask = np.zeros(self.n_nodes, dtype=bool)
         if self.element.dimension == 3:
-            faces = np.asarray(edges, dtype=np.int64).ravel()
-            if faces.size:
-                mask[np.concatenate([self.mesh.face(f) for f in faces])] = True  # type: ignore[attr-defined]  # a PolyhedralMesh
+            mask[self.mesh.face_vertex_ids(edges)] = True  # type: ignore[attr-defined]  # a PolyhedralMesh
             return mask
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if edges.size:

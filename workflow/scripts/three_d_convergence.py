@@ -9,6 +9,7 @@ with logged(smk):
 
     from vemkit.studies.three_d import convergence_dataset, markdown_table
 
+    COLUMNS = ("n", "cells", "dofs", "error_h1", "rate_h1", "rate_h1_dofs", "error_l2", "rate_l2", "rate_l2_dofs")
     cases = list(smk.params.cases)
     records = []
     for path in smk.input:
@@ -32,20 +33,7 @@ with logged(smk):
                 rows.append(
                     {
                         "case": case,
-                        **{
-                            k: float(ds[k].values[i, j])
-                            for k in (
-                                "n",
-                                "cells",
-                                "dofs",
-                                "error_h1",
-                                "rate_h1",
-                                "rate_h1_dofs",
-                                "error_l2",
-                                "rate_l2",
-                                "rate_l2_dofs",
-                            )
-                        },
+                        **{k: float(ds[k].values[i, j]) for k in COLUMNS},
                     }
                 )
     for r in rows:
@@ -60,18 +48,7 @@ with logged(smk):
         "per DOF, in dofs^(-1/3).\n\n"
         + markdown_table(
             rows,
-            [
-                "case",
-                "n",
-                "cells",
-                "dofs",
-                "error_h1",
-                "rate_h1",
-                "rate_h1_dofs",
-                "error_l2",
-                "rate_l2",
-                "rate_l2_dofs",
-            ],
+            ["case", *COLUMNS],
             formats={k: ".2f" for k in ("rate_h1", "rate_l2", "rate_h1_dofs", "rate_l2_dofs")},
         )
         + "\nOrders between the two finest levels, in the mean cell size (cells^(-1/3)):\n\n"

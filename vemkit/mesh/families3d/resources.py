@@ -131,25 +131,8 @@ def scene_resources3d(scene):
 
 
 def check_scene_resources3d(scene, max_dofs):
-    """The prediction of :func:`scene_resources3d`; ResourceLimitError beyond ``max_dofs`` or the
-    machine's memory (as ``vemkit.config.limits.check_scene_resources`` in 2D)."""
-    from vemkit.config.boundary_conditions import check_file_sides
-    from vemkit.config.limits import check_resources
-    from vemkit.config.mesh_file_header import mesh_file_header
+    """The prediction of :func:`scene_resources3d`, checked as in 2D
+    (``vemkit.config.limits.check_scene_estimate``)."""
+    from vemkit.config.limits import check_scene_estimate
 
-    estimate = scene_resources3d(scene)
-    options = scene.mesh_options
-    if "file" in options:
-        check_resources(
-            estimate,
-            max_dofs,
-            what=f"the mesh file {options['file']} ({estimate.vertices:,} vertices)",
-            fix="a coarser mesh",
-        )
-        check_file_sides(scene, mesh_file_header(scene.mesh_file, dimension=3))
-        return estimate
-    size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
-    check_resources(
-        estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})", fix="a coarser discretization.mesh"
-    )
-    return estimate
+    return check_scene_estimate(scene, scene_resources3d(scene), max_dofs, dimension=3)

@@ -142,14 +142,6 @@ def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK)
     return out
 
 
-def face_vertex_ids(mesh, faces) -> np.ndarray:
-    """The vertices of ``faces``, face after face (with repeats)."""
-    faces = np.asarray(faces, dtype=np.int64)
-    sizes = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
-    start = np.repeat(mesh.face_offsets[faces] - np.cumsum(sizes) + sizes, sizes)
-    return mesh.face_vertices[start + np.arange(int(sizes.sum()), dtype=np.int64)]
-
-
 def dirichlet_components(mesh, dirichlet):
     """(prescribed (N, 3) bool, values (N, 3)) of side names (u = 0) or a mapping side -> (u1, u2, u3),
     each None (free), a number or a function of (x, y, z), on the vertices of the sides' faces."""
@@ -157,7 +149,7 @@ def dirichlet_components(mesh, dirichlet):
     values = np.zeros((mesh.n_vertices, 3))
     items = dirichlet.items() if isinstance(dirichlet, dict) else ((side, (0.0, 0.0, 0.0)) for side in dirichlet)
     for side, components in items:
-        vs = np.unique(face_vertex_ids(mesh, mesh.boundary[side]))
+        vs = np.unique(mesh.face_vertex_ids(mesh.boundary[side]))
         x, y, z = mesh.vertices[vs].T
         for k, g in enumerate(components):
             if g is None:
