@@ -125,6 +125,11 @@ def machine() -> str:
         )
     except (OSError, StopIteration):
         cpu = platform.processor()
+    # numba compiles for the host's microarchitecture (its vector width: "AMD EPYC" is znver3 on one
+    # machine and znver5, with AVX-512, on another, and their last bits differ): LLVM's name of it
+    from llvmlite import binding
+
+    cpu = f"{cpu} ({binding.get_host_cpu_name()})"
     return (
         f"{cpu} | python {platform.python_version()} numpy {numpy.__version__} scipy {scipy.__version__} "
         f"numba {numba.__version__} pyamg {pyamg.__version__}"

@@ -17,7 +17,7 @@ from vemkit.exceptions import InputError, LinearSolveError, SceneError
 DIRECT_LIMIT = 20_000  # "auto" picks the direct solver below this many unknowns (measured crossover)
 
 
-def _v_cycle(levels, coarse_solver, level, b):
+def v_cycle(levels, coarse_solver, level, b):
     """One V-cycle from x = 0 on ``level`` (the smoothers and transfers of the hierarchy)."""
     here = levels[level]
     x = np.zeros_like(b)
@@ -26,7 +26,7 @@ def _v_cycle(levels, coarse_solver, level, b):
     if level == len(levels) - 2:
         coarse_x = coarse_solver(levels[-1].A, coarse_b)
     else:
-        coarse_x = _v_cycle(levels, coarse_solver, level + 1, coarse_b)
+        coarse_x = v_cycle(levels, coarse_solver, level + 1, coarse_b)
     x += here.P @ coarse_x
     here.postsmoother(here.A, x, b)
     return x
@@ -52,7 +52,7 @@ def v_cycle_preconditioner(hierarchy):
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
     return spla.LinearOperator(
-        levels[0].A.shape, dtype=float, matvec=lambda b: _v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
+        levels[0].A.shape, dtype=float, matvec=lambda b: v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
     )
 
 
@@ -73,6 +73,10 @@ AMG_OPTIONS = dict(
     coarse_solver="splu",  # pinv (the default) costs seconds when coarsening stalls above max_coarse
     keep=False,
 )
+#: 3D: pyamg counts max_coarse in 3 x 3 block rows; 600 of them keep the coarsest LU under ~2000 unknowns
+#: (a box at 5.6e4 DOFs: 4 356 unknowns and a 0.3 s factorization with 2000; 192 with 600, the CG
+#: solve 0.45 -> 0.20 s; the contact solver refactors it at every Newton step, vemkit.solvers.amg_update)
+BLOCK_MAX_COARSE = 600
 FINEST_OWN = 2000  # above this many unknowns the finest level is vemkit.solvers.amg_setup's
 
 
@@ -122,6 +126,7 @@ def _block_hierarchy(A, near_nullspace, options):
     level in scalar CSR (``v_cycle_preconditioner``)."""
     import pyamg
 
+    options = dict(options, max_coarse=BLOCK_MAX_COARSE)
     hierarchy = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(3, 3)), B=near_nullspace, **options)
     hierarchy.levels[0].A = A
     return hierarchy

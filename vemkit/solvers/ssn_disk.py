@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
+from vemkit.solvers.sparse_ops import SumOperator
 from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis
 
 STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
@@ -57,12 +58,13 @@ def disk_direction(newton, point, k, sets, solve):
         weight = np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0)
         return rank_one_blocks(cb, weight, cb.tangent, n) + rank_one_blocks(cb, weight, cb.tangent2, n)
 
-    A = K + cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n)
+    J = cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n)
     if not law.reduced:  # the friction bound's derivative w p_tau'(t) (t1, t2) lambda_hat nu^T (unsymmetric)
         lam_hat = np.where(slip[:, None], slip_base, np.where(stick[:, None], lam, 0.0))
         along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
-        A = A + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
-    A = A.tocsr()
+        J = J + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
+    # direct: K + J formed as it always was; AMG: K x + J x, no copy of K's values
+    A = (K + J).tocsr() if newton.reduced.method == "direct" else SumOperator(K, J)
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = solve(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction

@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import LinearSolveError
 from vemkit.solvers.linear import linear_solver
 from vemkit.solvers.sparse_ops import as_matrix, reduced_operator
@@ -104,6 +105,14 @@ class ReducedSolver:
         self.preconditioner = getattr(base, "preconditioner", None)
         self.rebuilds = 0
         self.baseline = baseline  # CG iterations per decade of residual reduction with K
+        # 3D: the hierarchy of K follows every step's K + J + stick penalty (vemkit.solvers.amg_update)
+        self.updated = None
+        if self.method == "amg" and problem.contact.dimension == 3:
+            from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy
+
+            cb, ones = problem.contact, np.ones(problem.contact.normal.shape)
+            support = rank_one_blocks(cb, np.ones(cb.size), ones, problem.n_dofs)  # every contact block
+            self.updated = BoundaryUpdatedHierarchy(base.hierarchy, support)
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True):
         """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs). A: a
@@ -126,6 +135,10 @@ class ReducedSolver:
             return np.zeros(A.shape[0]), 0
         krylov = spla.cg if symmetric else _gmres
         A_red = A if Z is None else reduced_operator(A, Z)  # Z^T A Z never formed (a matrix the size of K)
+        if self.updated is not None:  # the V-cycle of K + J + penalty, no rebuild criterion
+            self.preconditioner = self.updated.preconditioner(A.J + penalty())
+            y, its = self._krylov(krylov, A_red, Z, b, eta)
+            return lift(y), its
         y, its = self._krylov(krylov, A_red, Z, b, eta)
         decades = max(np.log10(1.0 / eta), 1.0)
         if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
