@@ -268,13 +268,23 @@ def _evaluate(newton, u, lam) -> _Point:
     gradient = Ku + normal_force - f
     R = gradient + friction_force
     q = lam + cb.times(newton.gamma, slip)
-    C = cb.times(cb.weight * newton.b_ref, lam - cb.project(q))
+    C = cb.times(complementarity_weight(newton, t), lam - cb.project(q))
     scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
     point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
     if newton.energy_merit:
         friction = law.k_friction * (cb.weight @ cb.magnitude(slip))
         point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
     return point
+
+
+def complementarity_weight(newton, t):
+    """The weight of C in the merit: w b_ref for the reduced law; w p_tau(t) for m_tau > 0, so that
+    C counts as the friction force it misplaces and a vertex without friction force (p_tau = 0, where
+    lambda only follows the slip direction) does not count: with w b_ref there, its lambda moved
+    by the step made the Newton direction no descent direction of theta (measured on the Hertz half
+    sphere, a stall at a step length ~0)."""
+    cb, law = newton.problem.contact, newton.problem.law
+    return cb.weight * (newton.b_ref if law.reduced else law.friction_bound(t))
 
 
 def _converged(newton, point) -> bool:
