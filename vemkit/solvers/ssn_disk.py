@@ -77,14 +77,17 @@ def disk_direction(newton, point, k, sets, solve):
 
 
 def disk_alignment(newton, point) -> float:
-    """||w b_ref (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, u_tau != 0).
+    """||w b (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, |u_tau| > tol max|u|).
 
     Part of the convergence test in 3D: there C = lambda - P(q) measures the direction of lambda only
     through q = lambda + gamma u_tau, i.e. damped by gamma |u_tau| / (1 + gamma |u_tau|), which is tiny
     at a vertex that barely slides (measured: C ~ 1e-3 x the direction error on a Voronoi box); the
     slip direction (2.8) itself is asked for to tol, as the independent check does."""
     cb = newton.problem.contact
-    sliding = (cb.magnitude(point.q) > 1.0) & (cb.magnitude(point.slip) > 0.0)
+    # sliding as the independent check has it (|u_tau| > tol max|u|): a stick vertex's slip of
+    # rounding size (u_tau - u_tau^ref after a stick step) has no direction to follow
+    moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
+    sliding = (cb.magnitude(point.q) > 1.0) & moving
     miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
     from vemkit.solvers.ssn import complementarity_weight
 
