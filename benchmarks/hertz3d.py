@@ -20,22 +20,18 @@ of p^2 = p0^2 (1 - r^2 / a^2) over the vertices in contact, p0_nodal the largest
 foundation (K. L. Johnson, Contact Mechanics, 1985, section 4.2): a = (3 P R / (4 E*))^(1/3),
 p0 = 3 P / (2 pi a^2), E* = E / (1 - nu^2), both evaluated at the measured P.
 
-``--mindlin`` also attempts Cattaneo-Mindlin (``mindlin``: the half sphere pushed sideways, Coulomb
-with m_tau = m_nu = 1, k_tau = mu k_nu). It does not converge yet: vemkit's ssn on the coupled law
-stalls (residual about 5e-5, "the friction bound couples too strongly"), uzawa's lagged normal
-compliance is unstable at k = 1e3 E/R, and a fixed point on the friction bound (``frozen_bound_solve``)
-converges at shift 0.001 (h = 0.015) but elsewhere reaches a residual of 1e-8 and not the 3D
-slip-direction test (``ssn_disk.disk_alignment``) at the barely sliding vertices; the failures are
-recorded in the report. Where it converges the stick radius is well below Mindlin's at nu = 0.3 and
-closer at nu = 0.45: one static solve with the slip counted from the reference configuration keeps
-the radial slip of the normal loading (an elastic sphere on a rigid plane, Dundurs' beta != 0), which
-Cattaneo-Mindlin's incremental, uncoupled theory leaves out.
+``--mindlin`` also runs Cattaneo-Mindlin in steps (``mindlin``, ``vemkit.studies.mindlin``): the half
+sphere x >= 0, Coulomb with m_tau = m_nu = 1, k_tau = mu k_nu, mu = 0.3; step 0 the normal load
+(frictionless, Mindlin's setting: his theory assumes the normal loading leaves no shear traction,
+or with Coulomb friction on), then the top moved sideways along z in SHIFTS, each step's slip
+counted from the previous step's u_tau (``slip_reference``). The Gamma_C normals on the roller
+plane x = 0 are put into the plane (``roller_normals``). Stick radius c from the vertices with
+|lambda| < 1 against c = a (1 - Q/(mu P))^(1/3); the shear traction against Johnson's q(r).
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
 import math
 import tempfile
 import time
@@ -214,61 +210,30 @@ def run(h: float, H: float, k: float, folder: Path) -> dict:
     return row
 
 
-SOLVER_MINDLIN = {"method": "ssn", "tol": 1e-6, "linear": "amg", "max_iterations": 100}
+SOLVER_MINDLIN = {"method": "ssn", "tol": 1e-6, "linear": "direct", "max_iterations": 60}
 MU = 0.3  # Coulomb coefficient of the Cattaneo-Mindlin runs
-#: (h, H, k_nu R/E, sideways displacement of the top along z, Poisson's ratio): nu -> 0.5 removes the
-#: normal-tangential coupling of an elastic sphere on a rigid plane (Dundurs' beta) that Mindlin ignores
-MINDLIN = [(0.015, 0.2, 1e3, 0.001, 0.3), (0.015, 0.2, 1e3, 0.003, 0.3), (0.015, 0.2, 1e3, 0.001, 0.45)]
+#: (h, H, k_nu R/E, Poisson's ratio, normal step frictionless): nu -> 0.5 removes the normal-tangential
+#: coupling of an elastic sphere on a rigid plane (Dundurs' beta) that Mindlin ignores
+MINDLIN = [
+    (0.015, 0.2, 1e3, 0.3, True),
+    (0.015, 0.2, 1e3, 0.3, False),
+    (0.015, 0.2, 1e3, 0.49, True),
+    (0.015, 0.2, 1e3, 0.49, False),
+]
+MINDLIN_QUICK = [(0.03, 0.25, 1e3, 0.3, True)]
+#: the platen's sideways displacements (along z) of the tangential steps, each from the previous one
+SHIFTS = (0.0005, 0.001, 0.0015, 0.002, 0.0025, 0.003)
 
 
-def frozen_bound_solve(problem, k_tau: float, tol: float = 1e-6, max_outer: int = 30):
-    """The quasi-variational Coulomb law p_tau = k_tau (t)_+ (m_tau = 1) by a fixed point on the bound:
-    each pass solves with the friction bound frozen at k_tau (t)_+ of the previous pass (a law whose
-    bound does not depend on u; ssn), until the bound changes by < tol relative. vemkit's ssn on the
-    coupled law itself stalls at a residual of about 5e-5 here (the bound's slope couples too strongly).
-    Returns the solution (of the scene's law: the last pass's problem has the frozen bound, the
-    returned quantities are evaluated with the true law) and the number of passes."""
-    from vemkit.contact.laws import ContactLaw
-    from vemkit.solvers.dispatch import solve
-
-    law = problem.law
-
-    class Frozen(ContactLaw):
-        bound = None
-
-        def friction_bound(self, penetration):
-            return self.bound.copy()
-
-        def friction_bound_derivative(self, penetration):
-            return np.zeros_like(self.bound)
-
-    frozen = Frozen(law.k_normal, law.m_normal, law.k_friction, law.m_friction)
-    cb = problem.contact
-    frictionless = dataclasses.replace(problem, law=ContactLaw(law.k_normal, law.m_normal, 0.0, 0.0))
-    start = solve(frictionless, dict(SOLVER_MINDLIN))
-    frozen.bound = k_tau * np.maximum(cb.normal_displacement(start.u) - cb.gap, 0.0)
-    passes, initial = 0, None
-    work = dataclasses.replace(problem, law=frozen)
-    while passes < max_outer:
-        passes += 1
-        solution = solve(work, dict(SOLVER_MINDLIN), initial=initial)
-        bound = k_tau * np.maximum(cb.normal_displacement(solution.u) - cb.gap, 0.0)
-        change = np.max(np.abs(bound - frozen.bound)) / max(np.max(bound), 1e-300)
-        frozen.bound, initial = bound, (solution.u, solution.multiplier)
-        if change < tol:
-            break
-    return solution, passes
-
-
-def mindlin(h: float, H: float, k: float, shift: float, nu: float, folder: Path) -> dict:
-    """Cattaneo-Mindlin: the half sphere x >= 0 (a tangential load along z is not symmetric about
-    z = 0), the top moved by (free, -delta, shift) in one static solve; Coulomb with
-    m_tau = m_nu = 1, k_tau = MU k_nu. Q = 2 sum w sigma_tau . e3, P = 2 sum w p; stick = the contact
-    vertices with |lambda| < 1 - 1e-6; c = sqrt(2 A_stick / pi), a = sqrt(2 A_contact / pi) from the
-    nodal weights (the areas of the half disks), c_max the largest radius of a stick vertex."""
+def mindlin(h: float, H: float, k: float, nu: float, frictionless_normal: bool, folder: Path) -> list[dict]:
+    """Cattaneo-Mindlin in steps on the half sphere x >= 0 (a tangential load along z is not symmetric
+    about z = 0): step 0 the top pressed down by delta (Coulomb, or frictionless), then the top moved
+    sideways along z by SHIFTS, each step's slip counted from the previous step's u_tau
+    (``vemkit.studies.mindlin``); Coulomb m_tau = m_nu = 1, k_tau = MU k_nu. One row per tangential step."""
     from vemkit.config.scene import scene_from_dict
+    from vemkit.contact.boundary import FoundationLine
     from vemkit.contact.problem import scene_problem
-    from vemkit.solvers.solution import contact_state
+    from vemkit.studies.mindlin import loading_in_steps, mindlin_measures, roller_normals
 
     start = time.perf_counter()
     msh = folder / f"half_{h:g}_{H:g}.msh"
@@ -277,53 +242,44 @@ def mindlin(h: float, H: float, k: float, shift: float, nu: float, folder: Path)
     data = copy.deepcopy(yaml.safe_load(SCENE.read_text()))
     data["discretization"]["mesh"] = {"file": str(msh)}
     data["material"]["nu"] = nu
-    data["boundary"]["dirichlet"] = {"top": [None, -0.01, shift], "sym_x": [0.0, None, None]}
     data["contact"]["normal"] = {"k": k * E / R, "m": 1.0}
     data["contact"]["friction"] = {"k": MU * k * E / R, "m": 1.0}
-    problem = scene_problem(scene_from_dict(data, source=str(SCENE)))
-    solution, outer = frozen_bound_solve(problem, k * MU * E / R)
-    cb = problem.contact
-    state = contact_state(problem, solution.u, solution.multiplier)
-    p = state.normal_pressure
-    on = p > 0
-    traction = state.tangential_stress[:, :1] * cb.tangent + state.tangential_stress[:, 1:] * cb.tangent2
-    P, Q = 2.0 * float(np.sum(cb.weight * p)), 2.0 * float(np.sum(cb.weight * traction[:, 2]))
-    stick = on & (np.linalg.norm(solution.multiplier, axis=1) < 1 - 1e-6)
-    r = np.hypot(cb.coords[:, 0], cb.coords[:, 2])
-    a = math.sqrt(2.0 * float(np.sum(cb.weight[on])) / math.pi)
-    c = math.sqrt(2.0 * float(np.sum(cb.weight[stick])) / math.pi)
-    ratio = abs(Q) / (MU * P)
-    c_pred = a * (1.0 - ratio) ** (1.0 / 3.0) if ratio < 1 else 0.0
-    return {
-        "h": h,
-        "H": H,
-        "k": k,
-        "mu": MU,
-        "shift": shift,
-        "cells": int(problem.mesh.n_cells),
-        "dofs": int(problem.n_dofs),
-        "P": P,
-        "Q": Q,
-        "Q_over_muP": ratio,
-        "a_weights": a,
-        "nu": nu,
-        "a_hertz": (3.0 * P * R * (1.0 - nu**2) / (4.0 * E)) ** (1.0 / 3.0),
-        "c_weights": c,
-        "c_max": float(r[stick].max()) if stick.any() else 0.0,
-        "c_mindlin": c_pred,
-        "err_c": c / c_pred - 1 if c_pred > 0 else float("nan"),
-        "stick_vertices": int(stick.sum()),
-        "slip_vertices": int((on & ~stick).sum()),
-        "iterations": int(solution.iterations),
-        "outer_iterations": outer,
-        "converged": bool(solution.converged),
-        "wall": time.perf_counter() - start,
-    }
+
+    def problem_at(shift):
+        data["boundary"]["dirichlet"] = {"top": [None, -0.01, shift], "sym_x": [0.0, None, None]}
+        problem = scene_problem(scene_from_dict(data, source=str(SCENE)))
+        return roller_normals(problem, FoundationLine(*scene_from_dict(data, source=str(SCENE)).foundation))
+
+    solver = dict(SOLVER_MINDLIN, linear="direct" if h >= 0.015 else "amg")
+    steps = loading_in_steps(problem_at, SHIFTS, solver, frictionless_normal_step=frictionless_normal)
+    rows = []
+    for shift, problem, solution, reference, check in steps[1:]:
+        m = mindlin_measures(problem, solution, reference, MU)
+        profile = {key: m.pop(key) for key in ("r", "q", "on", "stick")}
+        m.update(
+            h=h,
+            H=H,
+            k=k,
+            nu=nu,
+            mu=MU,
+            shift=shift,
+            frictionless_normal=frictionless_normal,
+            cells=int(problem.mesh.n_cells),
+            dofs=int(problem.n_dofs),
+            iterations=int(solution.iterations),
+            check=float(check["worst"]),
+            passed=bool(check["passed"]),
+            wall=time.perf_counter() - start,
+        )
+        m["profile"] = {key: np.asarray(v).tolist() for key, v in profile.items()}
+        m["normal_step_iterations"] = int(steps[0][2].iterations)
+        rows.append(m)
+    return rows
 
 
 def main() -> None:
     parser = quick_parser(__doc__, "one coarse mesh, k = 1e3 E/R")
-    parser.add_argument("--mindlin", action="store_true", help="also attempt Cattaneo-Mindlin (does not converge yet)")
+    parser.add_argument("--mindlin", action="store_true", help="also Cattaneo-Mindlin in steps")
     args = parser.parse_args()
     cases = QUICK if args.quick else CASES
     rows = []
@@ -363,37 +319,45 @@ def main() -> None:
         from vemkit.exceptions import ConvergenceError
 
         with tempfile.TemporaryDirectory() as tmp:
-            for h, H, k, shift, nu in MINDLIN:
+            for h, H, k, nu, frictionless in MINDLIN_QUICK if args.quick else MINDLIN:
                 try:
-                    extra.append(mindlin(h, H, k, shift, nu, Path(tmp)))
-                    print(f"Mindlin shift = {shift}: {extra[-1]['wall']:.1f} s", flush=True)
+                    extra += mindlin(h, H, k, nu, frictionless, Path(tmp))
+                    print(
+                        f"Mindlin h = {h}, nu = {nu}, frictionless normal step {frictionless}: {extra[-1]['wall']:.1f} s",
+                        flush=True,
+                    )
                 except ConvergenceError as error:
-                    failures.append({"h": h, "H": H, "k": k, "shift": shift, "nu": nu, "error": str(error)})
-                    print(f"Mindlin shift = {shift}: {error}", flush=True)
+                    failures.append(
+                        {"h": h, "H": H, "k": k, "nu": nu, "frictionless": frictionless, "error": str(error)}
+                    )
+                    print(f"Mindlin h = {h}, nu = {nu}: {error}", flush=True)
     if failures:
         lines += ["", "## Cattaneo-Mindlin: not converged", ""]
         lines += [
-            f"- h = {f['h']}, k = {f['k']:g}, shift = {f['shift']}, nu = {f['nu']}: {f['error']}" for f in failures
+            f"- h = {f['h']}, k = {f['k']:g}, nu = {f['nu']}, frictionless normal step {f['frictionless']}: {f['error']}"
+            for f in failures
         ]
     if extra:
         lines += [
             "",
-            "## Cattaneo-Mindlin (half sphere x >= 0, Coulomb mu = 0.3, m_tau = m_nu = 1, k_tau = mu k_nu)",
+            "## Cattaneo-Mindlin in steps (half sphere x >= 0, Coulomb mu = 0.3, m_tau = m_nu = 1, k_tau = mu k_nu)",
             "",
-            "One static solve (a fixed point on the friction bound, frozen_bound_solve): top moved by (free, -0.01, shift). c = sqrt(2 A_stick/pi) from the nodal "
-            "weights of the vertices with |lambda| < 1; Mindlin c = a (1 - Q/(mu P))^(1/3) with the measured "
-            "Q, P and a = sqrt(2 A_contact/pi).",
+            "Step 0: the top pressed down by 0.01 (with Coulomb friction, or frictionless: the column 'normal "
+            "step'); then the top moved sideways along z by the shift, each step's slip counted from the previous "
+            "step's u_tau (ssn with slip_reference). c = sqrt(2 A_stick/pi) from the nodal weights of the vertices "
+            "with |lambda| < 1; Mindlin c = a (1 - Q/(mu P))^(1/3) at the measured Q, P and a = sqrt(2 A_contact/pi); "
+            "q misfit: RMS of |sigma_tau . e_z| - q_Mindlin(r) over the contact vertices / (mu p0).",
             "",
-            "| h | cells | DOFs | k R/E | nu | shift | P | Q | Q/(mu P) | a | a Hertz | c | c_max | c Mindlin (err) "
-            "| stick/slip vertices | bound passes | wall s |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "| h | DOFs | nu | normal step | shift | P | Q/(mu P) | a | c | c_max | c Mindlin (err) | q misfit "
+            "| stick/slip | ssn it. | check |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         ]
         for r in extra:
             lines.append(
-                f"| {r['h']:g} | {r['cells']} | {r['dofs']} | {r['k']:.0e} | {r['nu']:g} | {r['shift']:g} | {r['P']:.5f} "
-                f"| {r['Q']:.2e} | {r['Q_over_muP']:.3f} | {r['a_weights']:.4f} | {r['a_hertz']:.4f} "
-                f"| {r['c_weights']:.4f} | {r['c_max']:.4f} | {r['c_mindlin']:.4f} ({pc(r['err_c'])}) "
-                f"| {r['stick_vertices']}/{r['slip_vertices']} | {r['outer_iterations']} | {r['wall']:.1f} |"
+                f"| {r['h']:g} | {r['dofs']} | {r['nu']:g} | {'frictionless' if r['frictionless_normal'] else 'Coulomb'} "
+                f"| {r['shift']:g} | {r['P']:.5f} | {r['Q_over_muP']:.3f} | {r['a']:.4f} | {r['c']:.4f} | {r['c_max']:.4f} "
+                f"| {r['c_mindlin']:.4f} ({pc(r['err_c'])}) | {r['q_rms_misfit']:.3f} "
+                f"| {r['stick_vertices']}/{r['slip_vertices']} | {r['iterations']} | {r['check']:.0e} |"
             )
     record = {"machine": MACHINE, "quick": args.quick, "rows": rows, "mindlin": extra, "mindlin_failures": failures}
     write_report("hertz3d", record, lines)

@@ -66,7 +66,7 @@ def floating_point_errors_raise():
         yield
 
 
-def solve(problem, solver_options: dict, progress=None, initial=None):
+def solve(problem, solver_options: dict, progress=None, initial=None, slip_reference=None):
     """Run the configured contact solver; raises ConvergenceError on failure.
 
     Parameters
@@ -81,6 +81,10 @@ def solve(problem, solver_options: dict, progress=None, initial=None):
     initial : tuple, optional
         None (each solver's own start) or (u0 free-dof vector, multiplier per contact vertex), a
         warm start (e.g. a coarser solution prolongated to this mesh).
+    slip_reference : array, optional
+        u_tau^ref per contact vertex (the previous load step's ``cb.tangential_displacement(u)``):
+        the slip is counted from it (the incremental friction law of a loading in steps); None:
+        from the unloaded shape.
 
     Returns
     -------
@@ -118,6 +122,8 @@ def solve(problem, solver_options: dict, progress=None, initial=None):
         raise SceneError(f"solver.method = {method!r} is unknown; use ssn or uzawa", key="solver.method")
     if initial is not None:
         kwargs["initial"] = initial
+    if slip_reference is not None:
+        kwargs["slip_reference"] = slip_reference
     try:
         with single_threaded_blas(), floating_point_errors_raise():
             return run(problem, **common, **kwargs)

@@ -67,7 +67,15 @@ def residual_scale(load_norm: float, contact_force_norm: float) -> float:
     return scale if scale > 0.0 else 1.0
 
 
-def contact_residual(problem, u, multiplier) -> dict:
+def relative_slip(cb, u, slip_reference=None):
+    """The slip u_tau - u_tau^ref at the contact vertices: counted from ``slip_reference`` (the
+    previous load step's u_tau, the incremental friction law of a loading in steps), from the
+    unloaded shape when None (the static law (2.8)-(2.9))."""
+    slip = cb.tangential_displacement(u)
+    return slip if slip_reference is None else slip - np.asarray(slip_reference, dtype=float)
+
+
+def contact_residual(problem, u, multiplier, slip_reference=None) -> dict:
     """How well (u, lambda) satisfies the discrete problem, each measure dimensionless.
 
     equilibrium      ||K u + contact forces - f|| / ||f||  (||f|| + ||contact forces|| if f = 0)
@@ -75,7 +83,8 @@ def contact_residual(problem, u, multiplier) -> dict:
     complementarity  max_c |lambda_c . u_tau,c - |u_tau,c|| / max|u| (sigma_tau opposes slip, (2.8))
     (3D: lambda_c and u_tau,c vectors of the tangent plane, |.| the Euclidean norm; with |lambda| <= 1,
     lambda . u_tau = |u_tau| is lambda = u_tau / |u_tau| wherever u_tau != 0)
-    max of the three under ``worst``; non-finite input gives inf everywhere.
+    max of the three under ``worst``; non-finite input gives inf everywhere. u_tau is the slip
+    counted from ``slip_reference`` (``relative_slip``).
     """
     u = np.asarray(u, dtype=float)
     lam = np.asarray(multiplier, dtype=float)
@@ -87,7 +96,7 @@ def contact_residual(problem, u, multiplier) -> dict:
     scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(forces)))
     equilibrium = float(np.linalg.norm(K @ u + forces - f)) / scale
     if cb.size:
-        slip = cb.tangential_displacement(u)
+        slip = relative_slip(cb, u, slip_reference)
         umax = float(np.max(np.abs(u))) if u.size else 0.0
         bound = float(np.max(np.maximum(cb.magnitude(lam) - 1.0, 0.0)))
         compl = float(np.max(np.abs(cb.dot(lam, slip) - cb.magnitude(slip)))) / (umax if umax > 0.0 else 1.0)
@@ -121,12 +130,13 @@ class ContactState:
         return {name: int(np.sum(self.state == code)) for code, name in STATE_NAMES.items()}
 
 
-def contact_state(problem, u, multiplier, tol: float = 1e-8) -> ContactState:
-    """Classify the contact vertices and return the derived quantities (see ``ContactState``)."""
+def contact_state(problem, u, multiplier, tol: float = 1e-8, slip_reference=None) -> ContactState:
+    """Classify the contact vertices and return the derived quantities (see ``ContactState``); the
+    slip counted from ``slip_reference`` (``relative_slip``)."""
     cb, law = problem.contact, problem.law
     u = np.asarray(u, dtype=float)
     penetration = cb.normal_displacement(u) - cb.gap
-    slip = cb.tangential_displacement(u)
+    slip = relative_slip(cb, u, slip_reference)
     bound = law.friction_bound(penetration)
     scale = float(np.max(np.abs(u))) if u.size else 0.0
     state = np.where(penetration <= 0.0, SEPARATED, np.where(cb.magnitude(slip) <= tol * scale, STICK, SLIP))

@@ -73,6 +73,7 @@ from vemkit.solvers.solution import (
     ContactSolution,
     contact_residual,
     history_arrays,
+    relative_slip,
     residual_scale,
     young_modulus,
 )
@@ -115,6 +116,7 @@ class _Newton:
     short_steps: int = 0
     eta: float = ETA_MAX  # relative tolerance of the last inexact step
     theta_previous: float = 0.0
+    slip_reference: np.ndarray | None = None  # u_tau^ref: the slip is u_tau - u_tau^ref (a load step)
 
     @property
     def zero(self):
@@ -142,14 +144,21 @@ class _Point:
     floor: float = 0.0
 
 
-def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None, initial=None) -> ContactSolution:
+def solve_ssn(
+    problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None, initial=None, slip_reference=None
+) -> ContactSolution:
     """Semismooth Newton for (5.2)-(5.3); see the module docstring. ``tol``: relative residual.
+
+    ``slip_reference``: None, or u_tau^ref per contact vertex (``cb.tangential_displacement`` of the
+    previous load step's u): the incremental (backward-Euler) friction law of a loading in steps,
+    lambda . (u_tau - u_tau^ref) = |u_tau - u_tau^ref|, stick where u_tau = u_tau^ref.
 
     progress(k, record) is called after every Newton iteration with that iteration's history entries.
     ``initial``: None, or (u0 free-dof vector, lambda0 per contact vertex), a warm start (module docstring).
     Raises ConvergenceError (never returns NaN).
     """
     newton, u = _plain_start(problem, linear, tol, None if initial is None else initial[0])
+    newton.slip_reference = None if slip_reference is None else np.asarray(slip_reference, dtype=float)
     cb, law = problem.contact, problem.law
     t = cb.normal_displacement(u) - cb.gap
     if cb.size == 0 or (not np.any(law.normal_pressure(t)) and not np.any(law.friction_bound(t))):
@@ -157,9 +166,9 @@ def solve_ssn(problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=
     _prepare(newton, t)
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
     if cb.dimension == 2:
-        trial = newton.kd_tau * cb.tangential_displacement(u) / (cb.weight * newton.b_ref)
+        trial = newton.kd_tau * relative_slip(cb, u, slip_reference) / (cb.weight * newton.b_ref)
     else:
-        trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), cb.tangential_displacement(u))
+        trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), relative_slip(cb, u, slip_reference))
     point = _evaluate(newton, u, cb.project(trial))
     if initial is not None:
         warm = _evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
@@ -214,12 +223,12 @@ def _plain_solution(newton, u):
         u = base.solve(newton.problem.load, x0=u, tol=tol)
         newton.linear_total += base.iterations
     cb = newton.problem.contact
-    return _finish(newton, u, cb.direction(cb.tangential_displacement(u)), 0)
+    return _finish(newton, u, cb.direction(relative_slip(cb, u, newton.slip_reference)), 0)
 
 
 def _finish(newton, u, lam, iterations):
     info = newton.info
-    info["residual"] = contact_residual(newton.problem, u, lam)
+    info["residual"] = contact_residual(newton.problem, u, lam, newton.slip_reference)
     info["amg_rebuilds"] = newton.reduced.rebuilds if newton.reduced is not None else 0
     return ContactSolution(
         u,
@@ -261,20 +270,30 @@ def _evaluate(newton, u, lam) -> _Point:
     K, f, cb, law, n = problem.stiffness, problem.load, problem.contact, problem.law, problem.n_dofs
     zero = newton.zero
     t = cb.normal_displacement(u) - cb.gap
-    slip = cb.tangential_displacement(u)
+    slip = relative_slip(cb, u, newton.slip_reference)
     Ku = K @ u
     normal_force = cb.normal_force(u, law)
     friction_force = cb.scatter(zero, cb.times(cb.weight * law.friction_bound(t), lam), n)
     gradient = Ku + normal_force - f
     R = gradient + friction_force
     q = lam + cb.times(newton.gamma, slip)
-    C = cb.times(cb.weight * newton.b_ref, lam - cb.project(q))
+    C = cb.times(complementarity_weight(newton, t), lam - cb.project(q))
     scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
     point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
     if newton.energy_merit:
         friction = law.k_friction * (cb.weight @ cb.magnitude(slip))
         point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
     return point
+
+
+def complementarity_weight(newton, t):
+    """The weight of C in the merit: w b_ref for the reduced law; w p_tau(t) for m_tau > 0, so that
+    C counts as the friction force it misplaces and a vertex without friction force (p_tau = 0, where
+    lambda only follows the slip direction) does not count: with w b_ref there, its lambda moved
+    by the step made the Newton direction no descent direction of theta (measured on the Hertz half
+    sphere, a stall at a step length ~0)."""
+    cb, law = newton.problem.contact, newton.problem.law
+    return cb.weight * (newton.b_ref if law.reduced else law.friction_bound(t))
 
 
 def _converged(newton, point) -> bool:

@@ -29,7 +29,7 @@ import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.solvers.sparse_ops import SumOperator
-from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis
+from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis, stick_multiplier, stick_shift
 
 STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
 
@@ -49,7 +49,7 @@ def disk_direction(newton, point, k, sets, solve):
     direction = cb.tangent * e_full[:, :1] + cb.tangent2 * e_full[:, 1:]  # e in space, (n_c, 3)
     coefficient = np.zeros(cb.size)
     coefficient[slip] = cb.weight[slip] * bound[slip] * slope
-    stick_shift = cb.scatter(zero, np.where(stick[:, None], -point.slip, 0.0), n)
+    shift = stick_shift(cb, stick, point.slip, n)
     friction_now = cb.scatter(zero, cb.times(cb.weight * bound, lam), n)
     slip_force = cb.scatter(zero, cb.times(cb.weight * bound, slip_base), n)
     Z = stick_basis(cb, np.flatnonzero(stick), n) if np.any(stick) else None
@@ -60,19 +60,18 @@ def disk_direction(newton, point, k, sets, solve):
 
     J = cb.normal_jacobian(point.u, law, newton.stiffness_cap) + rank_one_blocks(cb, coefficient, direction, n)
     if not law.reduced:  # the friction bound's derivative w p_tau'(t) (t1, t2) lambda_hat nu^T (unsymmetric)
-        lam_hat = np.where(slip[:, None], slip_base, np.where(stick[:, None], lam, 0.0))
+        lam_hat = np.where(frictional[:, None], lam, 0.0)  # d(b lambda) = b d lambda + lambda b' dt: lambda now
         along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
         J = J + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
     # direct: K + J formed as it always was; AMG: K x + J x, no copy of K's values
     A = (K + J).tocsr() if newton.reduced.method == "direct" else SumOperator(K, J)
-    rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
+    rhs = -(point.R - friction_now) - A @ shift - slip_force
     correction, its = solve(newton, point, k, A, Z, rhs, penalty)
-    du = stick_shift + correction
+    du = shift + correction
     du_tau = cb.tangential_displacement(du)
     lam_new = lam.copy()
     lam_new[slip] = base + (slope * np.sum(e * du_tau[slip], axis=1))[:, None] * e
-    stick_force = cb.tangential_displacement(rhs - A @ correction)
-    lam_new[stick] = stick_force[stick] / (cb.weight[stick] * bound[stick])[:, None]
+    lam_new[stick] = stick_multiplier(cb, stick, rhs - A @ correction, cb.weight * bound)
     slip_new = point.slip + du_tau
     moving = ~frictional & (cb.magnitude(slip_new) > 0.0)
     lam_new[moving] = cb.direction(slip_new[moving])
@@ -80,13 +79,18 @@ def disk_direction(newton, point, k, sets, solve):
 
 
 def disk_alignment(newton, point) -> float:
-    """||w b_ref (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, u_tau != 0).
+    """||w b (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, |u_tau| > tol max|u|).
 
     Part of the convergence test in 3D: there C = lambda - P(q) measures the direction of lambda only
     through q = lambda + gamma u_tau, i.e. damped by gamma |u_tau| / (1 + gamma |u_tau|), which is tiny
     at a vertex that barely slides (measured: C ~ 1e-3 x the direction error on a Voronoi box); the
     slip direction (2.8) itself is asked for to tol, as the independent check does."""
     cb = newton.problem.contact
-    sliding = (cb.magnitude(point.q) > 1.0) & (cb.magnitude(point.slip) > 0.0)
+    # sliding as the independent check has it (|u_tau| > tol max|u|): a stick vertex's slip of
+    # rounding size (u_tau - u_tau^ref after a stick step) has no direction to follow
+    moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
+    sliding = (cb.magnitude(point.q) > 1.0) & moving
     miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
-    return float(np.linalg.norm(cb.weight[sliding] * newton.b_ref * miss)) / point.scale
+    from vemkit.solvers.ssn import complementarity_weight
+
+    return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale

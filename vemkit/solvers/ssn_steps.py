@@ -66,16 +66,81 @@ def stick_basis(cb, stick, n):
 
 def _stick_basis_3d(cb, stick, n):
     first, others = cb.dofs[stick, 0], cb.dofs[stick, 1:]
+    held = np.zeros(stick.size, dtype=bool) if cb.fixed is None else cb.fixed[stick].any(axis=1)
     keep = np.ones(n, dtype=bool)
     keep[others.ravel()] = False
+    keep[first[held]] = False  # a held stick vertex: its columns are those of held_stick_moves
     column = np.cumsum(keep) - 1
     rows = np.flatnonzero(keep)
     vals = np.ones(rows.size)
-    vals[column[first]] = cb.normal[stick, 0]
-    rows = np.concatenate([rows, others.ravel()])
-    cols = np.concatenate([np.arange(vals.size), np.repeat(column[first], 2)])
-    vals = np.concatenate([vals, cb.normal[stick, 1:].ravel()])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, int(keep.sum())))
+    free = ~held
+    vals[column[first[free]]] = cb.normal[stick[free], 0]
+    rows = np.concatenate([rows, others[free].ravel()])
+    cols = np.concatenate([np.arange(vals.size), np.repeat(column[first[free]], 2)])
+    vals = np.concatenate([vals, cb.normal[stick[free], 1:].ravel()])
+    width = int(keep.sum())
+    for c in stick[held]:  # the null space of the stick constraints on the unprescribed components
+        for direction in held_stick_moves(cb, c)[1]:
+            rows = np.concatenate([rows, cb.dofs[c]])
+            cols = np.concatenate([cols, np.full(3, width)])
+            vals = np.concatenate([vals, direction])
+            width += 1
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, width))
+
+
+HELD_RANK_TOL = 1e-10  # singular values of the stick constraints below this (relative) are a held direction
+
+
+def held_stick_moves(cb, c, slip=None):
+    """A stick vertex ``c`` with prescribed components (a symmetry roller meeting Gamma_C): the stick
+    constraints t1 . v = -s1, t2 . v = -s2 on its other components P. Returns (the min-norm move
+    v (3,) that meets them, zeros on the prescribed ones, for s = ``slip`` (2,); the (k, 3) null
+    space directions, k = |P| - rank). When nu has a component along a held axis (a vertex normal
+    averaged over the faces on one side of the plane), the vertex is pinned: v is determined, k = 0."""
+    free = ~cb.fixed[c]
+    M = np.stack([cb.tangent[c][free], cb.tangent2[c][free]])  # (2, |P|)
+    U, sigma, Vt = np.linalg.svd(M)
+    rank = int(np.sum(sigma > HELD_RANK_TOL * max(sigma.max(), 1.0)))
+    null = np.zeros((Vt.shape[0] - rank, 3))
+    null[:, free] = Vt[rank:]
+    move = np.zeros(3)
+    if slip is not None:
+        inverse = Vt[:rank].T @ ((U[:, :rank].T @ -np.asarray(slip, float)) / sigma[:rank])
+        move[free] = inverse
+    return move, null
+
+
+def stick_shift(cb, stick_mask, slip, n):
+    """The free-dof move that makes u_tau = u_tau^ref at the stick vertices (slip = u_tau - u_tau^ref
+    there): -(s1 t1 + s2 t2) (-s tau in 2D), or held_stick_moves' v at a vertex with a prescribed
+    component."""
+    zero = np.zeros(cb.size)
+    mask = stick_mask if cb.dimension == 2 else stick_mask[:, None]
+    shift = cb.scatter(zero, np.where(mask, -slip, 0.0), n)
+    for c in _held(cb, stick_mask):
+        shift[cb.dofs[c]] = held_stick_moves(cb, c, slip[c])[0]
+    return shift
+
+
+def stick_multiplier(cb, stick_mask, reaction, scale):
+    """The 3D lambda at the stick vertices from ``reaction`` (the free-dof vector of the force left
+    for friction; scale = w b): (t1, t2) . reaction / scale, or at a vertex with a prescribed
+    component the least-squares lambda of scale (lambda_1 t1 + lambda_2 t2) = reaction on its
+    unprescribed components (the held ones' force is the constraint's)."""
+    force = cb.tangential_displacement(reaction)
+    lam = force[stick_mask] / scale[stick_mask][:, None]
+    index = np.flatnonzero(stick_mask)
+    for c in _held(cb, stick_mask):
+        free = ~cb.fixed[c]
+        T = np.stack([cb.tangent[c], cb.tangent2[c]], axis=1)[free]  # (|P|, 2)
+        lam[np.searchsorted(index, c)] = np.linalg.lstsq(T, reaction[cb.dofs[c]][free], rcond=None)[0] / scale[c]
+    return lam
+
+
+def _held(cb, stick_mask):
+    if cb.dimension == 2 or cb.fixed is None:
+        return np.zeros(0, np.int64)
+    return np.flatnonzero(stick_mask & cb.fixed.any(axis=1))
 
 
 def disk_slip_step(q, lam, gamma):

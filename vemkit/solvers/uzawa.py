@@ -74,6 +74,7 @@ from vemkit.solvers.solution import (
     contact_force_vector,
     contact_residual,
     history_arrays,
+    relative_slip,
     residual_scale,
 )
 from vemkit.solvers.sparse_ops import abs_matvec
@@ -171,6 +172,7 @@ def solve_uzawa(
     tol=1e-10,
     progress=None,
     initial=None,
+    slip_reference=None,
 ) -> ContactSolution:
     """Steps 1-3 of the paper; see the module docstring. ``tol``: relative tolerance of each linear
     solve and of the residual a stop must reach (acceptable_residual).
@@ -179,13 +181,15 @@ def solve_uzawa(
     du = |u^n - u^{n-1}| / |u^n|, dlambda = max |lambda^n - lambda^{n-1}|, residual = the relative
     equilibrium residual of (u^n, lambda^n) (exact up to the linear-solve tolerance), rho, and
     linear_iterations. ``initial``: None (Step 1) or (u^0 free-dof vector, lambda^0 per contact
-    vertex). Raises ConvergenceError (never returns NaN).
+    vertex). ``slip_reference``: as vemkit.solvers.ssn.solve_ssn (a load step's incremental law: (5.5)
+    with u_tau^n - u_tau^ref). Raises ConvergenceError (never returns NaN).
     """
     if stop not in ("either", "both"):
         raise SceneError(f"solver.stop = {stop!r}: use either or both", key="solver.stop")
     if rho is not None and not rho > 0.0:
         raise SceneError(f"solver.rho = {rho}: must be > 0", key="solver.rho")
     options = dict(rho=rho, eps_u=eps_u, eps_lambda=eps_lambda, stop=stop, max_iterations=max_iterations, tol=tol)
+    options["slip_reference"] = slip_reference
     state = None
     try:
         state = _start(problem, linear, options, initial)
@@ -231,7 +235,7 @@ def _start(problem, linear, options, initial=None) -> _Uzawa:
         and not np.any(rhs - problem.load)
     ):
         state.u = u_first
-        state.lam = cb.direction(cb.tangential_displacement(u_first)) if cb.size else state.lam
+        state.lam = cb.direction(relative_slip(cb, u_first, options["slip_reference"])) if cb.size else state.lam
         state.info["rho"] = float("nan") if options["rho"] is None else float(options["rho"])
         return state
     if options["rho"] is None and not law.frictionless:
@@ -302,7 +306,9 @@ def _uzawa_iteration(state):
             x0 = _extrapolated_start(u, state.step, rhs - state.previous_rhs, state.previous_rhs_change)
         u_new, lin_its = _solve_step(state, rhs, x0, lin_tol)
     while True:
-        lam_new = cb.project(lam + state.rho * law.k_friction * cb.tangential_displacement(u_new))  # (5.5)
+        lam_new = cb.project(
+            lam + state.rho * law.k_friction * relative_slip(cb, u_new, options["slip_reference"])
+        )  # (5.5)
         if not (np.all(np.isfinite(u_new)) and np.all(np.isfinite(lam_new))):
             fail(state, "non-finite values", "diverged")
         state.du = _relative_change(u_new, u)
@@ -379,8 +385,8 @@ def _stop_check(state, stopped_by):
     problem, n = state.problem, state.n
     lam = state.lam
     if problem.law.frictionless:  # lambda carries no force: the one consistent with the slip
-        lam = problem.contact.direction(problem.contact.tangential_displacement(state.u))
-    check = contact_residual(problem, state.u, lam)
+        lam = problem.contact.direction(relative_slip(problem.contact, state.u, state.options["slip_reference"]))
+    check = contact_residual(problem, state.u, lam, state.options["slip_reference"])
     level = acceptable_residual(problem, state.u, state.forces, state.options["tol"], state.K_abs)
     if check["worst"] <= level:
         state.lam = lam

@@ -47,7 +47,7 @@ from functools import cache
 import numpy as np
 
 from vemkit.exceptions import InputError, LinearSolveError, SolveError, TimeBudgetExceeded
-from vemkit.solvers.solution import contact_force_vector, contact_residual, residual_scale
+from vemkit.solvers.solution import contact_force_vector, contact_residual, relative_slip, residual_scale
 
 FAILURE_CLASSES = (
     "diverged",
@@ -99,11 +99,13 @@ def failure_class(exc: BaseException, phase: str = "solve") -> str:
     return "unexpected_exception"
 
 
-def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL) -> dict:
-    """The independent check of the module docstring: {measure: value, "worst": max, "passed": bool}."""
+def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL, slip_reference=None) -> dict:
+    """The independent check of the module docstring: {measure: value, "worst": max, "passed": bool};
+    u_tau the slip counted from ``slip_reference`` (a load step's incremental law, None: from the
+    unloaded shape)."""
     u = np.asarray(u, dtype=float)
     lam = np.asarray(multiplier, dtype=float)
-    out = {k: float(v) for k, v in contact_residual(problem, u, lam).items() if k != "worst"}
+    out = {k: float(v) for k, v in contact_residual(problem, u, lam, slip_reference).items() if k != "worst"}
     cb, law = problem.contact, problem.law
     finite = np.all(np.isfinite(u)) and np.all(np.isfinite(lam))
     if not finite:
@@ -125,7 +127,7 @@ def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL) -> d
         )
         scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(contact_force_vector(problem, u, lam))))
         t = cb.normal_displacement(u) - cb.gap
-        slip = cb.tangential_displacement(u)
+        slip = relative_slip(cb, u, slip_reference)
         bound = cb.weight * law.friction_bound(t)
         umax = float(np.max(np.abs(u))) or 1.0
         slipping = (cb.magnitude(slip) > tol * umax) & (bound > 0.0)
