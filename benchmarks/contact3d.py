@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/contact3d.py [--quick] [--sizes 24 40 60 86] [--uzawa-sizes 40]
 
-The scene is benchmarks/contact3d.yaml (a box on a foundation, sticking in the middle of Gamma_C and
+The scene is config/scenes/3d/sheared_box.yaml (a box on a foundation, sticking in the middle of Gamma_C and
 sliding around it in a turning direction), hexahedra at n cells per unit length (n = 86: 999 108
 DOFs). Every case is one whole process, ``vemkit solve`` (mesh, assembly, solve, the independent
 check, the netCDF file), measured by wait4: wall and CPU time, peak resident memory; beside it the
@@ -23,7 +23,7 @@ from pathlib import Path
 
 from _common import MACHINE, quick_parser, targets_line, write_report
 
-SCENE = Path(__file__).resolve().with_name("contact3d.yaml")
+SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "3d" / "sheared_box.yaml"
 VEMKIT = Path(sys.executable).with_name("vemkit")
 TARGET_WALL_S, TARGET_PEAK_GIB = 90.0, 8.0
 
@@ -82,7 +82,7 @@ def main() -> None:
         "# 3D frictional contact: whole `vemkit solve` processes (benchmarks/contact3d.py)",
         "",
         f"Machine: {MACHINE}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the end.",
-        "Scene benchmarks/contact3d.yaml (hexahedra, n cells per unit length); ssn tol 1e-10, uzawa 1e-8, AMG.",
+        "Scene config/scenes/3d/sheared_box.yaml (hexahedra, n cells per unit length); ssn tol 1e-10, uzawa 1e-8, AMG.",
         "",
         "| method | n | DOFs | iterations | linear its | wall s | CPU s | solver s | assembly s | peak GiB "
         "| predicted GiB | check |",

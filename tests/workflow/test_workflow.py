@@ -450,3 +450,15 @@ def test_plots_draw(tmp_path):
     fig = plots.displacement_figure(mesh, x * y, x - y, title="smoke")
     assert plots.save(fig, tmp_path / "f.png")[0].stat().st_size > 1000
     assert plots.auto_magnification(np.array([0.3])) == 0.5
+
+
+def test_a_3d_studies_scene_plans_its_sweep_and_stability_matrix():
+    """config/sweeps3d.yaml: the sweeps and the stability matrix on the sheared box (model: 3d)."""
+    jobs = planned_jobs(
+        "results/sweeps/box3d.nc",
+        "results/sweeps/box3d/profiles.png",
+        "results/stability/stability.md",
+        "--configfile",
+        "config/sweeps3d.yaml",
+    )
+    assert jobs.get("sweep_part") == 1 and jobs.get("sweep_figure") == 1 and jobs.get("stability_part") == 1, jobs

@@ -177,8 +177,9 @@ def discrete_problem(
     )
 
 
-def _scene_gap(scene):
-    """The gap of the scene: its foundation line (SPEC §7) or its gap expression (zero if none)."""
+def scene_gap(scene):
+    """The gap of the scene: its foundation line or plane (SPEC §7, §10) or its gap expression of the
+    coordinates (zero if none), as ``ContactBoundary.with_gap`` takes it."""
     if scene.foundation is not None:
         return FoundationLine(*scene.foundation)
     gap = scene.gap_expression
@@ -199,7 +200,7 @@ def scene_problem_data(scene) -> dict:
         dirichlet=scene.dirichlet,
         pressure=pressures,
         contact=scene.contact_sides,
-        gap=_scene_gap(scene),
+        gap=scene_gap(scene),
         law=law,
         body_force=body,
         stabilization=scene.stabilization,

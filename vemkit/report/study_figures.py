@@ -156,17 +156,24 @@ def sweep_profiles_figure(ds, across: str, select=None, title: str = "") -> Figu
         raise ValueError(f"this sweep has no contact-boundary profiles ({ds.attrs.get('profiles', '')})")
     sub, held = _fixed(ds, (across,), select)
     x = ds["contact_x"].values
+    surface = "contact_z" in ds.coords  # a 3D body: every vertex of the surface Gamma_C against its x
     fig = Figure(figsize=(13.0, 3.8), layout="constrained")
     axes = fig.subplots(1, 3)
+    names = ("profile_pressure", "profile_tangential_stress", "profile_slip")
     for k, value in enumerate(sub[across].values):
         point = sub.sel({across: value})
         label = f"{across} = {_value_labels([value])[0]}" + ("" if int(point["status"]) == 0 else " (not converged)")
-        style = dict(color=COLORS[k % len(COLORS)], lw=1.3, label=label)
-        for ax, name in zip(axes, ("profile_pressure", "profile_tangential_stress", "profile_slip")):
-            ax.plot(x, point[name].values, **style)
-    for ax, name in zip(axes, ("profile_pressure", "profile_tangential_stress", "profile_slip")):
+        style = dict(color=COLORS[k % len(COLORS)], label=label)
+        style.update(dict(ls="none", marker=".", ms=3) if surface else dict(lw=1.3))
+        for ax, name in zip(axes, names):
+            values = point[name]
+            if "contact_tangent" in values.dims:  # 3D: the magnitude of the tangential vector
+                values = np.sqrt((values**2).sum("contact_tangent", skipna=False))
+            ax.plot(x, values.values, **style)
+    for ax, name in zip(axes, names):
         ax.set_xlabel("x on $\\Gamma_C$ [mm]")
-        ax.set_ylabel(_label(ds, name))
+        tangential = surface and "contact_tangent" in ds[name].dims
+        ax.set_ylabel(("|" + _label(ds, name) + "|") if tangential else _label(ds, name))
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7)
     fig.suptitle((title + "\n" if title else "") + (held or ""), fontsize=9)

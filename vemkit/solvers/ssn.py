@@ -303,6 +303,12 @@ def _converged(newton, point) -> bool:
         from vemkit.solvers.ssn_disk import disk_alignment
 
         residual = max(residual, disk_alignment(newton, point))
+        # and lambda in the unit disk to tol, as the independent check asks: neither the weighted C nor
+        # the rounding floor below sees |lambda| > 1 where w b is small against the body's forces
+        # (E = 2e9, k_tau = 3: |lambda| = 1 + 2.8e-4 was accepted after one step)
+        excess = float(np.max(newton.problem.contact.magnitude(point.lam) - 1.0, initial=0.0))
+        if excess > newton.tol:
+            return False
     if residual <= newton.tol:
         return True
     problem = newton.problem

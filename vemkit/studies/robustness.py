@@ -96,10 +96,11 @@ CASES = [
 ]
 
 
-def case_overrides(case: dict, n: int) -> list[str]:
-    """Scene overrides of a case on an n x n mesh (a mesh entry replaces the whole mesh section)."""
+def case_overrides(case: dict, n: int, family: str = "square") -> list[str]:
+    """Scene overrides of a case at n cells per unit length (a mesh entry replaces the whole mesh
+    section; ``family`` where the case names none: squares in 2D, the scene's own family in 3D)."""
     settings = dict(case["set"])
-    mesh = {"family": "square", **settings.pop(_MESH, {}), "n": int(n)}
+    mesh = {"family": family, **settings.pop(_MESH, {}), "n": int(n)}
     return [f"{_MESH}={json.dumps(mesh)}"] + [f"{k}={json.dumps(v)}" for k, v in settings.items()]
 
 
@@ -114,7 +115,8 @@ def run_case(scene, case: dict, solvers: dict, n: int, *, time_budget=None, chec
 
     result = {"case": case, "n_dofs": -1, "parameters": {}, "outcomes": {}}
     try:
-        case_scene = scene.with_overrides(case_overrides(case, n))
+        family = "square" if scene.dimension == 2 else scene.mesh_options.get("family", "hex")
+        case_scene = scene.with_overrides(case_overrides(case, n, family))
         result["parameters"] = case_parameters(case_scene)
         problem = scene_problem(case_scene)
         linear = None

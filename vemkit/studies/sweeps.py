@@ -53,6 +53,17 @@ QUANTITIES = {  # name: (long name, units)
     "tangential_force": ("resultant tangential contact stress sum_c w_c sigma_tau (all Gamma_C vertices)", "daN/mm"),
     "residual": ("worst independent check of the discrete conditions (vemkit.studies.robustness)", "1"),
 }
+#: a 3D body (SPEC §10): Gamma_C is a surface, so areas instead of lengths, forces instead of forces per
+#: unit depth, and the tangential force is the magnitude of the resultant vector sum_c w_c sigma_tau,c
+QUANTITIES_3D = {
+    "max_penetration": QUANTITIES["max_penetration"],
+    "contact_area": ("area of Gamma_C where u_nu - g_a > 0 (nodal weights)", "mm2"),
+    "stick_area": ("area of Gamma_C in contact and sticking (contact_state)", "mm2"),
+    "slip_area": ("area of Gamma_C in contact and slipping (contact_state)", "mm2"),
+    "normal_force": (QUANTITIES["normal_force"][0], "daN"),
+    "tangential_force": ("magnitude of the resultant tangential contact force |sum_c w_c sigma_tau,c|", "daN"),
+    "residual": QUANTITIES["residual"],
+}
 PROFILES = {  # name: (ContactState attribute or "multiplier", long name, units)
     "pressure": ("normal_pressure", "p_nu(u_nu - g_a) along Gamma_C", "daN/mm2"),
     "tangential_stress": ("tangential_stress", "sigma_tau = -p_tau lambda along Gamma_C", "daN/mm2"),
@@ -97,8 +108,8 @@ def _override(key, value) -> str:
 class _Point:
     """What one grid point produced: the outcome and, when converged, its quantities and profiles."""
 
-    def __init__(self, outcome: Outcome, n_dofs=-1, quantities=None, profiles=None, setup_time=0.0):
-        self.outcome, self.n_dofs, self.setup_time = outcome, n_dofs, setup_time
+    def __init__(self, outcome: Outcome, n_dofs=-1, quantities=None, profiles=None, setup_time=0.0, dimension=2):
+        self.outcome, self.n_dofs, self.setup_time, self.dimension = outcome, n_dofs, setup_time, dimension
         self.quantities, self.profiles = quantities or {}, profiles
 
 
@@ -117,16 +128,24 @@ def point_quantities(problem, outcome: Outcome):
     cb, sol = problem.contact, outcome.solution
     st = contact_state(problem, sol.u, sol.multiplier)
     w = cb.weight
+    measure = "area" if cb.dimension == 3 else "length"
+    if cb.dimension == 3:  # the resultant vector of w sigma_tau in space (components in the vertex bases)
+        stress = st.tangential_stress
+        tangential = float(
+            np.linalg.norm(np.sum(w[:, None] * (cb.tangent * stress[:, :1] + cb.tangent2 * stress[:, 1:]), axis=0))
+        )
+    else:
+        tangential = float(np.sum(w * st.tangential_stress))
     q = {
         "max_penetration": float(np.max(np.maximum(st.penetration, 0.0), initial=0.0)),
-        "contact_length": float(np.sum(w[st.penetration > 0.0])),
-        "stick_length": float(np.sum(w[st.state == STICK])),
-        "slip_length": float(np.sum(w[st.state == SLIP])),
+        f"contact_{measure}": float(np.sum(w[st.penetration > 0.0])),
+        f"stick_{measure}": float(np.sum(w[st.state == STICK])),
+        f"slip_{measure}": float(np.sum(w[st.state == SLIP])),
         "normal_force": _normal_force(problem, sol.u, st),
-        "tangential_force": float(np.sum(w * st.tangential_stress)),
+        "tangential_force": tangential,
         "residual": float(outcome.checks.get("worst", np.nan)),
     }
-    order = np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))
+    order = np.lexsort(tuple(cb.coords[:, axis] for axis in reversed(range(cb.dimension))))  # by x, then y (, z)
     values = {"multiplier": np.asarray(sol.multiplier, dtype=float)}
     profiles = {
         name: np.asarray(values.get(attr, getattr(st, attr, None)), dtype=float)[order]
@@ -134,17 +153,19 @@ def point_quantities(problem, outcome: Outcome):
     }
     profiles["state"] = np.asarray(st.state, dtype=np.int8)[order]
     profiles["x"], profiles["y"], profiles["w"] = cb.coords[order, 0], cb.coords[order, 1], cb.weight[order]
+    if cb.dimension == 3:
+        profiles["z"] = cb.coords[order, 2]
     return q, profiles
 
 
 def _contact_problem(problem, scene):
     """``problem`` with the contact law and gap of ``scene`` (K, load and mesh unchanged)."""
     from vemkit.contact.laws import ContactLaw
+    from vemkit.contact.problem import scene_gap
 
     normal, friction = scene.normal_compliance, scene.friction_bound
     law = ContactLaw(normal.k, normal.m, friction.k, friction.m)
-    gap = scene.gap_expression
-    contact = problem.contact.with_gap(lambda x, y: np.broadcast_to(gap(x, y), np.shape(x)))
+    contact = problem.contact.with_gap(scene_gap(scene))  # a foundation or an expression, 2D or 3D
     return replace(problem, law=law, contact=contact, info=dict(problem.info))
 
 
@@ -219,7 +240,7 @@ def _solve_point(group, problem, shared, values, linear_cache, time_budget, chec
     if not outcome.converged:
         return _Point(outcome, problem.n_dofs, setup_time=linear_setup)
     quantities, profiles = point_quantities(point_problem, outcome)
-    return _Point(outcome, problem.n_dofs, quantities, profiles, linear_setup)
+    return _Point(outcome, problem.n_dofs, quantities, profiles, linear_setup, problem.contact.dimension)
 
 
 def _coordinate(key, values):
@@ -246,12 +267,18 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
     n_dofs = np.full(shape, INT_FILL, np.int64)
     wall, setup = np.zeros(shape), np.zeros(shape)
     messages = np.full(shape, "", dtype=object)
-    quantities = {k: np.full(shape, np.nan) for k in QUANTITIES}
+    dimension = max((p.dimension for p in results.values()), default=2)
+    table = QUANTITIES_3D if dimension == 3 else QUANTITIES
+    quantities = {k: np.full(shape, np.nan) for k in table}
     profiles = [p.profiles for p in results.values() if p.profiles is not None]
     sizes = {p["x"].tobytes() + p["y"].tobytes() for p in profiles}
     keep_profiles = len(sizes) == 1
     n_c = len(profiles[0]["x"]) if keep_profiles else 0
-    profile_data = {k: np.full(shape + (n_c,), np.nan) for k in PROFILES}
+    # 3D: tangential profiles have two components in the vertex basis (contact_tangent, SPEC §10)
+    tangent_shape = (
+        {k: (2,) if dimension == 3 and np.ndim(profiles[0][k]) == 2 else () for k in PROFILES} if keep_profiles else {}
+    )
+    profile_data = {k: np.full(shape + (n_c,) + tangent_shape.get(k, ()), np.nan) for k in PROFILES}
     state = np.full(shape + (n_c,), INT_FILL, np.int8)
     for index, point in results.items():
         o = point.outcome
@@ -281,7 +308,7 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             "flag_meanings": "invalid valid",
         },
     )
-    for k, (long_name, units) in QUANTITIES.items():
+    for k, (long_name, units) in table.items():
         ds[k] = (dims, quantities[k], {"long_name": long_name, "units": units})
     ds["iterations"] = (dims, iterations, {"long_name": "nonlinear iterations (-1: unknown)"})
     ds["n_dofs"] = (dims, n_dofs, {"long_name": "free unknowns (-1: not assembled)"})
@@ -297,11 +324,23 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
         ds = ds.assign_coords(
             contact_x=("contact_node", first["x"], {"long_name": "x of the contact vertex", "units": "mm"}),
             contact_y=("contact_node", first["y"], {"long_name": "y of the contact vertex", "units": "mm"}),
-            contact_weight=("contact_node", first["w"], {"long_name": "nodal quadrature weight", "units": "mm"}),
+            contact_weight=(
+                "contact_node",
+                first["w"],
+                {"long_name": "nodal quadrature weight", "units": "mm2" if dimension == 3 else "mm"},
+            ),
         )
+        if dimension == 3:
+            ds = ds.assign_coords(
+                contact_z=("contact_node", first["z"], {"long_name": "z of the contact vertex", "units": "mm"})
+            )
         pdims = dims + ("contact_node",)
         for k, (_, long_name, units) in PROFILES.items():
-            ds[f"profile_{k}"] = (pdims, profile_data[k], {"long_name": long_name, "units": units})
+            extra = ("contact_tangent",) if tangent_shape.get(k) else ()
+            meta = {"long_name": long_name, "units": units}
+            if extra:
+                meta["comment"] = "components along the vertex's tangent basis (t1, t2) of the solution file (SPEC §10)"
+            ds[f"profile_{k}"] = (pdims + extra, profile_data[k], meta)
         ds["profile_state"] = (
             pdims,
             state,
@@ -319,7 +358,7 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             "grid": json.dumps({k: list(v) for k, v in grid.items()}),
             "points": int(np.prod(shape)),
             "converged_points": int(np.sum(status == 0)),
-            "profiles": "along Gamma_C (contact_node ordered by x, y)"
+            "profiles": f"along Gamma_C (contact_node ordered by {'x, y, z' if dimension == 3 else 'x, y'})"
             if keep_profiles
             else "omitted: the grid changes the contact nodes (mesh)"
             if sizes
