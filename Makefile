@@ -53,8 +53,8 @@ reproduce: $(GMSH_STAMP)
 DOCS_STAMP := $(VENV)/.installed-docs
 SPHINXOPTS ?= -W --keep-going -q
 
-$(DOCS_STAMP): pyproject.toml | $(STAMP)
-	$(BIN)/python -m pip install --quiet -e ".[docs]"
+$(DOCS_STAMP): pyproject.toml $(LOCK) | $(STAMP)
+	$(BIN)/python -m pip install --quiet -c $(LOCK) -e ".[docs]"
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP) $(NUMBA_STAMP)
@@ -118,7 +118,7 @@ format: $(STAMP)
 	$(BIN)/ruff format .
 
 # ---- lock (issue 23 item 8) -------------------------------------------------------------------
-# `make lock`: resolve pyproject.toml's dependencies and extras afresh in a throw-away venv (newest
+# `make lock`: resolve pyproject.toml's dependencies and extras (the docs extra too) afresh in a throw-away venv (newest
 # versions the package index serves within the bounds) and pin them in requirements.lock (pip freeze,
 # without vemkit itself). Then `make install` (the lock is newer than the venv's stamp) and `make test`
 # before committing the new lock.
@@ -128,7 +128,7 @@ lock:
 	rm -rf $(LOCK_VENV)
 	$(PYTHON) -m venv $(LOCK_VENV)
 	$(LOCK_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(LOCK_VENV)/bin/python -m pip install --quiet ".[$(EXTRAS)]"
+	$(LOCK_VENV)/bin/python -m pip install --quiet ".[$(EXTRAS),docs]"
 	{ echo "# The tested dependency versions (make lock; make install installs with them as constraints)."; \
 	  echo "# $$($(LOCK_VENV)/bin/python -c 'import platform, sys; print(f"Python {platform.python_version()} on {sys.platform}")'), $$(date -u +%Y-%m-%d)"; \
 	  $(LOCK_VENV)/bin/python -m pip freeze --exclude vemkit; } > $(LOCK).tmp
