@@ -13,7 +13,6 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import InputError, LinearSolveError, SceneError
-from vemkit.solvers.parallel_smoothing import finest_smoothers, parallel_operator, product
 
 DIRECT_LIMIT = 20_000  # "auto" picks the direct solver below this many unknowns (measured crossover)
 
@@ -23,7 +22,7 @@ def v_cycle(levels, coarse_solver, level, b):
     here = levels[level]
     x = np.zeros_like(b)
     here.presmoother(here.A, x, b)
-    coarse_b = here.R @ (b - product(here.A, x))
+    coarse_b = here.R @ (b - here.A @ x)
     if level == len(levels) - 2:
         coarse_x = coarse_solver(levels[-1].A, coarse_b)
     else:
@@ -50,9 +49,6 @@ def v_cycle_preconditioner(hierarchy):
     for here in levels[:-1]:  # the transfers too: BSR (1 x 3, 3 x 3) products cost 1.5 x CSR's, same sums
         here.P = here.P.tocsr()
         here.R = here.R if here.R.format == "csc" else here.R.tocsr()  # csc: P^T as a view of P
-    smoothers = finest_smoothers(levels[0].A.shape[0])  # both cores on the finest level's sweeps
-    if smoothers is not None and len(levels) > 1:
-        levels[0].presmoother, levels[0].postsmoother = smoothers
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
     return spla.LinearOperator(
@@ -162,9 +158,8 @@ class AMGSolver:
         def callback(xk):
             count[0] += 1
 
-        operator = parallel_operator(A)
         x, info = spla.cg(
-            operator, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback
+            A, b, x0=x0, rtol=tol, atol=0.0, maxiter=self.maxiter, M=self.preconditioner, callback=callback
         )
         self.iterations = count[0]
         self.residual = float(np.linalg.norm(b - A @ x) / bnorm)

@@ -79,10 +79,8 @@ class SumOperator(spla.LinearOperator):
         self.K, self.J = K, J.tocsr()
 
     def _matvec(self, x):
-        from vemkit.solvers.parallel_smoothing import product
-
         x = np.ravel(x)
-        return product(self.K, x) + self.J @ x
+        return self.K @ x + self.J @ x
 
     def _rmatvec(self, x):
         x = np.ravel(x)
