@@ -44,8 +44,9 @@ with logged(smk):
     ]
     text = (
         "# 3D manufactured convergence\n\nRelative errors of Pi u_h against the exact u "
-        "(config/scenes/3d/box_manufactured.yaml, extruded_manufactured.yaml); rates in h = 1/n and, "
-        "per DOF, in dofs^(-1/3).\n\n"
+        "(elasticity: config/scenes/3d/box_manufactured.yaml, extruded_manufactured.yaml; the cases "
+        "contact-<kind>-<family>: the manufactured frictional contact of config/scenes/3d/contact_<kind>"
+        "[_extruded].yaml, tests/manufactured_contact3d.py); rates in h = 1/n and, per DOF, in dofs^(-1/3).\n\n"
         + markdown_table(
             rows,
             ["case", *COLUMNS],
