@@ -117,16 +117,20 @@ def test_the_mesh_description_is_what_xugrid_builds(family):
 IMPORTED = """
 import sys
 from vemkit.cli import _in_process
-status = _in_process(["solve", sys.argv[1], "-o", sys.argv[2], "-q", "--set", "discretization.mesh.n=2"])
+status = _in_process(["solve", *sys.argv[1:], "-q"])
 heavy = ("xarray", "pandas", "xugrid", "dask", "scipy.spatial", "matplotlib", "meshio", "pyamg")
 print(status, " ".join(sorted(m for m in heavy if m in sys.modules)))
 """
 
 
-def test_the_command_line_solve_imports_no_xarray_nor_pandas(tmp_path):
-    run = subprocess.run(
-        [sys.executable, "-c", IMPORTED, str(PAPER), str(tmp_path / "out.nc")], capture_output=True, text=True
-    )
+@pytest.mark.parametrize("mesh", ["family", "file"])
+def test_the_command_line_solve_imports_no_xarray_nor_pandas(mesh, tmp_path):
+    """Neither with a mesh family nor with a mesh file (UGRID, read through netCDF4)."""
+    args = [str(PAPER), "-o", str(tmp_path / "out.nc"), "--set", "discretization.mesh.n=2"]
+    if mesh == "file":
+        mesh_description(build_mesh("square", 2)).write_netcdf4(tmp_path / "mesh.nc")
+        args += ["--set", f"discretization.mesh={{file: {tmp_path / 'mesh.nc'}}}"]
+    run = subprocess.run([sys.executable, "-c", IMPORTED, *args], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     status, *imported = run.stdout.split()
     assert status == "0" and imported == [], f"vemkit solve imported {imported}"
