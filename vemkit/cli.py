@@ -108,17 +108,17 @@ def cmd_solve(args) -> int:
     _check_resources(scene, args.max_dofs)  # before anything is built
 
     from vemkit.io.output_files import atomic_outputs
-    from vemkit.io.solution_file import check_finite
+    from vemkit.io.solution_file import check_finite, write_file
     from vemkit.studies.scene_solve import solve_scene
 
     progress = _Progress(not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
     try:
-        problem, solution, ds = solve_scene(scene, progress=progress, verify=True)
+        problem, solution, ds = solve_scene(scene, progress=progress, verify=True, dataset=False)
     finally:
         progress.close()
     check_finite(ds, args.output)
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
-        ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
+        write_file(ds, output_part)
         if vtu_part is not None:
             _write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:

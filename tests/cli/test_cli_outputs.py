@@ -95,15 +95,15 @@ def test_a_signal_at_any_moment_leaves_the_earlier_file_and_no_temporary(tmp_pat
 
 WRITE_INTERRUPTED = """
 import os, signal, sys, time
-import xarray as xr
 from vemkit.cli import main
-original = xr.Dataset.to_netcdf
+from vemkit.mesh.file_description import FileDescription  # the command's netCDF writer
+original = FileDescription.write_netcdf4
 def slow_write(self, path, *args, **kwargs):
     original(self, path, *args, **kwargs)
     os.kill(os.getpid(), signal.{signame})
     time.sleep(0.2)
     open(sys.argv[-1], "w").write("written, then signalled")
-xr.Dataset.to_netcdf = slow_write
+FileDescription.write_netcdf4 = slow_write
 sys.exit(main(sys.argv[1:-1]))
 """
 

@@ -132,14 +132,14 @@ IN_THE_WRITE = """
 original_run = cli._run
 def marked_run(argv):
     import time
-    import xarray as xr
-    write = xr.Dataset.to_netcdf
+    from vemkit.mesh.file_description import FileDescription  # the command's netCDF writer
+    write = FileDescription.write_netcdf4
     def slow_write(self, path, *args, **kwargs):
         write(self, path, *args, **kwargs)
         open(MARK, "w").close()
         time.sleep(0.5)
         open(MARK + ".written", "w").close()
-    xr.Dataset.to_netcdf = slow_write
+    FileDescription.write_netcdf4 = slow_write
     return original_run(argv)
 cli._run = marked_run
 """

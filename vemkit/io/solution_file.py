@@ -1,6 +1,9 @@
-"""A solved problem as a self-describing xarray Dataset, and its safe netCDF file (SPEC §6).
+"""A solved problem as a self-describing netCDF file or xarray Dataset, written safely (SPEC §6).
 
-The Dataset carries the UGRID-1.0 mesh topology ``mesh2d``, the nodal displacement ``u1``,
+:func:`solution_description` spells out the file once (a
+:class:`~vemkit.mesh.file_description.FileDescription`); :func:`solution_dataset` is its xarray
+Dataset (the Python API, the studies) and :func:`write_file` writes either (the command line writes
+the description directly: no xarray, no pandas at its start-up). The file carries the UGRID-1.0 mesh topology ``mesh2d``, the nodal displacement ``u1``,
 ``u2`` (``mesh2d_nNodes``), per-cell strain, stress and shear energy density
 (``mesh2d_nFaces``), the contact boundary quantities (``contact_node``), the solver history
 (``iteration``), and global attributes: the scene as YAML, solver, iterations, wall time, version.
@@ -11,45 +14,47 @@ so a failed or interrupted run leaves the target as it was.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 import vemkit
 from vemkit.exceptions import ResultError
 from vemkit.io.output_files import atomic_outputs
-from vemkit.mesh.files import mesh_to_ugrid_dataset, read_ugrid
+from vemkit.mesh.file_description import FileDescription
+from vemkit.mesh.files import mesh_description, read_ugrid
 from vemkit.vem.projection import shear_energy_density, stress
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 STATE_MEANINGS = "separated stick slip"
 
 
 def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> xr.Dataset:
+    """Everything a user needs from one solve as an xarray Dataset (:func:`solution_description`)."""
+    return solution_description(problem, solution, scene_yaml=scene_yaml, extra_attrs=extra_attrs).to_dataset()
+
+
+def solution_description(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> FileDescription:
     """Everything a user needs from one solve, described by its own attributes (a 3D body: the
     ``mesh3d`` file of ``vemkit.io.solution_file3d``)."""
     from vemkit.solvers.solution import contact_state
 
     if problem.space.element.dimension == 3:
-        from vemkit.io.solution_file3d import solution_dataset3d
+        from vemkit.io.solution_file3d import solution_description3d
 
-        return solution_dataset3d(problem, solution, scene_yaml=scene_yaml, extra_attrs=extra_attrs)
+        return solution_description3d(problem, solution, scene_yaml=scene_yaml, extra_attrs=extra_attrs)
     mesh = problem.mesh
     element_order = problem.space.order  # k of Section 3
     u = problem.vertex_displacement(solution.u)
     strain = problem.projected(solution.u).cell_mean_strain()
     sig = stress(strain, problem.lam, problem.mu)
-    ds = mesh_to_ugrid_dataset(mesh)
+    ds = mesh_description(mesh)
     node, face = "mesh2d_nNodes", "mesh2d_nFaces"
-    ds["u1"] = (
-        node,
-        u[:, 0],
-        {"long_name": "horizontal displacement", "units": "mm", "mesh": "mesh2d", "location": "node"},
-    )
-    ds["u2"] = (
-        node,
-        u[:, 1],
-        {"long_name": "vertical displacement", "units": "mm", "mesh": "mesh2d", "location": "node"},
-    )
+    for component, direction in ((1, "horizontal"), (2, "vertical")):
+        attrs = {"long_name": f"{direction} displacement", "units": "mm", "mesh": "mesh2d", "location": "node"}
+        ds.add(f"u{component}", node, u[:, component - 1], attrs)
     face_attrs = {
         "mesh": "mesh2d",
         "location": "face",
@@ -69,19 +74,20 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             "daN/mm2",
         ),
     ):
-        ds[name] = (face, values, dict(face_attrs, long_name=long_name, units=units))
+        ds.add(name, face, values, dict(face_attrs, long_name=long_name, units=units))
 
     cb = problem.contact
     if cb.size:
         st = contact_state(problem, solution.u, solution.multiplier)
         order = np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))
         c = "contact_node"
-        ds = ds.assign_coords(
-            contact_x=(c, cb.coords[order, 0], {"long_name": "x of contact vertex", "units": "mm"}),
-            contact_y=(c, cb.coords[order, 1], {"long_name": "y of contact vertex", "units": "mm"}),
+        for k, axis in enumerate("xy"):
+            attrs = {"long_name": f"{axis} of contact vertex", "units": "mm"}
+            ds.add(f"contact_{axis}", c, cb.coords[order, k], attrs, coordinate=True)
+        ds.add("contact_vertex", c, cb.vertices[order], {"long_name": "mesh2d node index of the contact vertex"})
+        ds.add(
+            "contact_weight", c, cb.weight[order], {"long_name": "nodal quadrature weight on Gamma_C", "units": "mm"}
         )
-        ds["contact_vertex"] = (c, cb.vertices[order], {"long_name": "mesh2d node index of the contact vertex"})
-        ds["contact_weight"] = (c, cb.weight[order], {"long_name": "nodal quadrature weight on Gamma_C", "units": "mm"})
         for name, values, long_name, units in (
             ("normal_pressure", st.normal_pressure, "p_nu(u_nu - g_a) (2.6)", "daN/mm2"),
             ("tangential_stress", st.tangential_stress, "sigma_tau = -p_tau lambda (2.7)-(2.8)", "daN/mm2"),
@@ -90,8 +96,9 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
             ("slip", st.slip, "tangential displacement u_tau", "mm"),
             ("penetration", st.penetration, "u_nu - g_a (> 0: penetration)", "mm"),
         ):
-            ds[name] = (c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
-        ds["contact_state"] = (
+            ds.add(name, c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
+        ds.add(
+            "contact_state",
             c,
             np.asarray(st.state, dtype=np.int8)[order],
             {
@@ -105,10 +112,10 @@ def solution_dataset(problem, solution, *, scene_yaml: str = "", extra_attrs=Non
     return with_solver_record(ds, problem, solution, scene_yaml, extra_attrs)
 
 
-def with_solver_record(ds: xr.Dataset, problem, solution, scene_yaml: str, extra_attrs=None) -> xr.Dataset:
+def with_solver_record(ds: FileDescription, problem, solution, scene_yaml: str, extra_attrs=None) -> FileDescription:
     """``ds`` with the solver history (``iteration``) and the global attributes of SPEC §6 (2D and 3D)."""
     for key, values in solution.history.items():
-        ds[f"history_{key}"] = ("iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
+        ds.add(f"history_{key}", "iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
     ds.attrs.update(
         {
             "Conventions": "CF-1.8 UGRID-1.0",
@@ -133,7 +140,7 @@ def with_solver_record(ds: xr.Dataset, problem, solution, scene_yaml: str, extra
 ENTITY_VARIABLES = {"edge": ("mesh2d_nEdges", "edge_mean", "edge"), "cell": ("mesh2d_nFaces", "face_mean", "face")}
 
 
-def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
+def _add_node_fields(ds: FileDescription, problem, solution) -> None:
     """The degrees of freedom on entities other than vertices (k = 2: the edge and cell means of
     Section 3.1) as edge and face variables; contact points are vertices or edge midpoints
     (``contact_vertex`` / ``contact_edge``, -1 where the other applies)."""
@@ -143,7 +150,8 @@ def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
     for entity in (e for e in space.element.layout if e != "vertex"):
         dimension, suffix, location = ENTITY_VARIABLES[entity]
         for c in (1, 2):
-            ds[f"u{c}_{suffix}"] = (
+            ds.add(
+                f"u{c}_{suffix}",
                 dimension,
                 values[space.node_range(entity), c - 1],
                 {
@@ -158,12 +166,14 @@ def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
     if cb.size and "edge" in space.element.layout:
         nv = problem.mesh.n_vertices
         node = cb.vertices[np.lexsort((cb.coords[:, 1], cb.coords[:, 0]))]
-        ds["contact_vertex"] = (
+        ds.add(
+            "contact_vertex",
             "contact_node",
             np.where(node < nv, node, -1),
             {"long_name": "mesh2d node index of the contact vertex (-1: an edge midpoint)"},
         )
-        ds["contact_edge"] = (
+        ds.add(
+            "contact_edge",
             "contact_node",
             np.where(node < nv, -1, node - nv),
             {"long_name": "mesh2d edge index of the contact edge midpoint (-1: a vertex)"},
@@ -173,13 +183,23 @@ def _add_node_fields(ds: xr.Dataset, problem, solution) -> None:
         )
 
 
-def check_finite(ds: xr.Dataset, what: str = "result") -> None:
+def check_finite(ds: xr.Dataset | FileDescription, what: str = "result") -> None:
     for name, var in ds.variables.items():
-        if np.issubdtype(var.dtype, np.floating) and not np.all(np.isfinite(var.values)):
+        values = np.asarray(var.values)
+        if np.issubdtype(values.dtype, np.floating) and not np.all(np.isfinite(values)):
             raise ResultError(f"{what}: variable {name} holds NaN or inf; nothing was written")
 
 
-def write_netcdf(ds: xr.Dataset, path) -> Path:
+def write_file(contents: xr.Dataset | FileDescription, path) -> None:
+    """Write a description through netCDF4 (no xarray) or a Dataset through xarray: the same file
+    for the same contents (:mod:`vemkit.mesh.file_description`)."""
+    if isinstance(contents, FileDescription):
+        contents.write_netcdf4(path)
+    else:
+        contents.to_netcdf(path, format="NETCDF4", engine="netcdf4")
+
+
+def write_netcdf(ds: xr.Dataset | FileDescription, path) -> Path:
     """Write ``ds`` to ``path`` (netCDF4) atomically: all or nothing, never NaN.
 
     The file is written next to ``path`` and renamed over it only when complete
@@ -189,7 +209,7 @@ def write_netcdf(ds: xr.Dataset, path) -> Path:
     check_finite(ds, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_outputs(path) as (temporary,):
-        ds.to_netcdf(temporary, format="NETCDF4", engine="netcdf4")
+        write_file(ds, temporary)
     return path
 
 
@@ -197,6 +217,8 @@ def read_solution(path):
     """(Mesh, Dataset) of a solution file written by ``vemkit solve`` or the workflow: a
     :class:`~vemkit.mesh.mesh.Mesh` (``mesh2d``) or a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
     (``mesh3d``, SPEC §10)."""
+    import xarray as xr
+
     with xr.open_dataset(path) as ds:
         ds = ds.load()
     if "mesh3d" in ds.variables:

@@ -1,6 +1,6 @@
 """The solution file of a 3D body (SPEC §10): the ``mesh3d`` topology and the fields of one solve.
 
-On top of :func:`vemkit.mesh.files3d.mesh3d_to_dataset` (nodes, polygonal faces, the signed faces
+On top of :func:`vemkit.mesh.files3d.mesh3d_description` (nodes, polygonal faces, the signed faces
 of each volume, the named boundary parts): node variables ``u1``, ``u2``, ``u3``
 (``mesh3d_nNodes``); volume variables ``strain_IJ`` and ``stress_IJ`` for IJ = 11, 22, 33, 12, 13,
 23 (tensor components of eps(Pi u_h), constant per cell for k = 1, and sigma = C eps) and
@@ -21,25 +21,26 @@ their components along t1 and t2 (the global attribute ``contact_tangent_basis``
 from __future__ import annotations
 
 import numpy as np
-import xarray as xr
 
-from vemkit.mesh.files3d import TOPOLOGY, mesh3d_to_dataset
+from vemkit.mesh.file_description import FileDescription
+from vemkit.mesh.files3d import TOPOLOGY, mesh3d_description
 from vemkit.vem.projection import COMPONENTS_3D, stress, von_mises
 
 AXES = ("x", "y", "z")
 
 
-def solution_dataset3d(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> xr.Dataset:
-    """The ``mesh3d`` Dataset of a solved 3D problem (module docstring)."""
+def solution_description3d(problem, solution, *, scene_yaml: str = "", extra_attrs=None) -> FileDescription:
+    """The ``mesh3d`` file of a solved 3D problem (module docstring)."""
     from vemkit.io.solution_file import with_solver_record
 
     u = problem.vertex_displacement(solution.u)
     strain = problem.projected(solution.u).cell_mean_strain()  # (M, 6), COMPONENTS_3D
     sigma = stress(strain, problem.lam, problem.mu)
-    ds = mesh3d_to_dataset(problem.mesh)
+    ds = mesh3d_description(problem.mesh)
     node, volume = f"{TOPOLOGY}_nNodes", f"{TOPOLOGY}_nVolumes"
     for c, axis in enumerate(AXES):
-        ds[f"u{c + 1}"] = (
+        ds.add(
+            f"u{c + 1}",
             node,
             u[:, c],
             {"long_name": f"displacement along {axis}", "units": "mm", "mesh": TOPOLOGY, "location": "node"},
@@ -50,20 +51,22 @@ def solution_dataset3d(problem, solution, *, scene_yaml: str = "", extra_attrs=N
         "comment": "of the projection Pi_1 (3.8): constant per cell (k = 1)",
     }
     for k, ij in enumerate(COMPONENTS_3D):
-        ds[f"strain_{ij}"] = (volume, strain[:, k], dict(cell, long_name=f"strain eps{ij} of Pi u", units="1"))
+        ds.add(f"strain_{ij}", volume, strain[:, k], dict(cell, long_name=f"strain eps{ij} of Pi u", units="1"))
     for k, ij in enumerate(COMPONENTS_3D):
-        ds[f"stress_{ij}"] = (
+        ds.add(
+            f"stress_{ij}",
             volume,
             sigma[:, k],
             dict(cell, long_name=f"stress sigma{ij} = C eps(Pi u)", units="daN/mm2"),
         )
-    ds["von_mises"] = (
+    ds.add(
+        "von_mises",
         volume,
         von_mises(sigma),
         dict(cell, long_name="von Mises stress sqrt(3/2 |dev sigma|^2)", units="daN/mm2"),
     )
     if problem.contact.size:
-        ds = _with_contact(ds, problem, solution)
+        _add_contact(ds, problem, solution)
     return with_solver_record(ds, problem, solution, scene_yaml, extra_attrs)
 
 
@@ -74,7 +77,7 @@ TANGENT_BASIS = (
 )
 
 
-def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
+def _add_contact(ds: FileDescription, problem, solution) -> None:
     """The contact node variables of the module docstring."""
     from vemkit.io.solution_file import STATE_MEANINGS
     from vemkit.solvers.solution import contact_state
@@ -83,14 +86,17 @@ def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
     st = contact_state(problem, solution.u, solution.multiplier)
     order = np.lexsort((cb.coords[:, 2], cb.coords[:, 1], cb.coords[:, 0]))
     c, t = "contact_node", "contact_tangent"
-    ds = ds.assign_coords(
-        {
-            f"contact_{a}": (c, cb.coords[order, k], {"long_name": f"{a} of contact vertex", "units": "mm"})
-            for k, a in enumerate(AXES)
-        }
-    )
-    ds["contact_vertex"] = (c, cb.vertices[order], {"long_name": "mesh3d node index of the contact vertex"})
-    ds["contact_weight"] = (
+    for k, a in enumerate(AXES):
+        ds.add(
+            f"contact_{a}",
+            c,
+            cb.coords[order, k],
+            {"long_name": f"{a} of contact vertex", "units": "mm"},
+            coordinate=True,
+        )
+    ds.add("contact_vertex", c, cb.vertices[order], {"long_name": "mesh3d node index of the contact vertex"})
+    ds.add(
+        "contact_weight",
         c,
         cb.weight[order],
         {"long_name": "nodal weight on Gamma_C: sum over its faces of int_F Pi^F phi_i ds", "units": "mm2"},
@@ -100,21 +106,23 @@ def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
         ("friction_bound", st.friction_bound, "p_tau(u_nu - g_a)", "daN/mm2"),
         ("penetration", st.penetration, "u_nu - g_a (> 0: penetration)", "mm"),
     ):
-        ds[name] = (c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
+        ds.add(name, c, np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
     for name, values, long_name, units in (
         ("tangential_stress", st.tangential_stress, "sigma_tau = -p_tau lambda (2.7)-(2.8), in (t1, t2)", "daN/mm2"),
         ("friction_multiplier", solution.multiplier, "lambda in the unit disk (5.3), in (t1, t2)", "1"),
         ("slip", st.slip, "tangential displacement u_tau, in (t1, t2)", "mm"),
     ):
-        ds[name] = ((c, t), np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
+        ds.add(name, (c, t), np.asarray(values, dtype=float)[order], {"long_name": long_name, "units": units})
     for name, vectors in (("normal", cb.normal), ("tangent1", cb.tangent), ("tangent2", cb.tangent2)):
         for k, a in enumerate(AXES):
-            ds[f"contact_{name}_{a}"] = (
+            ds.add(
+                f"contact_{name}_{a}",
                 c,
                 vectors[order, k],
                 {"long_name": f"{a} component of the unit {'outward normal nu' if name == 'normal' else name}"},
             )
-    ds["contact_state"] = (
+    ds.add(
+        "contact_state",
         c,
         np.asarray(st.state, dtype=np.int8)[order],
         {
@@ -124,4 +132,3 @@ def _with_contact(ds: xr.Dataset, problem, solution) -> xr.Dataset:
         },
     )
     ds.attrs["contact_tangent_basis"] = TANGENT_BASIS
-    return ds

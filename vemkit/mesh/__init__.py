@@ -4,7 +4,9 @@ Owns :class:`Mesh` (vertices and counter-clockwise polygons as plain arrays, nam
 parts), the mesh families on any domain (the body itself, :class:`Domain`, is input:
 ``vemkit.config.domain``) (``families``), the mesh checks (``checks``),
 triangulation of cells (``triangulate``), geometry helpers (``geometry``: the shoelace area and
-centroid, point binning) and mesh files (``files``: UGRID netCDF, gmsh .msh, VTU).
+centroid, point binning; ``close_points``: pairs of points within a radius), mesh files (``files``:
+UGRID netCDF, gmsh .msh, VTU) and the description of a netCDF file with its two sinks, netCDF4
+and xarray (``file_description``: the mesh and solution files are spelled out there once).
 Imports from vemkit: ``exceptions`` and ``config`` only.
 """
 

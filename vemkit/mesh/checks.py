@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from scipy.spatial import cKDTree
 
 from vemkit.exceptions import MeshError
+from vemkit.mesh.close_points import close_pairs
 from vemkit.mesh.geometry import bin_boxes
 from vemkit.mesh.mesh import Mesh
 
@@ -159,7 +159,7 @@ def _first_self_intersection(vertices, offsets, cell_vertices):
 
 # -- vertices -------------------------------------------------------------------------------
 def _check_vertices(mesh: Mesh, length_tol: float) -> None:
-    pairs = cKDTree(mesh.vertices).query_pairs(length_tol, output_type="ndarray")
+    pairs = close_pairs(mesh.vertices, length_tol)
     if pairs.size:
         a, b = sorted(int(x) for x in pairs[np.argmin(pairs.min(axis=1))])
         raise MeshError(

@@ -26,9 +26,9 @@ Everything is vectorized (numpy), so a mesh of 10^6 cells is checked in seconds.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from vemkit.exceptions import MeshError
+from vemkit.mesh.close_points import close_pairs
 from vemkit.mesh.polyhedral import PolyhedralMesh
 
 #: largest distance of a face vertex from the face's plane, relative to the face's diameter
@@ -222,7 +222,7 @@ def _check_vertices(mesh: PolyhedralMesh, tol: float) -> None:
     if unused.size:
         raise MeshError(f"vertex {unused[0]} belongs to no face; remove it (and renumber)")
     extent = float(np.max(np.ptp(mesh.vertices, axis=0)))
-    pairs = cKDTree(mesh.vertices).query_pairs(tol * max(extent, np.finfo(float).tiny), output_type="ndarray")
+    pairs = close_pairs(mesh.vertices, tol * max(extent, np.finfo(float).tiny))
     if pairs.size:
         a, b = sorted(int(x) for x in pairs[np.argmin(pairs.min(axis=1))])
         where = tuple(mesh.vertices[a].tolist())

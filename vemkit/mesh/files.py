@@ -12,7 +12,7 @@ Line elements carry the sides: each physical line group becomes the boundary par
 physical name, or by its number when it has none. Boundary edges in no group form the part
 ``untagged``; a tagged line that is not a boundary edge is refused.
 
-UGRID layout (what ``mesh_to_ugrid_dataset`` builds with xugrid, and ``read_ugrid`` reads):
+UGRID layout (what ``mesh_description`` writes, as xugrid would, and ``read_ugrid`` reads):
 
 - topology variable ``mesh2d`` (cf_role mesh_topology); its attribute ``vemkit_meta`` holds the
   mesh's ``meta`` as JSON text, ``vemkit_boundary_parts`` the boundary part names (JSON list);
@@ -32,13 +32,13 @@ import json
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from vemkit.config.domain import SIDE_NAME
 from vemkit.config.limits import check_resources, estimate_resources, memory_budget
 from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
+from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
 
@@ -56,40 +56,68 @@ def padded_face_nodes(mesh: Mesh, fill_value: int = FILL_VALUE) -> np.ndarray:
     return out
 
 
-def mesh_to_ugrid_dataset(mesh: Mesh) -> xr.Dataset:
-    """The mesh as a UGRID-1.0 ``xarray.Dataset`` (see the module docstring), ready to take node or face data."""
-    import xugrid  # lazily, as meshio below: 35-110 ms of import that only writing a mesh needs
-
-    grid = xugrid.Ugrid2d(
-        mesh.vertices[:, 0],
-        mesh.vertices[:, 1],
-        FILL_VALUE,
-        padded_face_nodes(mesh),
-        name=TOPOLOGY,
-        edge_node_connectivity=mesh.edges,
-    )
-    ds = grid.to_dataset()
+def mesh_description(mesh: Mesh) -> FileDescription:
+    """The mesh's UGRID-1.0 file (see the module docstring), ready to take node or face data: what
+    ``xugrid.Ugrid2d(...).to_dataset()`` gives (the same variables, attributes and order; a test
+    compares them), plus the boundary parts and the meta."""
+    t = TOPOLOGY
     names = list(mesh.boundary)
     for name in names:
         if not SIDE_NAME.fullmatch(name):
             raise ValueError(f"boundary part name {name!r}: use letters, digits, _ and - only")
-        ds[f"boundary_{name}"] = xr.DataArray(
+    out = FileDescription({"Conventions": "CF-1.9 UGRID-1.0"})
+    out.add(t, (), np.int64(0), _topology_attrs())
+    for name, dims, table in (
+        ("face", (f"{t}_nFaces", f"{t}_nMax_face_nodes"), padded_face_nodes(mesh)),
+        ("edge", (f"{t}_nEdges", "two"), mesh.edges),
+    ):
+        attrs = {"cf_role": f"{name}_node_connectivity", "start_index": 0, "_FillValue": FILL_VALUE}
+        out.add(f"{t}_{name}_nodes", dims, np.asarray(table, dtype=np.int64), attrs)
+    for k, axis in enumerate("xy"):
+        attrs = {"standard_name": f"projection_{axis}_coordinate"}
+        out.add(f"{t}_node_{axis}", f"{t}_nNodes", mesh.vertices[:, k], attrs, coordinate=True)
+    for name in names:
+        out.add(
+            f"boundary_{name}",
+            (f"boundary_{name}_nEdges", "two"),
             mesh.boundary[name],
-            dims=(f"boundary_{name}_nEdges", "two"),
-            attrs={
+            {
                 "long_name": f"boundary part {name}: edges as vertex pairs, counter-clockwise",
                 "start_index": 0,
-                "mesh": TOPOLOGY,
+                "mesh": t,
             },
         )
-    ds[TOPOLOGY].attrs["vemkit_boundary_parts"] = json.dumps(names)
-    ds[TOPOLOGY].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=json_scalar)
-    return ds
+    out[t].attrs["vemkit_boundary_parts"] = json.dumps(names)
+    out[t].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=json_scalar)
+    return out
+
+
+def _topology_attrs() -> dict:
+    """The attributes of xugrid's topology variable (UGRID-1.0 ``mesh_topology``)."""
+    t = TOPOLOGY
+    return {
+        "cf_role": "mesh_topology",
+        "long_name": "Topology data of 2D mesh",
+        "topology_dimension": 2,
+        "node_dimension": f"{t}_nNodes",
+        "edge_dimension": f"{t}_nEdges",
+        "face_dimension": f"{t}_nFaces",
+        "max_face_nodes_dimension": f"{t}_nMax_face_nodes",
+        "edge_node_connectivity": f"{t}_edge_nodes",
+        "face_node_connectivity": f"{t}_face_nodes",
+        "node_coordinates": f"{t}_node_x {t}_node_y",
+        "name": t,
+    }
+
+
+def mesh_to_ugrid_dataset(mesh: Mesh):
+    """The mesh as a UGRID-1.0 ``xarray.Dataset`` (:func:`mesh_description`)."""
+    return mesh_description(mesh).to_dataset()
 
 
 def write_ugrid(mesh: Mesh, path) -> None:
     """Write the mesh as a UGRID-1.0 netCDF4 file."""
-    mesh_to_ugrid_dataset(mesh).to_netcdf(Path(path), format="NETCDF4")
+    mesh_description(mesh).write_netcdf4(path)
 
 
 def read_ugrid(path) -> Mesh:
@@ -97,19 +125,22 @@ def read_ugrid(path) -> Mesh:
 
     Only the variables of the mesh are read (node coordinates, face table, boundary parts), never
     the rest of the file (a solution file's fields)."""
-    with xr.open_dataset(Path(path), mask_and_scale=False) as ds:
-        topologies = [v for v in ds.variables if ds[v].attrs.get("cf_role") == "mesh_topology"]
+    import netCDF4  # not xarray: 0.3-0.6 s of a command's start-up
+
+    with netCDF4.Dataset(Path(path)) as nc:
+        nc.set_auto_maskandscale(False)  # the stored values, as xarray's mask_and_scale=False
+        topologies = [v for v in nc.variables if _attrs(nc[v]).get("cf_role") == "mesh_topology"]
         if len(topologies) != 1:
             raise ValueError(f"{path}: expected one UGRID mesh topology variable, found {topologies or 'none'}")
-        topo = ds[topologies[0]].attrs
+        topo = _attrs(nc[topologies[0]])
         x_name, y_name = topo["node_coordinates"].split()
-        faces = ds[topo["face_node_connectivity"]]
-        fill = faces.attrs.get("_FillValue", FILL_VALUE)
-        start = int(faces.attrs.get("start_index", 0))
-        table = np.asarray(faces.values, dtype=np.int64)
-        vertices = np.stack([ds[x_name].values, ds[y_name].values], axis=1).astype(np.float64)
+        faces = nc[topo["face_node_connectivity"]]
+        fill = _attrs(faces).get("_FillValue", FILL_VALUE)
+        start = int(_attrs(faces).get("start_index", 0))
+        table = np.asarray(faces[...], dtype=np.int64)
+        vertices = np.stack([nc[x_name][...], nc[y_name][...]], axis=1).astype(np.float64)
         names = json.loads(topo.get("vemkit_boundary_parts", "[]"))
-        boundary = {name: np.asarray(ds[f"boundary_{name}"].values, dtype=np.int64) for name in names}
+        boundary = {name: np.asarray(nc[f"boundary_{name}"][...], dtype=np.int64) for name in names}
         try:
             meta = json.loads(topo.get("vemkit_meta", "{}"))
         except ValueError:
@@ -124,6 +155,11 @@ def read_ugrid(path) -> Mesh:
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
     cell_vertices = table[valid] - start
     return Mesh(vertices, offsets, cell_vertices, boundary, meta)
+
+
+def _attrs(variable) -> dict:
+    """A netCDF4 variable's attributes by name."""
+    return {key: variable.getncattr(key) for key in variable.ncattrs()}
 
 
 def write_vtu(mesh: Mesh, path, point_data: dict | None = None, cell_data: dict | None = None) -> None:

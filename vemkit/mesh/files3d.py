@@ -1,7 +1,7 @@
 """3D mesh files (SPEC §10): the ``mesh3d`` UGRID-style netCDF topology (round trip), VTU with VTK
 polyhedron cells (type 42, for ParaView) and gmsh ``.msh`` 3D meshes (read, through meshio).
 
-netCDF layout (``mesh3d_to_dataset`` / ``read_ugrid3d``):
+netCDF layout (``mesh3d_description`` / ``read_ugrid3d``):
 
 - ``mesh3d``: the topology variable, ``cf_role = "mesh_topology"``, ``topology_dimension = 3``,
   ``node_coordinates``, ``face_node_connectivity``, ``volume_face_connectivity``; ``vemkit_meta``
@@ -31,16 +31,20 @@ from __future__ import annotations
 import base64
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from vemkit.config.domain import SIDE_NAME
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
+from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.files import json_scalar
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import csr_rows, from_face_soup
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 TOPOLOGY = "mesh3d"
 FACE_FILL = -1
@@ -48,50 +52,58 @@ VOLUME_FILL = np.iinfo(np.int64).min
 VTK_POLYHEDRON = 42
 
 
-def mesh3d_to_dataset(mesh: PolyhedralMesh) -> xr.Dataset:
-    """The ``mesh3d`` topology of the module doc as an xarray Dataset."""
+def mesh3d_description(mesh: PolyhedralMesh) -> FileDescription:
+    """The ``mesh3d`` topology of the module doc, ready to take node or volume data."""
     t = TOPOLOGY
     faces = csr_rows(mesh.face_offsets, mesh.face_vertices, FACE_FILL)
     volumes = csr_rows(mesh.cell_offsets, mesh.cell_faces, VOLUME_FILL)
-    data = {f"{t}_node_{a}": ((f"{t}_nNodes",), mesh.vertices[:, k]) for k, a in enumerate("xyz")}
-    data[f"{t}_face_nodes"] = (
+    out = FileDescription()
+    for k, a in enumerate("xyz"):
+        out.add(f"{t}_node_{a}", f"{t}_nNodes", mesh.vertices[:, k])
+    out.add(
+        f"{t}_face_nodes",
         (f"{t}_nFaces", f"{t}_nMax_face_nodes"),
         faces,
         {"cf_role": "face_node_connectivity", "start_index": 0},
+        encoding={"_FillValue": FACE_FILL},
     )
-    data[f"{t}_volume_faces"] = (
+    out.add(
+        f"{t}_volume_faces",
         (f"{t}_nVolumes", f"{t}_nMax_volume_faces"),
         volumes,
         {"cf_role": "volume_face_connectivity", "start_index": 0, "orientation": "outward; -(f+1) is face f reversed"},
+        encoding={"_FillValue": VOLUME_FILL},
     )
     for name, part in mesh.boundary.items():
-        data[f"{t}_boundary_{name}"] = ((f"{t}_boundary_{name}_nFaces",), np.asarray(part, np.int64))
-    ds = xr.Dataset(data)
-    ds[f"{t}_face_nodes"].encoding["_FillValue"] = FACE_FILL
-    ds[f"{t}_volume_faces"].encoding["_FillValue"] = VOLUME_FILL
-    ds[t] = xr.DataArray(
-        np.int32(0),
-        attrs={
-            "cf_role": "mesh_topology",
-            "topology_dimension": 3,
-            "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z",
-            "face_node_connectivity": f"{t}_face_nodes",
-            "volume_face_connectivity": f"{t}_volume_faces",
-            "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
-            "vemkit_boundary_parts": json.dumps(list(mesh.boundary)),
-        },
-    )
-    return ds
+        out.add(f"{t}_boundary_{name}", f"{t}_boundary_{name}_nFaces", np.asarray(part, np.int64))
+    topology = {
+        "cf_role": "mesh_topology",
+        "topology_dimension": 3,
+        "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z",
+        "face_node_connectivity": f"{t}_face_nodes",
+        "volume_face_connectivity": f"{t}_volume_faces",
+        "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
+        "vemkit_boundary_parts": json.dumps(list(mesh.boundary)),
+    }
+    out.add(t, (), np.int32(0), topology)
+    return out
+
+
+def mesh3d_to_dataset(mesh: PolyhedralMesh):
+    """The ``mesh3d`` topology as an xarray Dataset (:func:`mesh3d_description`)."""
+    return mesh3d_description(mesh).to_dataset()
 
 
 def write_ugrid3d(mesh: PolyhedralMesh, path) -> None:
-    mesh3d_to_dataset(mesh).to_netcdf(Path(path), format="NETCDF4")
+    mesh3d_description(mesh).write_netcdf4(path)
 
 
 def read_ugrid3d(path) -> PolyhedralMesh:
     """The validated mesh of a ``mesh3d`` netCDF file; MeshError naming the file otherwise."""
     path = Path(path)
     t = TOPOLOGY
+    import xarray as xr
+
     try:
         with xr.open_dataset(path, mask_and_scale=False, decode_times=False) as ds:
             if t not in ds.variables:

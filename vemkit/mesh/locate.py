@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from scipy.spatial import cKDTree
 
 from vemkit.mesh.geometry import bin_boxes
 from vemkit.mesh.mesh import Mesh
@@ -95,5 +94,7 @@ def nearest_cells(mesh: Mesh, points: np.ndarray, within_diameter: bool = True) 
     if points.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
     means = np.add.reduceat(mesh.vertices[mesh.cell_vertices], mesh.cell_offsets[:-1]) / mesh.cell_sizes[:, None]
+    from scipy.spatial import cKDTree  # lazily: scipy.spatial is 0.1-0.3 s of a start-up
+
     distance, nearest = cKDTree(means).query(points)
     return np.where(distance <= mesh.cell_diameters[nearest], nearest, -1) if within_diameter else nearest

@@ -1,4 +1,4 @@
-"""One solve, from a validated scene to a result Dataset: scene -> mesh -> problem -> solver -> Dataset.
+"""One solve, from a validated scene to a result Dataset (or file description): scene -> mesh -> problem -> solver -> Dataset.
 
 Before any mesh is built, :func:`vemkit.config.limits.check_scene_resources` predicts cells, DOFs
 and peak memory from the scene alone and refuses a request beyond the limits. With ``verify=True`` a solve counts only if the independent
@@ -11,7 +11,7 @@ from __future__ import annotations
 from vemkit.config.expressions import vector_field
 from vemkit.contact.problem import scene_problem
 from vemkit.exceptions import MeshError, ResultError, VerificationError
-from vemkit.io.solution_file import solution_dataset
+from vemkit.io.solution_file import solution_description
 from vemkit.mesh.mesh import Mesh
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.verification import CHECK_KEYS, verify_solution
@@ -60,11 +60,13 @@ def mesh_family(mesh) -> str:
     return family
 
 
-def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False):
+def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False, dataset: bool = True):
     """Solve a scene; returns (problem, solution, dataset).
 
     ``verify``: raise VerificationError unless the independent check meets
     :func:`check_tolerance`; the dataset then records ``check_worst`` and ``check_tolerance``.
+    ``dataset=False``: the solution file's :class:`~vemkit.mesh.file_description.FileDescription`
+    instead of its xarray Dataset (the command line: xarray and pandas are never imported).
     """
     problem = scene_problem(scene, mesh)
     if problem.mesh.n_cells == 0 or problem.n_dofs == 0:
@@ -83,10 +85,10 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
         )
     try:
         with floating_point_errors_raise():
-            ds = solution_dataset(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
+            contents = solution_description(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
     except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
         raise ResultError(
             f"the stresses of the solution overflow double precision ({error}); "
             "rescale the units of the scene (E, k, tractions)"
         ) from None
-    return problem, solution, ds
+    return problem, solution, contents.to_dataset() if dataset else contents

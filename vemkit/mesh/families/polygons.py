@@ -17,9 +17,9 @@ import numpy as np
 import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from vemkit.config.domain import PolygonalDomain
+from vemkit.mesh.close_points import close_pairs
 from vemkit.mesh.geometry import bin_boxes, counter_clockwise
 from vemkit.mesh.mesh import Mesh
 
@@ -38,7 +38,7 @@ def merged_mesh(cells: Pieces, tol: float, kept: list | None = None) -> Mesh:
     Pieces that collapse to fewer than 3 points are dropped; ``kept`` (a list), if given, receives
     the boolean mask of the pieces that became cells."""
     used = np.flatnonzero(np.bincount(cells.refs, minlength=cells.pool.shape[0]))  # np.unique, faster
-    pairs = cKDTree(cells.pool[used]).query_pairs(tol, output_type="ndarray")
+    pairs = close_pairs(cells.pool[used], tol)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(used.size, used.size))
     _, component = connected_components(graph, directed=False)
     # every component is represented by its first (lowest) member: earlier pool points win
