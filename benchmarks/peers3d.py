@@ -16,7 +16,12 @@ that `vemkit mesh --scene` wrote (E = 1000, nu = 0.3):
               and the gap P1 on it) and GetFEM with the face rule of IM_TETRAHEDRON(5) (the same
               7 points), kn*pos_part(u.Normal - gap)*(Test_u.Normal) and the gap interpolated P1
               from its vertex values; GetFEM's Newton (its default line search) with MUMPS at every
-              size, vemkit ssn (linear solver auto: direct up to 20 000 unknowns, AMG-CG above).
+              size, vemkit ssn (linear solver auto: direct up to 20 000 unknowns, AMG-CG above);
+  friction    the same box, its top also moved sideways by SHIFT, with Coulomb's law on the
+              compliance pressure, p_tau = COULOMB KN t_+ (vemkit friction k = COULOMB KN, m = 1),
+              the nodal rule (GetFEM IM_NC(3, 1): the vertex rule |F|/3 on every face, vemkit's nodal
+              weights on triangles) and in GetFEM the friction stress sig_t = p_tau lam as a P1
+              field on the bottom with sig_t = Ball_projection(sig_t + r u_T, p_tau) (getfem_solve.py).
 vemkit: `vemkit solve`, tol 1e-12. Each solve is its own process (wall time and peak RSS by wait4).
 Writes benchmarks/out/peers3d.{json,md,png}.
 """
@@ -43,8 +48,11 @@ from _common import MACHINE, OUT, write_report
 E, NU = 1000.0, 0.3
 LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
 TRACTION = [0.0, 0.0, -1.0]
-PROBLEMS = ("elasticity", "compliance")
+PROBLEMS = ("elasticity", "compliance", "friction")
 DELTA, KN = 0.01, 1000.0  # the top face's push and the normal stiffness p(t) = KN t_+
+SHIFT = [0.004, 0.002]  # friction: the top face also moved sideways
+COULOMB = 0.3  # friction: p_tau = COULOMB KN t_+ (m_tau = 1), Coulomb's law on the compliance pressure
+TANGENTS = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]  # vemkit's (t1, t2) on the bottom, nu = (0, 0, -1)
 GAP = "0.02*((x - 0.4)**2 + (y - 0.55)**2)"  # of x, y (z = 0 on Gamma_C), >= 0
 #: spsolve up to here, AMG-CG above: in 3D the direct solver's fill grows fast (vemkit's own "auto"
 #: switches at 20 000 unknowns, vemkit.solvers.linear.DIRECT_LIMIT; SuperLU at 1e5 3D DOFs takes minutes)
@@ -61,11 +69,18 @@ def scene(mesh_entry: dict, problem: str = "elasticity") -> dict:
         "discretization": {"mesh": mesh_entry},
         "solver": {"tol": 1e-12},
     }
-    if problem == "compliance":
-        data["boundary"] = {"dirichlet": {"top": [0.0, 0.0, -DELTA]}, "contact": ["bottom"]}
+    if problem != "elasticity":
+        data["boundary"] = {"dirichlet": {"top": top_displacement(problem)}, "contact": ["bottom"]}
         data["contact"] = {"gap": GAP, "normal": {"k": KN, "m": 1.0}, "friction": {"k": 0.0, "m": 0.0}}
         data["discretization"].update(contact_quadrature="gauss", contact_gauss_points=3)
+    if problem == "friction":
+        data["contact"]["friction"] = {"k": COULOMB * KN, "m": 1.0}
+        data["discretization"].update(contact_quadrature="nodal")
     return data
+
+
+def top_displacement(problem: str) -> list[float]:
+    return [*(SHIFT if problem == "friction" else [0.0, 0.0]), -DELTA]
 
 
 def write_mesh(n: int, work: Path) -> Path:
@@ -103,14 +118,23 @@ def getfem_params(problem: str) -> dict:
     common = {"problem": problem, "lam": LAM, "mu": MU, "max_res": 1e-10, "lsolver": "mumps"}
     if problem == "elasticity":
         return common | {"dirichlet": ["bottom"], "neumann": "top", "traction_affine": [[t, 0, 0, 0] for t in TRACTION]}
-    return common | {
+    contact = {
         "dirichlet": ["top"],
-        "dirichlet_values": {"top": [0.0, 0.0, -DELTA]},
+        "dirichlet_values": {"top": top_displacement(problem)},
         "contact": "bottom",
         "kn": KN,
         "quadrature": "gauss",
         "gauss_points": 3,
     }
+    if problem == "friction":  # the vertex rule IM_NC(3, 1) on faces: vemkit's nodal weights on triangles
+        contact |= {
+            "quadrature": "nodal",
+            "kt": COULOMB * KN,
+            "friction_m": 1,
+            "tangents": TANGENTS,
+            "r_friction": 100.0,
+        }
+    return common | contact
 
 
 def gap_at(vertices: np.ndarray) -> np.ndarray:
@@ -128,7 +152,7 @@ def run_peer(peer: str, problem: str, n: int, case: dict, work: Path) -> tuple[n
         command = [sys.executable, str(PEERS / "skfem3d_solve.py")]
     else:
         params = getfem_params(problem)
-        arrays = case | ({"gap": gap_at(case["vertices"])} if problem == "compliance" else {})
+        arrays = case | ({"gap": gap_at(case["vertices"])} if problem != "elasticity" else {})
         command = [SYSTEM_PYTHON, str(PEERS / "getfem_solve.py")]
     np.savez(case_path, params=json.dumps(params), **arrays)
     record = measured(command + [str(case_path), str(result)])
@@ -169,9 +193,11 @@ def _tetrahedra(faces: np.ndarray, volumes: np.ndarray) -> np.ndarray:
     return tets.astype(np.int64)
 
 
-def peers_for(problem: str, getfem_reason: str | None) -> tuple:
-    """scikit-fem on elasticity; GetFEM on both unless it is missing."""
-    return (("skfem",) if problem == "elasticity" else ()) + (() if getfem_reason else ("getfem",))
+def peers_for(problem: str, getfem_reason: str | None, dofs: int = 0, getfem_contact_max: int = 10**9) -> tuple:
+    """scikit-fem on elasticity; GetFEM on every problem unless it is missing, or a contact problem
+    above the limit (its Newton refactorizes the MUMPS matrix at every step)."""
+    too_big = problem != "elasticity" and dofs > getfem_contact_max
+    return (("skfem",) if problem == "elasticity" else ()) + (() if getfem_reason or too_big else ("getfem",))
 
 
 def main() -> None:
@@ -179,15 +205,19 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="n = 4, 8 (a smoke test)")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 48])
     parser.add_argument("--problems", nargs="+", default=list(PROBLEMS), choices=PROBLEMS)
+    parser.add_argument("--getfem-contact-max-dofs", type=int, default=10**9, help="no GetFEM contact solves above")
+    parser.add_argument("--resume", action="store_true", help="keep the cases of benchmarks/out/peers3d.json")
     args = parser.parse_args()
     getfem_reason = getfem_missing()
     work = Path(tempfile.mkdtemp(prefix="vemkit-peers3d-"))
     for problem in args.problems:
         run_case(3, work, problem, ())  # Numba's on-disk cache compiled before anything is timed
-    rows: list[dict] = []
+    rows: list[dict] = json.loads((OUT / "peers3d.json").read_text())["rows"] if args.resume else []
+    done = {(r["n"], r["problem"]) for r in rows}
     for n in [4, 8] if args.quick else args.sizes:
-        for problem in args.problems:
-            rows += run_case(n, work, problem, peers_for(problem, getfem_reason))
+        for problem in (p for p in args.problems if (n, p) not in done):
+            chosen = peers_for(problem, getfem_reason, 3 * (n + 1) ** 3, args.getfem_contact_max_dofs)
+            rows += run_case(n, work, problem, chosen)
             report(rows, getfem_reason, quiet=True)  # after every case: a stopped run keeps its rows
     shutil.rmtree(work)
     report(rows, getfem_reason)
@@ -208,7 +238,7 @@ def report(rows: list[dict], getfem_reason: str | None, quiet: bool = False) -> 
     for r in rows:
         diff = f"{r['rel_diff_to_vemkit']:.1e}" if "rel_diff_to_vemkit" in r else "–"
         ratio = f"{r['vemkit_over_peer_wall']:.2f}" if "vemkit_over_peer_wall" in r else "–"
-        steps = r.get("iterations") if r["problem"] == "compliance" else "–"
+        steps = r.get("iterations") if r["problem"] != "elasticity" else "–"
         lines.append(
             f"| {r['n']} | {r['cells']:,} | {r['dofs']:,} | {r['problem']} | {r['code']} | {r['solver']} | "
             f"{steps} | {diff} | {r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | {r['assembly_s']:.2f} | "
@@ -231,7 +261,7 @@ def figure(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(PROBLEMS), figsize=(10, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, len(PROBLEMS), figsize=(13, 4.2), sharey=True)
     for ax, problem in zip(axes, PROBLEMS):
         for code, color in (("vemkit", "C0"), ("skfem", "C1"), ("getfem", "C2")):
             own = sorted((r for r in rows if r["problem"] == problem and r["code"] == code), key=lambda r: r["dofs"])

@@ -6,10 +6,10 @@ CASE.npz (written by benchmarks/peers.py or peers3d.py from the mesh file vemkit
 (n, d), `triangles` (m, 3) in 2D or `tetrahedra` (m, 4) in 3D, one (k, d) array of the vertices of
 every boundary edge / face per side (`side_<name>`), optionally `gap` (n,) vertex values of the gap
 (interpolated P1 on Gamma_C, as vemkit's gauss rule interpolates it), and `params` (JSON text):
-problem "elasticity" | "compliance" | "friction" (2D), lam, mu, traction_affine (one row [a, b_1 ..
+problem "elasticity" | "compliance" | "friction", lam, mu, traction_affine (one row [a, b_1 ..
 b_d] per component: t_i = a + b . x on the side `neumann`; no `neumann`: no traction), dirichlet
 (sides with u = 0 unless `dirichlet_values` gives the side's vector), contact, gap (a number unless
-the CASE has vertex gaps), kn, kt, r_friction, quadrature ("gauss" with gauss_points, or "nodal"),
+the CASE has vertex gaps), kn, kt, friction_m (0 or 1), tangents (3D friction), r_friction, quadrature ("gauss" with gauss_points, or "nodal"),
 max_res, lsolver ("mumps", "superlu" or "auto": MUMPS when this GetFEM has it, else SuperLU).
 OUT.npz: `u` (n, d) at the CASE vertices, `info` (JSON text: times, Newton iterations, linear solver).
 
@@ -111,24 +111,36 @@ def add_contact(model, mesh, regions, p, case, to_gf):
         model.add_initialized_data("gap", [p["gap"]])
     model.add_nonlinear_term(mim_c, "kn*pos_part(u.Normal - gap)*(Test_u.Normal)", region)
     if p["problem"] == "friction":
-        add_tresca_friction(model, mesh, mim_c, region, p)
+        add_friction(model, mesh, mim_c, region, p)
 
 
-def add_tresca_friction(model, mesh, mim_c, region, p):
-    """The friction bound kt independent of u (vemkit's m_tau = 0), with a nodal multiplier.
+def add_friction(model, mesh, mim_c, region, p):
+    """The friction term with a nodal multiplier, under IM_NC(d, 1) (the vertex rule on edges / faces)
+    vertex by vertex: vemkit's nodal problem.
 
-    lam_t in [-1, 1] on the contact side (P1 trace), friction stress kt*lam_t; the inclusion
-    lam_t in Sign(u.T) as the fixed point lam_t = P_[-1,1](lam_t + r u.T), tested with P1.
-    Under IM_NC(2,1) (trapezoid) both terms are vertex by vertex: vemkit's nodal problem.
+    2D, vemkit's m_tau = 0 (p_tau = kt): lam_t in [-1, 1] on the contact side (P1 trace), friction
+    stress kt*lam_t; the inclusion lam_t in Sign(u.T) as the fixed point lam_t = P_[-1,1](lam_t + r u.T),
+    tested with P1. 3D: the friction stress itself, sig_t = p_tau lam_t (two components in the
+    tangents t1, t2 of params "tangents", vemkit's basis of a flat Gamma_C), with p_tau = kt (m_tau = 0)
+    or kt (u.Normal - gap)_+ (friction_m = 1: Coulomb's law on the normal-compliance pressure), and
+    sig_t = Ball_projection(sig_t + r u_T, p_tau): also determined where p_tau = 0 (out of contact).
     """
-    model.add_fem_variable("lam_t", multiplier_fem(mesh, region, p))
     model.add_initialized_data("kt", [p["kt"]])
     model.add_initialized_data("r_t", [p["r_friction"]])
-    tangent = "[-Normal(2), Normal(1)]"  # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
-    model.add_nonlinear_term(mim_c, f"kt*lam_t*(Test_u.{tangent})", region)
-    z = f"(lam_t + r_t*(u.{tangent}))"
-    projected = f"({z} - pos_part({z} - 1) + pos_part(-{z} - 1))"
-    model.add_nonlinear_term(mim_c, f"(lam_t - {projected})*Test_lam_t/r_t", region)
+    if mesh.dim() == 2:
+        model.add_fem_variable("lam_t", multiplier_fem(mesh, region, p))
+        tangent = "[-Normal(2), Normal(1)]"  # (1, 0) on the bottom, nu = (0, -1): vemkit's tau
+        model.add_nonlinear_term(mim_c, f"kt*lam_t*(Test_u.{tangent})", region)
+        z = f"(lam_t + r_t*(u.{tangent}))"
+        projected = f"({z} - pos_part({z} - 1) + pos_part(-{z} - 1))"
+        model.add_nonlinear_term(mim_c, f"(lam_t - {projected})*Test_lam_t/r_t", region)
+        return
+    model.add_fem_variable("sig_t", multiplier_fem(mesh, region, p))
+    bound = "kt*pos_part(u.Normal - gap)" if p.get("friction_m", 0) == 1 else "kt"
+    t1, t2 = (f"[{a!r}, {b!r}, {c!r}]" for a, b, c in p["tangents"])
+    model.add_nonlinear_term(mim_c, f"sig_t(1)*(Test_u.{t1}) + sig_t(2)*(Test_u.{t2})", region)
+    z = f"(sig_t + r_t*[u.{t1}, u.{t2}])"
+    model.add_nonlinear_term(mim_c, f"(sig_t - Ball_projection({z}, {bound})).Test_sig_t/r_t", region)
 
 
 def linear_solver(requested):
@@ -151,8 +163,8 @@ def multiplier_fem(mesh, region, p):
     u is fixed there, so their friction rows would be empty (a singular tangent matrix); vemkit
     eliminates the same vertices, their friction terms never reach the solved equations.
     """
-    full = gf.MeshFem(mesh, 1)
-    full.set_fem(gf.Fem("FEM_PK(2,1)"))
+    full = gf.MeshFem(mesh, mesh.dim() - 1)
+    full.set_fem(gf.Fem(f"FEM_PK({mesh.dim()},1)"))
     dofs = set(full.basic_dof_on_region(region))
     for side_region in p["dirichlet_regions"]:
         dofs -= set(full.basic_dof_on_region(side_region))
