@@ -50,8 +50,8 @@ LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
 TRACTION = [0.0, 0.0, -1.0]
 PROBLEMS = ("elasticity", "compliance", "friction")
 DELTA, KN = 0.01, 1000.0  # the top face's push and the normal stiffness p(t) = KN t_+
-SHIFT = [0.004, 0.002]  # friction: the top face also moved sideways
-COULOMB = 0.3  # friction: p_tau = COULOMB KN t_+ (m_tau = 1), Coulomb's law on the compliance pressure
+SHIFT = [0.001, 0.0005]  # friction: the top face also moved sideways
+COULOMB = 0.1  # friction: p_tau = COULOMB KN t_+ (m_tau = 1), Coulomb's law on the compliance pressure
 TANGENTS = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]  # vemkit's (t1, t2) on the bottom, nu = (0, 0, -1)
 GAP = "0.02*((x - 0.4)**2 + (y - 0.55)**2)"  # of x, y (z = 0 on Gamma_C), >= 0
 #: spsolve up to here, AMG-CG above: in 3D the direct solver's fill grows fast (vemkit's own "auto"
