@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 import yaml
 
 import vemkit
@@ -89,3 +90,27 @@ def test_vemkit_3d_on_tetrahedra_is_scikit_fem_p1_through_the_benchmark(tmp_path
     vem, skfem_row = peers3d.run_case(3, tmp_path)
     assert vem["dofs"] == skfem_row["dofs"] == 3 * 4**3
     assert skfem_row["rel_diff_to_vemkit"] < 1e-10
+
+
+@pytest.mark.parametrize("problem", ["elasticity", "compliance", "friction"])
+def test_getfem_p1_tetrahedra_solve_the_same_3d_problem(problem, tmp_path):
+    """benchmarks/peers3d.py against GetFEM (issue 22 (d)): 3D elasticity; the box pressed onto a
+    curved foundation with the 7-point face rule on both sides (vemkit gauss, 3 points; GetFEM
+    IM_TETRAHEDRON(5)), part of the bottom in contact; and the same box sheared, with Coulomb's law on
+    the compliance pressure (nodal rule), sticking and sliding vertices."""
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    peers3d = pytest.importorskip("peers3d", reason="benchmarks/peers3d.py")
+    u_vem, _, case = peers3d.run_vemkit(4, problem, tmp_path)
+    u_getfem, record = peers3d.run_peer("getfem", problem, 4, case, tmp_path)
+    if problem != "elasticity":
+        bottom = np.unique(case["side_bottom"])
+        t = -u_vem[bottom, 2] - peers3d.gap_at(case["vertices"][bottom])  # nu = -e_z
+        assert 0 < np.sum(t > 0) < bottom.size - 3, t  # a contact zone and vertices out of contact
+    if problem == "friction":
+        with xr.open_dataset(tmp_path / "solve-friction-4.nc") as ds:
+            lam = np.linalg.norm(ds.friction_multiplier.values, axis=1)[ds.penetration.values > 0]
+        assert np.any(lam < 1 - 1e-6) and np.any(lam > 1 - 1e-12), lam  # sticking and sliding
+    assert np.abs(u_vem).max() > 1e-3
+    assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record

@@ -81,7 +81,7 @@ BAD = {
     "contact.foundation.normal=[0, 1]": "give 3",
     "contact.foundation.point=[0, 0, 0.1]": "beyond the foundation plane",
     "contact.foundation={point: [0, 0, -0.1], normal: [0, 0, -1]}": "beyond the foundation plane",
-    "discretization.contact_quadrature=gauss": "nodal rule at the Gamma_C vertices only",
+    "discretization.contact_quadrature=simpson": "contact_quadrature",
     "contact.normal.k=1e15": "must be at most",
 }
 

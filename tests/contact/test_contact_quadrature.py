@@ -85,7 +85,7 @@ def test_gauss_integrates_a_linear_penetration_exactly_and_differs_from_nodal():
 def test_gauss_jacobian_is_the_derivative_of_the_force(law, rng):
     pb = problem(6, "gauss", law)  # the bottom-right vertex is clamped: one edge has a fixed end
     cb = pb.contact
-    assert np.any(cb.edge_vertex < 0)
+    assert np.any(cb.facet_vertex < 0)
     u = pushed_down(pb, lambda x: 0.05 * np.sin(7 * x)) + 0.01 * rng.normal(size=pb.n_dofs)
     v = rng.normal(size=pb.n_dofs)
     J = cb.normal_jacobian(u, law).toarray()
@@ -137,8 +137,29 @@ def test_gauss_points_are_checked():
     pb = problem(4, "gauss")
     moved = pb.contact.with_gap(lambda x, y: 0.2 + x)
     assert np.allclose(moved.gap, 0.2 + moved.coords[:, 0])
-    assert np.allclose(moved.edge_gap, 0.2 + moved.edge_coords[:, :, 0])
+    assert np.allclose(moved.facet_gap, 0.2 + moved.facet_coords[:, :, 0])
     with pytest.raises(ValueError, match="with_gap"):
         import dataclasses
 
         dataclasses.replace(pb.contact, gap=pb.contact.gap + 1.0)
+
+
+def test_gauss_keeps_a_roller_vertex_on_gamma_c_with_its_free_component():
+    """A roller meets Gamma_C (u_x held at x = 0): its u_y stays in the law, the box is pressed
+    uniformly, t = DELTA / (1 + K H / E) everywhere (the gauss rule once read u_y = 0 there)."""
+    from test_contact3d_boundary import DELTA, E, H, K, pressed_box
+
+    from vemkit.config.scene import scene_from_dict
+    from vemkit.contact.problem import scene_problem
+    from vemkit.solvers.dispatch import solve
+
+    data = pressed_box("square", dimension=2)
+    data["discretization"].update(contact_quadrature="gauss")
+    pb = scene_problem(scene_from_dict(data))
+    cb = pb.contact
+    assert cb.fixed is not None and np.all(cb.facet_vertex >= 0)
+    solution = solve(pb, {"method": "ssn", "tol": 1e-12, "linear": "direct"})
+    t = cb.normal_displacement(solution.u) - cb.gap
+    assert np.allclose(t, DELTA / (1 + K * H / E), rtol=1e-12, atol=0)
+    force = cb.normal_force(solution.u, pb.law)
+    assert force[cb.dofs[cb.fixed]].tolist() == [0.0] * int(cb.fixed.sum())  # the constraint takes it

@@ -451,7 +451,7 @@ class Scene:
     contact_gauss_points = _field(
         "discretization",
         "contact_gauss_points",
-        doc="Gauss points per Gamma_C edge (used by contact_quadrature: gauss)",
+        doc="N of contact_quadrature: gauss: Gauss points per Gamma_C edge (2D), a rule of degree 2N - 1 per Gamma_C triangle (3D)",
     )
     order = _field("discretization", "order", convert=int, doc="polynomial order k of the virtual elements: 1 or 2")
     body_force_projection = property(

@@ -5,7 +5,7 @@ three components and its expressions take x, y and z. Before any mesh is built e
 test-evaluated on its side (:class:`BodyProbes`: a grid on each face of a box; on an extruded body the
 2D probes of a lateral side at several heights, the base's boundary on the end faces), the Dirichlet
 sides are tested for a free rigid motion (SPEC §10 names it), and what 3D does not have yet is refused
-in one line: order 2, the k = 2 load options, the gauss contact rule. Contact (SPEC §10): a foundation
+in one line: order 2 and the k = 2 load options. Contact (SPEC §10): a foundation
 plane (a point and a non-zero normal of three components, every contact side on its body side) or a
 gap expression of x, y, z that is >= 0 on the contact sides (:func:`check_contact_3d`).
 """
@@ -117,12 +117,6 @@ def _refuse_2d_only(data: dict, given: dict) -> None:
         raise SceneError(
             "discretization.body_force_projection is a k = 2 option; 3D bodies load the cell mean of f1; drop it",
             key="discretization.body_force_projection",
-        )
-    if discretization.get("contact_quadrature", "nodal") != "nodal":
-        raise SceneError(
-            f"discretization.contact_quadrature = {discretization['contact_quadrature']!r}: 3D bodies "
-            "have the nodal rule at the Gamma_C vertices only; set contact_quadrature: nodal",
-            key="discretization.contact_quadrature",
         )
 
 

@@ -9,18 +9,19 @@ normals of its contact edges (exact on straight parts), that of a midpoint its e
 tangent is tau = (-nu_2, nu_1) (on the bottom edge nu = (0, -1), tau = (1, 0)). Clamped points and
 points with every component prescribed are dropped: they belong to the closure of Gamma_D, and their
 displacement is given. A point with only some components prescribed (a symmetry roller meeting
-Gamma_C) stays (nodal rule): its prescribed components are fixed dofs (``vemkit.vem.dofs``: decoupled
-rows K_ii u_i = K_ii g_i, so u_i = g_i is what the law reads), no contact force or Jacobian entry goes
-into their rows (the constraint's reaction takes it), and the free components carry the law. With
-the ``gauss`` rule such a point is still dropped (its edge end keeps its prescribed displacement).
+Gamma_C) stays, with either rule: its prescribed components are fixed dofs (``vemkit.vem.dofs``:
+decoupled rows K_ii u_i = K_ii g_i, so u_i = g_i is what the law reads), no contact force or Jacobian
+entry goes into their rows (the constraint's reaction takes it), and the free components carry the
+law. (Until issue 21's 3D Gauss rule the ``gauss`` rule dropped such a point and read u = 0 in its
+free components: wrong wherever a roller met Gamma_C.)
 ``ContactBoundary.vertices`` holds node numbers of the space: a mesh vertex v, or n_vertices + e for the
 midpoint of edge e (k = 2). One class for d = 2 and 3: dofs, normals and coordinates are (n_c, d);
 tangential quantities are (n_c,) in 2D and (n_c, 2) in 3D (components along ``tangent`` = t1 and
 ``tangent2`` = t2, ``vemkit.contact.boundary3d``), the friction multiplier a scalar in [-1, 1] or a
 vector in the unit disk (``project``, ``direction``, ``magnitude``).
 
-``gauss`` quadrature (``contact_gauss_points`` N per edge; for an element with linear traces, k = 1):
-the normal-compliance term of (3.16),
+``gauss`` quadrature (``contact_gauss_points`` N per edge in 2D; for an element with linear traces,
+k = 1): the normal-compliance term of (3.16),
 
     int_{Gamma_C} p_nu(u_nu - g) v_nu ds  =  sum_e sum_q |e| w_q p_nu(t_eq) sum_a phi_a(s_q) v_a . nu_e,
 
@@ -30,6 +31,10 @@ also the vertex normal of the nodal rule on straight parts), and Gauss-Legendre 
 weights w_q on [0, 1]. A dropped end keeps its prescribed displacement and its own gap. Its consistent linearization is
 sum_q |e| w_q p_nu'(t_eq) phi_a phi_b nu_e nu_e^T, coupling the two ends of an edge (no longer
 one block per vertex). On a constant penetration along an edge both rules give the same force.
+The same code serves 3D (``vemkit.contact.boundary3d``): the sum runs over the Gamma_C facets f
+(edges, faces) and their Gauss points, sum_f sum_q |f| w_q p_nu(t_fq) sum_a phi_a(x_q) v_a . nu_f,
+with t interpolated from the facet's vertices by the interpolants ``gauss_shape`` (the two hat
+functions on an edge; on a face the linear interpolant of its triangle fan).
 
 The friction term keeps its nodal multiplier in both cases: sum_c w_c p_tau(u_nu,c - g_c)
 lambda_c tau_c. The multiplier lambda lives at the vertices, |lambda_c| <= 1 is a projection vertex
@@ -46,24 +51,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
-from vemkit.contact.gaps import FoundationLine, _edge_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
+from vemkit.contact.gaps import FoundationLine, _facet_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
+from vemkit.contact.gauss_rules import gauss_rule
 from vemkit.contact.trace_nodes import contact_edges, midpoint_edges, rule_weights
 from vemkit.exceptions import InputError, SceneError
 from vemkit.mesh.mesh import Mesh, edge_indices
 
 QUADRATURES = ("nodal", "gauss")
-MAX_GAUSS_POINTS = 10
-
-
-def gauss_rule(points: int):
-    """Gauss-Legendre points and weights on [0, 1] (weights sum to 1), exact for degree 2 points - 1."""
-    if not (isinstance(points, (int, np.integer)) and 1 <= points <= MAX_GAUSS_POINTS):
-        raise SceneError(
-            f"discretization.contact_gauss_points = {points!r}: give an integer from 1 to {MAX_GAUSS_POINTS}",
-            key="discretization.contact_gauss_points",
-        )
-    x, w = np.polynomial.legendre.leggauss(int(points))
-    return 0.5 * (x + 1.0), 0.5 * w
 
 
 def rank_one_blocks(cb, values, left, n, right=None):
@@ -90,16 +84,17 @@ class ContactBoundary:
     gap: np.ndarray  # (n_c,) initial gap g_a >= 0
     coords: np.ndarray  # (n_c, 2) vertex coordinates
     quadrature: str = "nodal"  # of the normal-compliance term: nodal or gauss
-    # (n_e, 2) contact-vertex index of the two ends of every Gamma_C edge, -1 at a clamped end
-    edge_vertex: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
-    edge_normal: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_e, 2) unit outward edge normals
-    edge_length: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_e,)
-    edge_gap: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_e, 2) gap at both ends
-    edge_coords: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))  # (n_e, end, xy)
-    gauss_points: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) on [0, 1]
-    gauss_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_q,) summing to 1
-    # (n_e, 2) prescribed u . nu_e at dropped (Dirichlet) edge ends, 0 at contact vertices
-    edge_prescribed: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    # the Gamma_C facets (edges in 2D, faces in 3D) of the gauss rule, m = the most vertices of a facet:
+    # (n_f, m) contact-point index of every facet vertex, -1 at a dropped vertex and at padding
+    facet_vertex: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    facet_normal: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_f, d) unit outward normals
+    facet_gap: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (n_f, m) gap at the facet vertices
+    facet_coords: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))  # (n_f, m, d)
+    # (n_f, m) prescribed u . nu_f at dropped (Dirichlet) facet vertices, 0 at contact points and padding
+    facet_prescribed: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    gauss_weight: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (n_f, n_q) |f| w_q (0: padding)
+    # (n_f, n_q, m) the interpolant of each facet vertex's value at the Gauss points (rows sum to 1)
+    gauss_shape: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 2)))
     # 3D: (n_c, 3) the second tangent t2 = nu x t1 (``tangent`` holds t1); (0, 2) in 2D
     tangent2: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     # (n_c, d) bool: components with Dirichlet data (a roller meeting Gamma_C); None: none. No contact
@@ -113,10 +108,10 @@ class ContactBoundary:
                 key="discretization.contact_quadrature",
             )
         if self.quadrature == "gauss":
-            free = self.edge_vertex >= 0
-            if not np.array_equal(self.edge_gap[free], self.gap[self.edge_vertex[free]]):
+            free = self.facet_vertex >= 0
+            if not np.array_equal(self.facet_gap[free], self.gap[self.facet_vertex[free]]):
                 raise InputError(
-                    "the contact gap changed but not the gap at the Gamma_C edge ends of the gauss "
+                    "the contact gap changed but not the gap at the Gamma_C facet vertices of the gauss "
                     "quadrature: use ContactBoundary.with_gap",
                     key="contact.gap",
                 )
@@ -205,7 +200,8 @@ class ContactBoundary:
         """This boundary with another gap, gap(x, y) -> array or a FoundationLine (at the vertices and
         the dropped edge ends)."""
         g = _gap_values(gap, self.coords, self.normal)
-        return replace(self, gap=g, edge_gap=_edge_gaps(gap, self.edge_coords, self.edge_vertex, g, self.edge_normal))
+        facet_gap = _facet_gaps(gap, self.facet_coords, self.facet_vertex, g, self.facet_normal)
+        return replace(self, gap=g, facet_gap=facet_gap)
 
     # -- the normal-compliance term and its linearization (nodal or gauss) ----------------------------
     def contact_force(self, u, law, multiplier):
@@ -222,59 +218,53 @@ class ContactBoundary:
             t = self.normal_displacement(u) - self.gap
             return self.scatter(self.weight * law.normal_pressure(t), self.zero_multiplier(), u.size)
         t = self._gauss_penetration(u)
-        end_force = (self._gauss_weight() * law.normal_pressure(t)) @ self._shape()  # (n_e, 2)
-        values = end_force[:, :, None] * self.edge_normal[:, None, :]  # (n_e, end, component)
+        vertex_force = np.einsum("fq,fqa->fa", self.gauss_weight * law.normal_pressure(t), self.gauss_shape)
+        values = vertex_force[:, :, None] * self.facet_normal[:, None, :]  # (n_f, vertex, component)
         return self._assemble_vector(values, u.size)
 
     def normal_energy(self, u, law) -> float:
         """int P_nu(u_nu - g) ds, P_nu' = p_nu (the normal-compliance part of the energy)."""
         if self.quadrature == "nodal":
             return self.weight @ law.normal_energy(self.normal_displacement(u) - self.gap)
-        return float(np.sum(self._gauss_weight() * law.normal_energy(self._gauss_penetration(u))))
+        return float(np.sum(self.gauss_weight * law.normal_energy(self._gauss_penetration(u))))
 
     def normal_jacobian(self, u, law, cap=np.inf):
         """d(normal_force)/du; p_nu' capped at ``cap`` (per contact vertex, or a number) for m_nu < 1."""
         if self.quadrature == "nodal":
             t = self.normal_displacement(u) - self.gap
             return rank_one_blocks(self, self.weight * np.minimum(law.normal_stiffness(t), cap), self.normal, u.size)
-        slope = np.minimum(law.normal_stiffness(self._gauss_penetration(u)), self._edge_cap(cap)[:, None])
-        phi = self._shape()
-        ends = np.einsum("eq,qa,qb->eab", self._gauss_weight() * slope, phi, phi)  # (n_e, 2, 2)
-        nn = self.edge_normal[:, :, None] * self.edge_normal[:, None, :]  # (n_e, 2, 2)
-        values = ends[:, :, None, :, None] * nn[:, None, :, None, :]  # (n_e, a, i, b, j)
-        dofs = self._edge_dofs(u.size)  # (n_e, 2, 2), clamped ends -> u.size
+        slope = np.minimum(law.normal_stiffness(self._gauss_penetration(u)), self._facet_cap(cap)[:, None])
+        phi = self.gauss_shape
+        ends = np.einsum("fq,fqa,fqb->fab", self.gauss_weight * slope, phi, phi)  # (n_f, m, m)
+        nn = self.facet_normal[:, :, None] * self.facet_normal[:, None, :]  # (n_f, d, d)
+        values = ends[:, :, None, :, None] * nn[:, None, :, None, :]  # (n_f, a, i, b, j)
+        dofs = self._facet_dofs(u.size, held_out=True)  # (n_f, m, d), dropped vertices -> u.size
         rows = np.broadcast_to(dofs[:, :, :, None, None], values.shape).ravel()
         cols = np.broadcast_to(dofs[:, None, None, :, :], values.shape).ravel()
         keep = (rows < u.size) & (cols < u.size)
         return sp.csr_matrix((values.ravel()[keep], (rows[keep], cols[keep])), shape=(u.size, u.size))
 
-    def _shape(self):
-        """(n_q, 2) the hat functions of the two edge ends at the Gauss points."""
-        return np.stack([1.0 - self.gauss_points, self.gauss_points], axis=1)
-
-    def _gauss_weight(self):
-        """(n_e, n_q) |e| w_q."""
-        return self.edge_length[:, None] * self.gauss_weights[None, :]
-
-    def _edge_dofs(self, n_dofs):
-        """(n_e, 2, 2) free dofs of the edge ends; clamped ends point at n_dofs (a dummy slot)."""
-        padded = np.vstack([self.dofs, [[n_dofs, n_dofs]]])
-        return padded[self.edge_vertex]  # -1 (clamped) indexes the dummy row
+    def _facet_dofs(self, n_dofs, held_out=False):
+        """(n_f, m, d) free dofs of the facet vertices; dropped ones point at n_dofs (a dummy slot), and
+        with ``held_out`` the prescribed components too (no contact force or Jacobian entry there)."""
+        dofs = self.dofs if self.fixed is None or not held_out else np.where(self.fixed, n_dofs, self.dofs)
+        padded = np.vstack([dofs, np.full((1, self.dofs.shape[1]), n_dofs)])
+        return padded[self.facet_vertex]  # -1 (dropped, padding) indexes the dummy row
 
     def _gauss_penetration(self, u):
-        """(n_e, n_q) u_nu - g at the Gauss points, both linear along each edge."""
+        """(n_f, n_q) u_nu - g at the Gauss points, interpolated from the facet vertices."""
         u_padded = np.append(u, 0.0)
-        end_u = u_padded[self._edge_dofs(u.size)]  # (n_e, 2, 2); u = 0 at clamped ends
-        ends = np.einsum("eai,ei->ea", end_u, self.edge_normal) + self.edge_prescribed - self.edge_gap
-        return ends @ self._shape().T
+        vertex_u = u_padded[self._facet_dofs(u.size)]  # (n_f, m, d); u = 0 at dropped vertices
+        vertex_t = np.einsum("fai,fi->fa", vertex_u, self.facet_normal) + self.facet_prescribed - self.facet_gap
+        return np.einsum("fqa,fa->fq", self.gauss_shape, vertex_t)
 
-    def _edge_cap(self, cap):
-        """(n_e,) the smaller cap of the free ends of each edge."""
+    def _facet_cap(self, cap):
+        """(n_f,) the smallest cap of the contact points of each facet."""
         cap = np.broadcast_to(np.asarray(cap, dtype=float), (self.size,))
-        return np.min(np.append(cap, np.inf)[self.edge_vertex], axis=1)
+        return np.min(np.append(cap, np.inf)[self.facet_vertex], axis=1)
 
     def _assemble_vector(self, values, n_dofs):
-        dofs = self._edge_dofs(n_dofs)
+        dofs = self._facet_dofs(n_dofs, held_out=True)
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
 
@@ -306,12 +296,9 @@ def check_quadrature(space, quadrature: str) -> None:
         )
 
 
-def contact_nodes(dofs, nodes, keep_partial: bool = True) -> np.ndarray:
-    """The ``nodes`` that are contact points: they carry unknowns and (``keep_partial``) at least one
-    component without Dirichlet data -- a roller meeting Gamma_C stays, its free components in the
-    law (issue 21); without ``keep_partial`` (the gauss rule) only nodes without any Dirichlet data."""
-    if not keep_partial:
-        return nodes[dofs.unconstrained_nodes()[nodes]]
+def contact_nodes(dofs, nodes) -> np.ndarray:
+    """The ``nodes`` that are contact points: they carry unknowns and at least one component without
+    Dirichlet data -- a roller meeting Gamma_C stays, its free components in the law (issue 21)."""
     d = dofs.dimension
     count = np.bincount(dofs.free_nodes[dofs.fixed_dofs // d], minlength=dofs.n_nodes)
     return nodes[(dofs.free_index[nodes] >= 0) & (count[nodes] < d)]
@@ -323,10 +310,10 @@ def fixed_components(dofs, point_dofs: np.ndarray) -> np.ndarray | None:
     return fixed if fixed.any() else None
 
 
-def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float, keep_partial: bool):
+def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float):
     """(vertices, weights, normals, edge data) of the Gamma_C vertices that are contact points."""
     length, weighted_normal, weight, nsum = edge_ends(mesh, edges, end_weight)
-    verts = contact_nodes(dofs, np.unique(edges), keep_partial)
+    verts = contact_nodes(dofs, np.unique(edges))
     normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)
     return verts, weight[verts], normal, (length, weighted_normal)
 
@@ -348,12 +335,12 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
     if space.element.dimension != 2:
         from vemkit.contact.boundary3d import contact_boundary_3d
 
-        return contact_boundary_3d(space, parts, dofs, gap, quadrature)
+        return contact_boundary_3d(space, parts, dofs, gap, quadrature, gauss_points)
     check_quadrature(space, quadrature)
     mesh = space.mesh
     edges = contact_edges(mesh, parts)
     w_end, w_mid = rule_weights(space.element)
-    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end, quadrature == "nodal")
+    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end)
     coords = mesh.vertices[verts]
     if w_mid is not None:
         mid, mid_w, mid_normal, mid_coords = _midpoints(space, parts, edges, dofs, length, weighted_normal, w_mid)
@@ -380,23 +367,28 @@ def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_p
 
 
 def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):
-    """The boundary with its Gamma_C edges (what the ``gauss`` quadrature of the normal term reads)."""
+    """The boundary with its Gamma_C edges as the facets of the ``gauss`` rule (the hat functions of
+    the two ends at the Gauss-Legendre points)."""
+    s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
+    shape = np.broadcast_to(np.stack([1.0 - s, s], axis=1), (edges.shape[0], s.size, 2))
+    return with_facets(cb, mesh, edges, weighted_normal / length[:, None], dofs, gap, length[:, None] * w, shape)
+
+
+def with_facets(cb: ContactBoundary, mesh, facet_nodes, facet_normal, dofs, gap, gauss_weight, gauss_shape):
+    """The boundary with the Gamma_C facets (n_f, m) mesh vertices each (a short facet padded with
+    its first vertex and zero shape), their unit normals, and the rule's |f| w_q and interpolants."""
     contact_index = np.full(mesh.n_vertices, -1, dtype=np.int64)
     contact_index[cb.vertices] = np.arange(cb.vertices.size)
-    edge_vertex = contact_index[edges]
-    edge_coords = mesh.vertices[edges]
-    edge_normal = weighted_normal / length[:, None]
-    edge_gap = _edge_gaps(gap, edge_coords, edge_vertex, cb.gap, edge_normal)
-    prescribed = np.einsum("eai,ei->ea", dofs.prescribed_displacement()[edges], edge_normal)
-    s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
+    facet_vertex = contact_index[facet_nodes]
+    coords = mesh.vertices[facet_nodes]
+    prescribed = np.einsum("fai,fi->fa", dofs.prescribed_displacement()[facet_nodes], facet_normal)
     return replace(
         cb,
-        edge_vertex=edge_vertex,
-        edge_normal=edge_normal,
-        edge_length=length,
-        edge_gap=edge_gap,
-        edge_coords=edge_coords,
-        gauss_points=s,
-        gauss_weights=w,
-        edge_prescribed=np.where(edge_vertex >= 0, 0.0, prescribed),
+        facet_vertex=facet_vertex,
+        facet_normal=facet_normal,
+        facet_gap=_facet_gaps(gap, coords, facet_vertex, cb.gap, facet_normal),
+        facet_coords=coords,
+        facet_prescribed=np.where(facet_vertex >= 0, 0.0, prescribed),
+        gauss_weight=gauss_weight,
+        gauss_shape=gauss_shape,
     )

@@ -1,4 +1,4 @@
-"""The contact boundary of a 3D body (SPEC §10): Gamma_C any set of boundary faces, the nodal rule.
+"""The contact boundary of a 3D body (SPEC §10): Gamma_C any set of boundary faces, the nodal or the gauss rule.
 
 Contact points: the vertices of the Gamma_C faces (k = 1). Weight of vertex i (the nodal rule,
 SPEC §3, on polygonal faces):
@@ -19,8 +19,33 @@ nu (the smallest |nu_k|, the first on ties), t1 = (e x nu) / |e x nu|, t2 = nu x
 t2 = (1, 0, 0); on y = 0, nu = (0, -1, 0): t1 = (0, 0, -1), t2 = (1, 0, 0). Tangential quantities
 (u_tau, lambda, sigma_tau) are their two components in (t1, t2).
 
+The ``gauss`` rule of the normal-compliance term (``contact_quadrature: gauss``, issue 21 item 1),
+N = ``contact_gauss_points``: on every Gamma_C face F the trace is taken as the linear interpolant on
+a triangle fan, and each triangle gets a rule exact for degree 2N - 1 (the degree of N Gauss points
+on an edge in 2D; ``vemkit.contact.gauss_rules.triangle_rule``: N = 3 the 7-point degree-5 rule).
+
+- a triangular face is its own fan: the rule integrates p_nu(t) phi_a of the P1 trace exactly for
+  polynomial integrands of degree <= 2N - 1 -- on a tetrahedral mesh (where k = 1 VEM is P1) it is
+  P1 FEM with that face rule (GetFEM's IM_TETRAHEDRON(5) for N = 3);
+- a face with m > 3 vertices: the fan triangles T_i = (c_F, x_i, x_i+1) from its area centroid c_F,
+  the trace linear on each, with the value sum_i a_i u_i at c_F, a_i = (3 w_i^F - |T_i-1| - |T_i|) / |F|
+  (w_i^F the nodal weight of vertex i on F above). The k = 1 VEM trace is not a polynomial on such
+  a face; this interpolant is what the rule integrates. It equals the VEM trace on the edges of F
+  (linear there), has its mean (the interpolant of vertex i integrates to w_i^F = int_F Pi^F phi_i,
+  which is int_F phi_i in the enhanced face space), and reproduces linear functions (sum_i a_i = 1,
+  sum_i a_i x_i = c_F). So a uniform penetration gives every vertex the force of the nodal rule
+  (the patch test: a box pressed uniformly stays uniform on a Voronoi mesh), a linear penetration is
+  integrated exactly, and on a triangle a_i = 1/3. The apex value sum_i (w_i^F / |F|) u_i = Pi^F u (c_F)
+  would reproduce linears too but fail the patch test (vertex forces off the nodal weights by
+  1e-5 relative on a 3 x 3 Voronoi box). Signed fan areas: they sum to |F| on a planar face.
+
+The penetration t = u . n_F - g is interpolated from the face's vertices (n_F the unit face normal,
+g the vertex gaps), as t along an edge in 2D; the friction term stays at the vertices with the nodal
+weights (``vemkit.contact.boundary``).
+
 Dirichlet data as in 2D (``vemkit.contact.boundary``): a clamped or fully prescribed vertex is
-dropped, one with some components prescribed stays with those components held.
+dropped (with the gauss rule its prescribed u . n_F enters the faces around it), one with some
+components prescribed stays with those components held.
 Gap: a callable g(x, y, z) >= 0 or a ``FoundationLine`` built from a 3D point and normal (a plane;
 gap along nu as in 2D).
 """
@@ -29,8 +54,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from vemkit.contact.boundary import ContactBoundary, contact_nodes, fixed_components
+from vemkit.contact.boundary import QUADRATURES, ContactBoundary, contact_nodes, fixed_components, with_facets
 from vemkit.contact.gaps import _gap_values
+from vemkit.contact.gauss_rules import triangle_rule
 from vemkit.exceptions import SceneError
 
 
@@ -70,12 +96,11 @@ def tangent_basis(normal: np.ndarray):
     return t1, np.cross(normal, t1)
 
 
-def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal") -> ContactBoundary:
+def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal", gauss_points: int = 3) -> ContactBoundary:
     """The contact points of the named boundary face sets ``parts`` (module docstring)."""
-    if quadrature != "nodal":
+    if quadrature not in QUADRATURES:
         raise SceneError(
-            f"discretization.contact_quadrature = {quadrature!r} is not available on 3D bodies yet "
-            "(the nodal rule at the Gamma_C vertices is); set contact_quadrature: nodal",
+            f"discretization.contact_quadrature = {quadrature!r}: use nodal or gauss",
             key="discretization.contact_quadrature",
         )
     mesh = space.mesh
@@ -89,7 +114,7 @@ def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal") -> C
     coords = mesh.vertices[verts]
     free = dofs.free_index[verts]
     point_dofs = np.stack([3 * free, 3 * free + 1, 3 * free + 2], axis=1).reshape(-1, 3)
-    return ContactBoundary(
+    cb = ContactBoundary(
         verts,
         point_dofs,
         weight[verts],
@@ -101,3 +126,54 @@ def contact_boundary_3d(space, parts, dofs, gap, quadrature: str = "nodal") -> C
         tangent2=t2,
         fixed=fixed_components(dofs, point_dofs),
     )
+    if quadrature == "nodal":
+        return cb
+    nodes, face_normal, gauss_weight, gauss_shape = face_fans(mesh, faces, face_weight, triangle_rule(gauss_points))
+    return with_facets(cb, mesh, nodes, face_normal, dofs, gap, gauss_weight, gauss_shape)
+
+
+def face_fans(mesh, faces, face_weight, rule):
+    """(nodes (n_f, m), unit normals, |T| w_q (n_f, n_q), interpolants (n_f, n_q, m)) of the gauss
+    rule on the Gamma_C faces (module docstring): the triangle rule on a triangular face, on every fan
+    triangle (c_F, x_i, x_i+1) of a larger one. ``face_weight``: the nodal weights w_i^F of
+    ``face_vertex_weights``, in its order (they fix the apex values)."""
+    points, weights = rule
+    q, sizes = weights.size, np.diff(mesh.face_offsets)[faces]
+    m = int(sizes.max(initial=3))
+    corner = np.arange(m)[None, :]
+    nodes = mesh.face_vertices[mesh.face_offsets[faces][:, None] + np.where(corner < sizes[:, None], corner, 0)]
+    va = mesh.face_vector_areas[faces]
+    area = np.linalg.norm(va, axis=1)
+    unit = va / area[:, None]
+    shape = np.zeros((faces.size, q * (m if m > 3 else 1), m))  # a fan: q points per triangle
+    gauss_weight = np.zeros(shape.shape[:2])
+    tri = sizes == 3
+    shape[tri, :q, :3] = points
+    gauss_weight[tri, :q] = area[tri, None] * weights
+    fan, nxt = np.flatnonzero(~tri), (corner + 1) % sizes[:, None]
+    if fan.size == 0:
+        return nodes, unit, gauss_weight, shape
+    fan_area = _fan_areas(mesh, faces[fan], nodes[fan], nxt[fan], unit[fan], sizes[fan])  # (n_fan, m)
+    nodal = np.zeros((faces.size, m))  # w_i^F per corner
+    owner = np.repeat(np.arange(faces.size), sizes)
+    nodal[owner, np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)] = face_weight
+    previous = np.take_along_axis(fan_area, (corner - 1) % sizes[fan, None], axis=1)
+    apex = np.where(corner < sizes[fan, None], 3.0 * nodal[fan] - previous - fan_area, 0.0) / area[fan, None]
+    for i in range(m):
+        rows = np.flatnonzero(i < sizes[fan])
+        cells, block, after = fan[rows][:, None], np.arange(i * q, (i + 1) * q)[None, :], nxt[fan[rows], i][:, None]
+        shape[cells, block, :] = points[None, :, 0, None] * apex[rows, None, :]
+        shape[cells, block, i] += points[None, :, 1]
+        shape[cells, block, after] += points[None, :, 2]
+        gauss_weight[cells, block] = fan_area[rows, i, None] * weights[None, :]
+    return nodes, unit, gauss_weight, shape
+
+
+def _fan_areas(mesh, faces, nodes, nxt, unit, sizes):
+    """(n, m) signed areas of the fan triangles (c_F, x_i, x_i+1) (0 past a face's size): they sum to
+    |F| on a planar face."""
+    centroid = mesh.face_centroids[faces][:, None, :]
+    a = mesh.vertices[nodes] - centroid
+    b = mesh.vertices[np.take_along_axis(nodes, nxt, axis=1)] - centroid
+    areas = 0.5 * np.sum(np.cross(a, b) * unit[:, None, :], axis=2)
+    return np.where(np.arange(nodes.shape[1])[None, :] < sizes[:, None], areas, 0.0)

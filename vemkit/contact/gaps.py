@@ -49,13 +49,13 @@ def _gap_values(gap, coords, normals, check=True):
     return g
 
 
-def _edge_gaps(gap, edge_coords, edge_vertex, vertex_gap, edge_normal):
-    """(n_e, 2) gap at the edge ends: the vertex gaps, evaluated anew only at dropped ends (with
-    the edge's normal)."""
-    ends = np.zeros(edge_vertex.shape)
-    free = edge_vertex >= 0
-    ends[free] = vertex_gap[edge_vertex[free]]
+def _facet_gaps(gap, facet_coords, facet_vertex, vertex_gap, facet_normal):
+    """(n_f, m) gap at the vertices of the Gamma_C facets (edges, faces): the contact points' gaps,
+    evaluated anew only at dropped vertices (with the facet's normal)."""
+    ends = np.zeros(facet_vertex.shape)
+    free = facet_vertex >= 0
+    ends[free] = vertex_gap[facet_vertex[free]]
     if np.any(~free):
-        normals = np.broadcast_to(edge_normal[:, None, :], edge_coords.shape)
-        ends[~free] = _gap_values(gap, edge_coords[~free], normals[~free], check=False)
+        normals = np.broadcast_to(facet_normal[:, None, :], facet_coords.shape)
+        ends[~free] = _gap_values(gap, facet_coords[~free], normals[~free], check=False)
     return ends
