@@ -73,3 +73,20 @@ def test_coarse_hertz_sphere_near_hertz(coarse):
     assert abs(row["err_p0_fit"]) < 0.05
     ds = with_profiles(records_dataset([row], ["h"]), [row], ["h"], ["r", "p"])
     assert np.allclose(ds["p"].values[0, : row["profile"]["p"].size], row["profile"]["p"])
+
+
+def test_coarse_mindlin_loading_passes_the_independent_check(coarse):
+    """Every load step's (u, lambda) from ssn passes verify_solution at 10 tol with |lambda| <= 1
+    (before ssn projected its final multiplier a sliding vertex barely in contact ended at
+    |lambda| - 1 = 1.5e-5 > 10 tol on this mesh: the merit weighs C by w p_tau(t)); the stick radius
+    shrinks as Q/(mu P) grows, within 12 % of Mindlin's c (measured -0.1 ... -9.6 %)."""
+    from vemkit.studies.mindlin import mindlin_run
+
+    data = copy.deepcopy(yaml.safe_load(SCENE.read_text()))
+    solver = {"method": "ssn", "tol": 1e-6, "linear": "direct", "max_iterations": 60}
+    rows = mindlin_run(data, 0.03, 0.25, 1e3, 0.3, (0.001, 0.002, 0.003), solver, coarse)
+    assert all(r["passed"] for r in rows), [r["check"] for r in rows]
+    ratios = [r["Q_over_muP"] for r in rows]
+    assert ratios == sorted(ratios) and ratios[-1] < 1
+    assert [r["c"] for r in rows] == sorted((r["c"] for r in rows), reverse=True)
+    assert all(abs(r["err_c"]) < 0.12 for r in rows)
