@@ -37,6 +37,7 @@ include: "workflow/rules/adaptivity.smk"
 include: "workflow/rules/verification.smk"
 # 3D verification: manufactured convergence, Lame, plane strain / plane stress (not in `rule all`):
 # `snakemake -j2 three_d`
+include: "workflow/rules/three_d_contact.smk"  # before three_d.smk: its targets join THREE_D_TARGETS
 include: "workflow/rules/three_d.smk"
 
 

@@ -14,7 +14,8 @@ import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
-THREE_D = yaml.safe_load((ROOT / "config" / "three_d.yaml").read_text())["three_d"]
+CONFIG = yaml.safe_load((ROOT / "config" / "three_d.yaml").read_text())
+THREE_D = CONFIG["three_d"]
 
 
 def dry_run(*args) -> subprocess.CompletedProcess:
@@ -51,10 +52,14 @@ def test_three_d_plans_every_case_and_study_and_is_not_in_the_default_target():
         "three_d_plane_strain": 1,
         "three_d_plane_stress": 1,
         "three_d_figure": cases + 1,
+        "three_d_hertz": 1,
+        "three_d_mindlin": 1,
     }
     assert not any(rule.startswith("three_d") for rule in planned())
     for case in THREE_D["manufactured"].values():
         assert (ROOT / case["scene"]).is_file()
+    for study in ("hertz", "mindlin"):
+        assert (ROOT / CONFIG[study]["scene"]).is_file()
 
 
 def test_a_bad_setting_is_refused_naming_the_key(tmp_path):
@@ -63,3 +68,19 @@ def test_a_bad_setting_is_refused_naming_the_key(tmp_path):
     run = dry_run("three_d", "--configfile", str(path))
     assert run.returncode != 0
     assert "three_d.lame.families[0]" in run.stdout + run.stderr
+
+
+@pytest.mark.parametrize(
+    ("study", "bad", "key"),
+    [
+        ("mindlin", {"shift": [0.001]}, "mindlin: Additional properties are not allowed ('shift'"),
+        ("hertz", {"nu": 0.5}, "hertz.nu"),
+        ("mindlin", {"solver": {"linear": "auto"}}, "mindlin.solver.linear"),
+    ],
+)
+def test_a_bad_contact_setting_is_refused_naming_the_key(tmp_path, study, bad, key):
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump({**CONFIG, study: {**CONFIG[study], **bad}}))
+    run = dry_run("three_d", "--configfile", str(path))
+    assert run.returncode != 0
+    assert key in run.stdout + run.stderr

@@ -177,12 +177,21 @@ def solve_ssn(
     newton.theta_previous = point.theta
     for k in range(1, max_iterations + 1):
         if _converged(newton, point):
-            return _finish(newton, point.u, point.lam, k - 1)
+            lam, move = _returned_multiplier(newton, point)
+            if move <= newton.tol:
+                return _finish(newton, point.u, lam, k - 1)
+            point = _evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
         point = _newton_iteration(newton, point, k)
+        if cb.dimension == 3 and not _converged(newton, point):
+            from vemkit.solvers.ssn_disk import aligned_multiplier
+
+            lam = aligned_multiplier(newton, point)  # the slip direction, when only it is left
+            point = point if lam is None else _evaluate(newton, point.u, lam)
         if progress is not None:
             progress(k, newton.records[-1])
-    if _converged(newton, point):
-        return _finish(newton, point.u, point.lam, max_iterations)
+    lam, move = _returned_multiplier(newton, point)
+    if _converged(newton, point) and move <= newton.tol:
+        return _finish(newton, point.u, lam, max_iterations)
     _fail(
         problem,
         max_iterations,
@@ -224,6 +233,15 @@ def _plain_solution(newton, u):
         newton.linear_total += base.iterations
     cb = newton.problem.contact
     return _finish(newton, u, cb.direction(relative_slip(cb, u, newton.slip_reference)), 0)
+
+
+def _returned_multiplier(newton, point):
+    """(lambda, its move) of a converged point; 3D: in the disk and along the slip (ssn_disk.final_multiplier)."""
+    if newton.problem.contact.dimension != 3:
+        return point.lam, 0.0
+    from vemkit.solvers.ssn_disk import final_multiplier
+
+    return final_multiplier(newton, point)
 
 
 def _finish(newton, u, lam, iterations):

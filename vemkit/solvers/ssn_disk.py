@@ -94,3 +94,47 @@ def disk_alignment(newton, point) -> float:
     from vemkit.solvers.ssn import complementarity_weight
 
     return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale
+
+
+def aligned_multiplier(newton, point):
+    """lambda = u_tau / |u_tau| at the sliding vertices (disk_alignment's), once the merit is
+    converged and only the slip direction (2.8) is not; else None.
+
+    At a vertex barely in contact (p_tau(t) ~ 1e-4 of the largest bound) gamma |u_tau| is ~1e-6, so
+    |q| = |lambda + gamma u_tau| ~ 1 and P(q) ~ lambda whatever lambda's direction: Newton turns lambda
+    towards the slip by ~gamma |u_tau| per step (measured on the Mindlin sphere: the direction error
+    2.3e-2 -> 2.1e-2 in 20 steps, disk_alignment stalled at 3.5e-6). Setting the direction moves the
+    friction force by disk_alignment x scale; the next Newton step restores the equilibrium."""
+    if np.sqrt(point.theta) / point.scale > newton.tol:
+        return None
+    return _slip_directions(newton, point, point.lam.copy())
+
+
+def _slip_directions(newton, point, lam, every: bool = False):
+    """``lam`` with u_tau / |u_tau| at disk_alignment's sliding vertices (|q| > 1, |u_tau| > tol max|u|;
+    ``every``: at every vertex with |u_tau| > tol max|u|, as the independent check counts sliding)."""
+    cb = newton.problem.contact
+    moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
+    sliding = moving if every else (cb.magnitude(point.q) > 1.0) & moving
+    lam[sliding] = cb.direction(point.slip[sliding])
+    return lam
+
+
+def final_multiplier(newton, point):
+    """(lambda, how far it moves the friction force / scale) that ssn returns at a converged 3D point:
+    P(lambda), and u_tau / |u_tau| at every vertex with |u_tau| > tol max|u|, so |lambda| <= 1 (2.7) and
+    lambda . u_tau = |u_tau| (2.8) hold to rounding; ssn returns it if the move is <= tol, else goes on
+    from it.
+
+    The merit weighs C = lambda - P(q) by w p_tau(t) (ssn.complementarity_weight), so at a vertex barely
+    in contact |lambda| may end above 1 (measured on the Mindlin sphere: 1.0096) or point away from a
+    slip of 6e-6 max|u| (lambda . u_tau - |u_tau| = 1.2e-5 max|u|) while the merit is below tol.
+    P(lambda) is no farther from lambda than P(q) is, and the sliding vertices' change is
+    disk_alignment's miss (a vertex of the stick set that moves by more than tol max|u| -- its state
+    changed in the last step -- may move more, hence the measure)."""
+    from vemkit.solvers.ssn import complementarity_weight
+
+    cb = newton.problem.contact
+    lam = _slip_directions(newton, point, cb.project(point.lam), every=True)
+    move = complementarity_weight(newton, point.t) * cb.magnitude(lam - point.lam)
+    return lam, float(np.linalg.norm(move)) / point.scale

@@ -10,17 +10,19 @@ with c = a (1 - Q/(mu P))^(1/3), and carries the shear traction
 ``loading_in_steps`` runs the steps on problems made by a callable (the platen's tangential
 displacement of each step -> DiscreteProblem, the mesh and the law fixed), ``mindlin_measures`` reads
 P, Q, a, c and the shear traction off a step on a half body (the plane x = 0 a symmetry plane: the
-forces doubled).
+forces doubled), ``mindlin_run`` the whole loading on the Hertz half sphere (``vemkit.studies.hertz``).
 """
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
+import time
+from pathlib import Path
 
 import numpy as np
 
-from vemkit.contact.boundary3d import tangent_basis
 from vemkit.contact.laws import ContactLaw
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import contact_state
@@ -50,25 +52,6 @@ def loading_in_steps(problem_at, shifts, solver: dict, *, frictionless_normal_st
         check = verify_solution(problem, solution.u, solution.multiplier, 10 * solver["tol"], slip_reference=reference)
         steps.append((shift, problem, solution, reference, check))
     return steps
-
-
-def roller_normals(problem, gap):
-    """The problem with the vertex normals of Gamma_C in the symmetry planes where a roller meets it:
-    nu's prescribed components set to zero, renormalized, the tangent basis and the gap (``gap``:
-    the scene's gap or FoundationLine) rebuilt. The area-weighted normal of a vertex on x = 0 sees
-    the faces on one side only and tilts out of the plane; with the roller u1 = 0 a stick vertex is
-    then pinned and a sliding one cannot follow its slip direction (the held component's friction
-    force is the constraint's), so ssn's slip-direction test stalls there (measured: 4e-4 on the
-    Hertz half sphere). The symmetric body's normal lies in the plane. (Its home should be
-    vemkit.contact.boundary3d; here until that module is free to edit.)"""
-    cb = problem.contact
-    if cb.fixed is None:
-        return problem
-    normal = np.where(cb.fixed, 0.0, cb.normal)
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    t1, t2 = tangent_basis(normal)
-    contact = dataclasses.replace(cb, normal=normal, tangent=t1, tangent2=t2).with_gap(gap)
-    return dataclasses.replace(problem, contact=contact)
 
 
 def mindlin_shear(r, a: float, c: float, mu: float, P: float):
@@ -117,3 +100,49 @@ def mindlin_measures(problem, solution, reference, mu: float, axis: int = 2, sym
         "on": on,
         "stick": stick,
     }
+
+
+def mindlin_run(data: dict, h: float, H: float, k: float, mu: float, shifts, solver: dict, folder, **mesh):
+    """Cattaneo-Mindlin on the half sphere x >= 0 of the Hertz scene ``data`` (its top pressed down by
+    its prescribed u2): step 0 frictionless (Mindlin's setting), then the top moved sideways along z
+    by ``shifts``, each step's slip counted from the previous step's u_tau; Coulomb m_tau = m_nu = 1,
+    k_tau = mu k_nu. One row (``mindlin_measures`` + sizes, ssn iterations, the independent check at
+    10 tol) per tangential step; its profile (r, q, on, stick, coordinates) under "profile"."""
+    from vemkit.studies.hertz import R, sphere_msh, sphere_problem
+
+    start = time.perf_counter()
+    msh = Path(folder) / f"half_{h:g}_{H:g}.msh"
+    if not msh.exists():
+        sphere_msh(msh, h, H, half=True, **mesh)
+    data = copy.deepcopy(data)
+    down = data["boundary"]["dirichlet"]["top"][1]
+    data["contact"]["normal"]["m"] = 1.0
+    data["contact"]["friction"] = {"k": mu * k * data["material"]["E"] / R, "m": 1.0}
+
+    def problem_at(shift):
+        data["boundary"]["dirichlet"] = {"top": [None, down, shift], "sym_x": [0.0, None, None]}
+        return sphere_problem(data, msh, k)
+
+    steps = loading_in_steps(problem_at, shifts, solver, frictionless_normal_step=True)
+    rows = []
+    for shift, problem, solution, reference, check in steps[1:]:
+        m = mindlin_measures(problem, solution, reference, mu)
+        profile = {key: m.pop(key) for key in ("r", "q", "on", "stick")}
+        profile.update(x=problem.contact.coords[:, 0], z=problem.contact.coords[:, 2])
+        m.update(
+            h=h,
+            H=H,
+            k=k,
+            mu=mu,
+            shift=shift,
+            cells=int(problem.mesh.n_cells),
+            dofs=int(problem.n_dofs),
+            iterations=int(solution.iterations),
+            normal_step_iterations=int(steps[0][2].iterations),
+            check=float(check["worst"]),
+            passed=bool(check["passed"]),
+            wall=time.perf_counter() - start,
+            profile=profile,
+        )
+        rows.append(m)
+    return rows

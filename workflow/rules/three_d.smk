@@ -19,6 +19,7 @@ THREE_D_TARGETS = (
     + [f"results/3d/{t}.{ext}" for t in ("lame", "plane_strain", "plane_stress") for ext in ("nc", "md")]
     + [f"results/3d/figures/{case}.png" for case in THREE_D_FIGURES]
     + [f"results/3d/vtu/{case}.vtu" for case in THREE_D_FIGURES]
+    + THREE_D_CONTACT_TARGETS
 )
 
 
