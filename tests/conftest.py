@@ -6,6 +6,20 @@ from vemkit.contact.problem import discrete_problem
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.mesh import from_polygons, tag_box_boundary
 
+#: the settings under which uzawa and ssn must agree to 1e-10 (issue 21 item 2): tol 1e-12, direct solves,
+#: uzawa stopped on both |du| and |dlambda| well below tol
+AGREEMENT_SOLVERS = {
+    "uzawa": {
+        "method": "uzawa",
+        "tol": 1e-12,
+        "linear": "direct",
+        "stop": "both",
+        "eps_u": 1e-13,
+        "eps_lambda": 1e-13,
+        "max_iterations": 20000,
+    },
+    "ssn": {"method": "ssn", "tol": 1e-12, "linear": "direct"},
+}
 PAPER = dict(E=2000.0, nu=0.4, gap=0.1, law=ContactLaw(10.0, 1.0, 450.0, 0.0))
 
 # one mesh of every family and kind, small enough for quick tests

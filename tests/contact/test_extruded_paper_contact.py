@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from conftest import AGREEMENT_SOLVERS
 
 from vemkit.config.scene import scene_from_dict
 from vemkit.contact.problem import scene_problem
@@ -24,18 +25,7 @@ from vemkit.solvers.solution import SEPARATED, SLIP, STICK, contact_state
 
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 BASE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
-OPTIONS = {
-    "uzawa": {
-        "method": "uzawa",
-        "tol": 1e-12,
-        "linear": "direct",
-        "stop": "both",
-        "eps_u": 1e-13,
-        "eps_lambda": 1e-13,
-        "max_iterations": 20000,
-    },
-    "ssn": {"method": "ssn", "tol": 1e-12, "linear": "direct"},
-}
+OPTIONS = AGREEMENT_SOLVERS
 
 
 def scenes(family: str, n: int, layers: int, friction: float):

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 import sympy
 import yaml
+from conftest import AGREEMENT_SOLVERS
 from manufactured_contact3d import BODIES, ELLIPSE_CENTRE, ELLIPSE_WEIGHTS, KINDS, scene_path, scene_text
 
 from vemkit.config.scene import load_scene
@@ -243,20 +244,11 @@ def test_every_3d_family_converges_at_h1_order_1_and_finds_the_exact_contact_sta
 
 
 def test_uzawa_and_ssn_agree_with_the_turning_slip():
-    uzawa = {
-        "method": "uzawa",
-        "tol": 1e-12,
-        "linear": "direct",
-        "stop": "both",
-        "eps_u": 1e-13,
-        "eps_lambda": 1e-13,
-        "max_iterations": 20000,
-    }
     scene = load_scene(
         str(scene_path("sliding", "box")), ["discretization.mesh.family=voronoi", "discretization.mesh.n=3"]
     )
     problem = scene_problem(scene)
-    a, b = solve(problem, uzawa), solve(problem, {"method": "ssn", "tol": 1e-12, "linear": "direct"})
+    a, b = solve(problem, AGREEMENT_SOLVERS["uzawa"]), solve(problem, AGREEMENT_SOLVERS["ssn"])
     assert a.converged and b.converged
     assert np.max(np.abs(a.u - b.u)) / np.max(np.abs(b.u)) < 1e-10
     assert np.max(np.abs(a.multiplier - b.multiplier)) < 1e-10

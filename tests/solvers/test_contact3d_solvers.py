@@ -6,6 +6,7 @@ check sees a multiplier turned off the slip direction and |lambda| > 1."""
 
 import numpy as np
 import pytest
+from conftest import AGREEMENT_SOLVERS
 
 from vemkit.config.scene import scene_from_dict
 from vemkit.contact.problem import scene_problem
@@ -13,16 +14,7 @@ from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import SLIP, STICK, contact_state
 from vemkit.solvers.verification import verify_solution
 
-UZAWA = {
-    "method": "uzawa",
-    "tol": 1e-12,
-    "linear": "direct",
-    "stop": "both",
-    "eps_u": 1e-13,
-    "eps_lambda": 1e-13,
-    "max_iterations": 20000,
-}
-SSN = {"method": "ssn", "tol": 1e-12, "linear": "direct"}
+UZAWA, SSN = AGREEMENT_SOLVERS["uzawa"], AGREEMENT_SOLVERS["ssn"]
 
 
 def sheared_box(family: str, n: int, friction: float, m: float = 0.0):

@@ -85,6 +85,12 @@ def sphere_msh(path, h: float, H: float, half: bool = False, refined: float = 1.
         gmsh.finalize()
 
 
+def hertz_peak_pressure(P: float, a: float) -> float:
+    """Hertz's peak pressure p0 = 3 P / (2 pi a^2) of a contact of radius a under the force P (Johnson,
+    Contact Mechanics, section 4.2)."""
+    return 3.0 * P / (2.0 * math.pi * a**2)
+
+
 def positive_area(xz: np.ndarray, p: np.ndarray) -> float:
     """Area of {p_h > 0} of the piecewise linear p on triangles (n, 3, 2) with vertex values (n, 3)."""
     total = 0.0
@@ -123,7 +129,7 @@ def hertz_measures(problem, solution, E: float, nu: float, symmetry: float = 4.0
     p0_fit = math.sqrt(max(c0, 0.0))
     a_fit = math.sqrt(c0 / -c1) if c1 < 0 < c0 else float("nan")
     a_h = (3.0 * P * R * (1 - nu**2) / (4.0 * E)) ** (1.0 / 3.0)
-    p0_h = 3.0 * P / (2.0 * math.pi * a_h**2)
+    p0_h = hertz_peak_pressure(P, a_h)
     return {
         "P": P,
         "a_zero": a_zero,

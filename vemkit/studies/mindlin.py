@@ -27,6 +27,7 @@ from vemkit.contact.laws import ContactLaw
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import contact_state
 from vemkit.solvers.verification import verify_solution
+from vemkit.studies.hertz import hertz_peak_pressure
 
 STICK_LEVEL = 1.0 - 1e-6  # |lambda| below this: a stick vertex
 
@@ -57,7 +58,7 @@ def loading_in_steps(problem_at, shifts, solver: dict, *, frictionless_normal_st
 def mindlin_shear(r, a: float, c: float, mu: float, P: float):
     """Johnson's q(r) (module docstring)."""
     r = np.asarray(r, dtype=float)
-    p0 = 3.0 * P / (2.0 * math.pi * a**2)
+    p0 = hertz_peak_pressure(P, a)
     outer = np.sqrt(np.maximum(a**2 - r**2, 0.0))
     inner = np.sqrt(np.maximum(c**2 - r**2, 0.0))
     return mu * p0 / a * (outer - inner)
@@ -82,7 +83,7 @@ def mindlin_measures(problem, solution, reference, mu: float, axis: int = 2, sym
     r = np.hypot(cb.coords[:, 0], cb.coords[:, axis])
     q = np.abs(traction[:, axis])
     q_mindlin = mindlin_shear(r, a, c_mindlin, mu, P)
-    p0 = 3.0 * P / (2.0 * math.pi * a**2)
+    p0 = hertz_peak_pressure(P, a)
     return {
         "P": P,
         "Q": Q,
