@@ -9,11 +9,16 @@ On a 3D body (SPEC §10) lambda and u_tau have two components in the vertex basi
 projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk.
 
 C = 0 is |lambda| <= 1, lambda u_tau = |u_tau| for any gamma > 0. The choice only steers the active
-sets: gamma_c = GAMMA_FACTOR kd_c / (|Gamma_C| b_ref), kd_c the stiffness diagonal in the tangential
-direction, |Gamma_C| = sum_c w_c, b_ref = k_tau for the reduced law (the largest friction bound of
-the starting point for m_tau > 0). It does not grow under refinement (the local choice
-kd / (w b) ~ 1/h made the sets of mixed stick/slip cases flip-flop: 8 -> 19 iterations from 2^-4
-to 2^-8, against 5-7 -> 7-9 with this one). Start: u = the plain linear solution,
+sets: gamma_c = GAMMA_FACTOR[d] kd_c / (L_C h^(d-2) b_ref), kd_c the stiffness diagonal in the tangential
+direction, L_C = |Gamma_C|^(1/(d-1)) the size of Gamma_C (|Gamma_C| = sum_c w_c), h = (|Gamma_C| /
+n_c)^(1/(d-1)) the mean vertex spacing on it, b_ref = k_tau for the reduced law (the largest friction
+bound of the starting point for m_tau > 0). Since kd ~ E h^(d-2), gamma neither grows nor shrinks
+under refinement: in 2D it is GAMMA_FACTOR kd / (|Gamma_C| b_ref) (the local choice kd / (w b) ~ 1/h
+made the sets of mixed stick/slip cases flip-flop: 8 -> 19 iterations from 2^-4 to 2^-8, against
+5-7 -> 7-9 with this one); in 3D the same formula without h (kd / (|Gamma_C| b_ref) ~ h) let q follow
+the old lambda ever more closely: 7, 8, 9, 11, 13-17, 14, 29 Newton iterations at n = 8 ... 86 on
+the sheared box (config/scenes/3d/sheared_box.yaml), against 7 at n = 16, 8 at 32, 9 at 48 and 64
+with h. Start: u = the plain linear solution,
 lambda = P(kd u_tau / (w b_ref)) (the local trial multiplier, which finds the slip zone at once);
 or, given ``initial = (u0, lambda0)`` (a warm start, e.g. the previous adaptive step's solution
 prolongated to the refined mesh), (u0, P(lambda0)) when its residual merit theta is below that of
@@ -81,7 +86,10 @@ from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
 from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
-GAMMA_FACTOR = 0.5  # gamma = GAMMA_FACTOR kd / (|Gamma_C| b_ref), see the module docstring
+# gamma = GAMMA_FACTOR[d] kd / (L_C h^(d-2) b_ref), see the module docstring; in 3D 0.1 keeps the
+# coarse meshes' gamma where 0.5 without h had it (4x less at n_c = 16) -- 0.2 lost 1e-10 agreement of
+# uzawa and ssn on a 3 x 3 x 3 Voronoi box with m_tau = 1, 0.5 stalled a load step at 9e-12 > 1e-12
+GAMMA_FACTOR = {2: 0.5, 3: 0.1}
 ROUNDING_FLOOR = 100.0  # accept a residual this many times eps * || |K| |u| + |f| + |J| |u| || (see _converged)
 ETA_MAX = 1e-3  # loosest relative CG tolerance of an inexact Newton step
 INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that starts the iteration
@@ -278,8 +286,14 @@ def _prepare(newton, t):
     b_lin = law.friction_bound(t)
     b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
-    newton.gamma = GAMMA_FACTOR * newton.kd_tau / (np.sum(cb.weight) * newton.b_ref)
+    newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
+
+
+def _gamma_length(cb) -> float:
+    """L_C h^(d-2) of the module docstring: |Gamma_C| in 2D, sqrt(|Gamma_C| |Gamma_C| / n_c) in 3D."""
+    area = float(np.sum(cb.weight))
+    return area if cb.dimension == 2 else float(np.sqrt(area * area / cb.size))
 
 
 def _evaluate(newton, u, lam) -> _Point:
