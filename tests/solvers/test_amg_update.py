@@ -89,3 +89,31 @@ def test_the_updated_cycle_preconditions_k_plus_a_stick_penalty_as_a_new_set_up_
     rebuilt = iterations(linear_solver(A, "amg", near_nullspace=problem.near_nullspace).preconditioner)
     plain = iterations(solver.preconditioner)
     assert updated <= 1.5 * rebuilt + 2 and 2 * updated < plain, (updated, rebuilt, plain)
+
+
+def test_the_single_precision_cycle_is_the_double_one_to_its_rounding():
+    """The cycle of the 3D Newton steps runs in float32 (vemkit.solvers.ssn_steps.CYCLE_PRECISION):
+    the same operator to ~1e-6 and the same CG iterations; CG itself, in double, reaches 1e-10."""
+    import scipy.sparse.linalg as spla
+
+    problem = _box_problem(10)
+    cb, n, K = problem.contact, problem.n_dofs, problem.stiffness
+    hierarchy = linear_solver(K, "amg", near_nullspace=problem.near_nullspace).hierarchy
+    D = rank_one_blocks(cb, np.full(cb.size, 1e3 * K.diagonal().max()), cb.tangent, n)
+    cycles = [
+        BoundaryUpdatedHierarchy(hierarchy, nodal=True, precision=precision).preconditioner(D)
+        for precision in (np.float64, np.float32)
+    ]
+    b = (K + D) @ np.random.default_rng(4).normal(size=n)
+    double, single = (M @ b for M in cycles)
+    assert single.dtype == np.float64
+    assert 1e-9 < np.max(np.abs(single - double)) / np.max(np.abs(double)) < 1e-5
+    counts = [0, 0]
+    for index, M in enumerate(cycles):
+
+        def counted(_, index=index):
+            counts[index] += 1
+
+        x, info = spla.cg(K + D, b, rtol=1e-10, M=M, callback=counted)
+        assert info == 0 and np.linalg.norm((K + D) @ x - b) <= 1e-10 * np.linalg.norm(b)
+    assert abs(counts[0] - counts[1]) <= 1, counts

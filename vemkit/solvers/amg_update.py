@@ -12,7 +12,9 @@ aggregates and the prolongators of K are kept and only the operators follow D:
 (the Galerkin coarse operators of K + D exactly, since R_l (A_l(K) + D_l) P_l = A_{l+1}(K) + D_{l+1});
 D_l lives on the few rows the boundary's aggregates touch, so the update is a small sparse product
 per level, the values of D added in the patterns of the levels (no new index arrays: D's blocks lie in
-K's pattern, the Galerkin products keep them inside), and a new LU of the coarsest level.
+K's pattern, the Galerkin products keep them inside), and a new LU of the coarsest level. The finest
+level is smoothed by vertices (``nodal``, vemkit.solvers.nodal_smoother): D's slip-direction
+blocks are rank one and up to ~1e6 times K's diagonal, which scalar Gauss-Seidel relaxes poorly.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from vemkit.solvers.linear import v_cycle
+from vemkit.solvers.nodal_smoother import NodalBlocks, nodal_smoothers
 
 
 def _lookup(A, D):
@@ -81,10 +84,11 @@ def _same_pattern(pattern, D) -> bool:
 class _LevelOperator:
     """One level's A(K) and a copy of its values that holds A(K) + D_l (updated in place)."""
 
-    def __init__(self, A):
+    def __init__(self, A, precision=np.float64):
         self.base = A.tocsr()
         self.base.sort_indices()
-        self.current = sp.csr_matrix((self.base.data.copy(), self.base.indices, self.base.indptr), shape=A.shape)
+        self.precision = precision
+        self.current = self._copy()
         self.touched = np.zeros(0, dtype=np.int64)
         self.pattern = None  # D's index arrays at the last update (its positions are ``touched``)
 
@@ -107,22 +111,33 @@ class _LevelOperator:
         """A(K) on the union of its pattern and D's (an entry of K that is exactly zero, e.g. the
         x-y coupling at a vertex of an axis-aligned hexahedral grid, is not stored)."""
         self.base = widened(self.base, D)
-        self.current = sp.csr_matrix((self.base.data.copy(), self.base.indices, self.base.indptr), shape=D.shape)
+        self.current = self._copy()
         self.touched = np.zeros(0, dtype=np.int64)
         self.pattern = None
+
+    def _copy(self):
+        """A(K)'s values in ``precision`` on its own index arrays (shared, not copied)."""
+        data = self.base.data.astype(self.precision, copy=True)
+        return sp.csr_matrix((data, self.base.indices, self.base.indptr), shape=self.base.shape)
 
 
 class BoundaryUpdatedHierarchy:
     """The V-cycle of a hierarchy of K (vemkit.solvers.linear.AMGSolver's, levels already in CSR) as
     the preconditioner of K + D, for any boundary term D (see the module docstring)."""
 
-    def __init__(self, hierarchy, support=None):
+    def __init__(self, hierarchy, support=None, nodal=False, precision=np.float64):
         """``support``: a matrix whose pattern holds every D to come (e.g. the full d x d blocks of all
-        contact vertices), so that the finest level's pattern is widened once, here."""
+        contact vertices), so that the finest level's pattern is widened once, here. ``nodal``: smooth
+        the finest level by vertices of three dofs (vemkit.solvers.nodal_smoother; else the
+        hierarchy's own smoothers). ``precision``: the floating type of the cycle (its operators,
+        transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way)."""
         self.levels = hierarchy.levels
+        self.precision = precision
+        self.nodal_blocks = NodalBlocks(hierarchy.levels[0].A) if nodal else None
         self.presmoother = [level.presmoother for level in self.levels[:-1]]
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
-        self.operators = [_LevelOperator(level.A) for level in self.levels]
+        self.transfers = [(level.P.astype(precision), level.R.astype(precision)) for level in self.levels[:-1]]
+        self.operators = [_LevelOperator(level.A, precision) for level in self.levels]
         if support is not None and pattern_positions(self.operators[0].base, _summed(support)) is None:
             self.operators[0].widen(_summed(support))
 
@@ -133,20 +148,24 @@ class BoundaryUpdatedHierarchy:
         for index, level in enumerate(self.levels):
             here = _Level(self.operators[index].update(D))
             if index < len(self.levels) - 1:
-                here.P, here.R = level.P, level.R
+                here.P, here.R = self.transfers[index]
                 here.presmoother, here.postsmoother = self.presmoother[index], self.postsmoother[index]
+                if index == 0 and self.nodal_blocks is not None:
+                    inverses = self.nodal_blocks.with_term(D).astype(self.precision)
+                    here.presmoother, here.postsmoother = nodal_smoothers(inverses)
                 D = _summed(level.R @ D @ level.P)
             levels.append(here)
-        if len(levels) == 1:
-            lu = spla.splu(levels[0].A.tocsc())
-            return spla.LinearOperator(levels[0].A.shape, matvec=lambda b: lu.solve(np.ravel(b)), dtype=float)
         lu = spla.splu(levels[-1].A.tocsc())
+        if len(levels) == 1:
+            cycle = lu.solve
+        else:
 
-        def coarse(_, b):
-            return lu.solve(b)
+            def cycle(b):
+                return v_cycle(levels, lambda _, coarse_b: lu.solve(coarse_b), 0, b)
 
+        precision = self.precision
         return spla.LinearOperator(
-            levels[0].A.shape, dtype=float, matvec=lambda b: v_cycle(levels, coarse, 0, np.ravel(b))
+            levels[0].A.shape, dtype=float, matvec=lambda b: cycle(np.ravel(b).astype(precision)).astype(float)
         )
 
 

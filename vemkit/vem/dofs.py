@@ -173,20 +173,45 @@ def cell_order_numbering(mesh: Mesh, offsets: np.ndarray, nodes: np.ndarray, n_n
     return first_appearance(nodes[idx], n_nodes)
 
 
+@numba.njit(cache=True)
+def _held_out(indptr, indices, data, held):
+    """The CSR arrays of A without the rows and columns of the held dofs, a held row keeping only its
+    diagonal entry, and without A's stored zeros (as zeroing, eliminate_zeros and adding the diagonal
+    back would give, in one pass)."""
+    n = indptr.shape[0] - 1
+    out_indptr = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        count = 0
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if (j == i) if held[i] else (not held[j] and data[p] != 0.0):
+                count += 1
+        out_indptr[i + 1] = out_indptr[i] + count
+    out_indices = np.empty(out_indptr[n], dtype=indices.dtype)
+    out_data = np.empty(out_indptr[n], dtype=data.dtype)
+    for i in range(n):
+        q = out_indptr[i]
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if (j == i) if held[i] else (not held[j] and data[p] != 0.0):
+                out_indices[q] = j
+                out_data[q] = data[p]
+                q += 1
+    return out_data, out_indices, out_indptr
+
+
 def apply_fixed_dofs(stiffness: sp.csr_matrix, load: np.ndarray, dofs: DofMap):
     """(K, f) with the fixed dofs held at their values by symmetric elimination (module doc)."""
     if dofs.fixed_dofs.size == 0:
         return stiffness, load
     fixed, g = dofs.fixed_dofs, dofs.fixed_values
     load = load - stiffness[:, fixed] @ g
-    K = stiffness.tocsr(copy=True)
+    K = stiffness.tocsr()
+    K.sum_duplicates()  # canonical: sorted, one entry per position (a no-op for the assembled matrix)
     diagonal = K.diagonal()[fixed]
-    held = np.zeros(K.shape[0], dtype=bool)
+    held = np.zeros(K.shape[0], dtype=np.bool_)
     held[fixed] = True
-    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-    K.data[held[rows] | held[K.indices]] = 0.0
-    K.eliminate_zeros()
-    K = (K + sp.csr_matrix((diagonal, (fixed, fixed)), shape=K.shape)).tocsr()
-    K.sort_indices()
+    K = sp.csr_matrix(_held_out(K.indptr, K.indices, K.data, held), shape=K.shape)
+    K.has_canonical_format = True
     load[fixed] = diagonal * g
     return K, load
