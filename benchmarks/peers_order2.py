@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/peers_order2.py [--quick] [--k2-sizes 16 32 64 128 256] [--k1-sizes ...]
 
 On triangles the k = 2 virtual element space is not P2 (it also has a cell moment per cell), so
-the codes are compared at equal error on the manufactured problem of benchmarks/peers/manufactured.py
+the codes are compared at equal error on the manufactured problem of benchmarks/peers/exact_elasticity.py
 (a smooth exact solution, Dirichlet data on two sides, tractions on the others, the body force).
 Every code solves on the structured triangle mesh `vemkit mesh triangle N` wrote, each in its own
 process (wait4: wall, CPU, peak RSS):
@@ -37,7 +37,7 @@ from peers import PEERS, SKFEM_DIRECT_MAX_DOFS, SYSTEM_PYTHON, VEMKIT, getfem_mi
 from _common import MACHINE, OUT, write_report
 
 sys.path.append(str(PEERS))  # benchmarks/peers: the problem's one home
-from manufactured import manufactured_problem  # noqa: E402
+from exact_elasticity import manufactured_problem  # noqa: E402
 
 ERROR_ORDER = 8  # every error integral: a degree-8 rule on every triangle (the integrands are smooth)
 LABELS = {("vemkit", 1): "vemkit k = 1", ("vemkit", 2): "vemkit k = 2", ("skfem", 1): "scikit-fem P1"}
@@ -150,17 +150,20 @@ def n_edges(case: dict) -> int:
     return len(np.unique(edges, axis=0))
 
 
-def run_size(n: int, orders, peers, problem: dict, work: Path) -> list[dict]:
-    """One structured mesh: vemkit and every peer at each order (k = 1 with P1, k = 2 with P2)."""
+def run_size(n: int, orders, peers, problem: dict, work: Path, getfem_max_dofs: float = np.inf) -> list[dict]:
+    """One structured mesh: vemkit and every peer at each order (k = 1 with P1, k = 2 with P2);
+    GetFEM only up to ``getfem_max_dofs`` DOFs of its space."""
     mesh_path = work / f"mesh-{n}.nc"
     write_mesh("structured", n, mesh_path)
     case = mesh_case(mesh_path)
     rows = []
     for order in orders:
+        fem_dofs = 2 * (len(case["vertices"]) + (order - 1) * n_edges(case))
+        chosen = [p for p in peers if p != "getfem" or fem_dofs <= getfem_max_dofs]
         rows.append({"n": n, "order": order, "code": "vemkit"} | run_vemkit(order, mesh_path, problem, work))
-        for peer in peers:
+        for peer in chosen:
             rows.append({"n": n, "order": order, "code": peer} | run_peer(peer, order, case, problem, work))
-        for row in rows[-1 - len(peers) :]:
+        for row in rows[-1 - len(chosen) :]:
             print(
                 f"n = {n}: {LABELS[row['code'], order]}: {row['dofs']} DOFs, |e|_1 = {row['error_h1_semi']:.3e}, "
                 f"process {row['process_s']:.2f} s",
@@ -245,9 +248,11 @@ def figure(rows: list[dict], path: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="n = 8, 16 only (a smoke test)")
-    parser.add_argument("--k2-sizes", type=int, nargs="+", default=[16, 32, 64, 128, 256])
+    parser.add_argument("--k2-sizes", type=int, nargs="*", default=[16, 32, 64, 128, 256])
     parser.add_argument("--k1-sizes", type=int, nargs="*", default=[16, 32, 64, 128, 256, 512])
+    parser.add_argument("--getfem-max-dofs", type=float, default=np.inf, help="no GetFEM solve above this")
     parser.add_argument("--keep", type=Path, help="keep the meshes and cases in this folder")
+    parser.add_argument("--resume", action="store_true", help="keep the runs of benchmarks/out/peers_order2.json")
     args = parser.parse_args()
     k2, k1 = ([8, 16], [8, 16]) if args.quick else (args.k2_sizes, args.k1_sizes)
     getfem_reason = getfem_missing()
@@ -255,19 +260,24 @@ def main() -> None:
     problem = manufactured_problem()
     work = Path(args.keep or tempfile.mkdtemp(prefix="vemkit-peers-order2-"))
     work.mkdir(parents=True, exist_ok=True)
-    for order in (1, 2):  # numba's on-disk cache compiled before anything is timed
-        write_mesh("structured", 4, work / "warm.nc")
-        subprocess.run(
-            [str(VEMKIT), "solve", str(warm_scene(problem, work, order)), "-o", str(work / "w.nc"), "-q"], check=True
-        )
-    rows = []
+    warm_up(problem, work)
+    rows = json.loads((OUT / "peers_order2.json").read_text())["rows"] if args.resume else []
+    done = {(r["n"], r["order"]) for r in rows}
     for n in sorted(set(k1) | set(k2)):
-        orders = [o for o, sizes in ((1, k1), (2, k2)) if n in sizes]
-        rows += run_size(n, orders, peers, problem, work)
+        orders = [o for o, sizes in ((1, k1), (2, k2)) if n in sizes and (n, o) not in done]
+        rows += run_size(n, orders, peers, problem, work, args.getfem_max_dofs)
         report(rows, peers, getfem_reason, quiet=True)  # after every size: a stopped run keeps its rows
     if not args.keep:
         shutil.rmtree(work)
     report(rows, peers, getfem_reason)
+
+
+def warm_up(problem: dict, work: Path) -> None:
+    """Numba's on-disk cache compiled (k = 1 and 2) before anything is timed."""
+    write_mesh("structured", 4, work / "warm.nc")
+    for order in (1, 2):
+        scene = warm_scene(problem, work, order)
+        subprocess.run([str(VEMKIT), "solve", str(scene), "-o", str(work / "w.nc"), "-q"], check=True)
 
 
 def warm_scene(problem: dict, work: Path, order: int) -> Path:

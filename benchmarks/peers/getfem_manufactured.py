@@ -1,4 +1,4 @@
-"""GetFEM P1 or P2 on the manufactured problem of benchmarks/peers/manufactured.py, and its errors
+"""GetFEM P1 or P2 on the manufactured problem of benchmarks/peers/exact_elasticity.py, and its errors
 against the exact solution (benchmarks/peers_order2.py; the system /usr/bin/python3, python3-getfem).
 
     /usr/bin/python3 benchmarks/peers/getfem_manufactured.py CASE.npz OUT.npz
@@ -18,8 +18,8 @@ import time
 
 import getfem as gf
 import numpy as np
+from exact_elasticity import evaluate, in_getfem
 from getfem_solve import build_mesh, linear_solver, solve  # this folder
-from manufactured import evaluate, in_getfem
 
 
 def vector(expressions):

@@ -1,10 +1,10 @@
-"""scikit-fem P1 or P2 on the manufactured problem of benchmarks/peers/manufactured.py, and its
+"""scikit-fem P1 or P2 on the manufactured problem of benchmarks/peers/exact_elasticity.py, and its
 errors against the exact solution (benchmarks/peers_order2.py).
 
     .venv/bin/python benchmarks/peers/skfem_manufactured.py CASE.npz OUT.npz
 
 CASE.npz as for skfem_solve.py; `params`: degree (1 or 2), the problem's expressions
-(manufactured.manufactured_problem), solver ("direct" | "amg"), cg_rtol, error_order. As scikit-fem's
+(exact_elasticity.manufactured_problem), solver ("direct" | "amg"), cg_rtol, error_order. As scikit-fem's
 users write it: `ElementVector(ElementTriP1 | ElementTriP2)`, its default quadrature (intorder 2k:
 exact stiffness, the load and the traction integrated to degree 2k), u = u_exact interpolated at the
 Dirichlet dofs (a lift), then spsolve or pyamg SA + CG with the rigid modes on the condensed
@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 import skfem
-from manufactured import evaluate  # this folder
+from exact_elasticity import evaluate  # this folder
 from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 from skfem_solve import facets_of, linear_solve, rigid_modes

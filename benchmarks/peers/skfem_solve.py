@@ -22,7 +22,8 @@ from skfem.models.elasticity import linear_elasticity
 def facets_of(mesh, edges):
     """The facet numbers of the given vertex pairs (any order), by sorted keys (no Python loop)."""
     n = mesh.p.shape[1]
-    facets, pairs = np.sort(mesh.facets, axis=0), np.sort(np.asarray(edges).reshape(-1, 2), axis=1)
+    facets = np.sort(mesh.facets, axis=0).astype(np.int64)  # int64: the keys exceed int32 from n ~ 46 000
+    pairs = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
     keys, wanted = facets[0] * n + facets[1], pairs[:, 0] * n + pairs[:, 1]
     order = np.argsort(keys)
     found = order[np.minimum(np.searchsorted(keys, wanted, sorter=order), keys.size - 1)]
