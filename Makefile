@@ -80,15 +80,18 @@ bench: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python benchmarks/meshing.py
 	$(BIN)/python benchmarks/assembly_k2.py
 
-# vemkit k = 1 against scikit-fem and GetFEM P1 on the same triangle meshes (benchmarks/peers.py,
-# README "Side by side with GetFEM and scikit-fem"). GetFEM: python3-getfem for /usr/bin/python3,
-# installed here when missing and root, else skipped with one line. PEERS_ARGS=--quick: a smoke test.
+# vemkit k = 1 against scikit-fem and GetFEM P1 on the same triangle meshes (benchmarks/peers.py),
+# and k = 2 against their P2 at equal error (benchmarks/peers_order2.py; docs/benchmarks/peers.md).
+# GetFEM: python3-getfem for /usr/bin/python3, installed here when missing and root, else skipped
+# with one line. PEERS_ARGS=--quick: a smoke test (both scripts; PEERS_ORDER2_ARGS: the second's own).
 PEERS_ARGS ?=
+PEERS_ORDER2_ARGS ?= $(filter --quick,$(PEERS_ARGS))
 getfem:
 	@bash benchmarks/peers/install_getfem.sh
 
 peers: $(STAMP) $(NUMBA_STAMP) getfem
 	$(BIN)/python benchmarks/peers.py $(PEERS_ARGS)
+	$(BIN)/python benchmarks/peers_order2.py $(PEERS_ORDER2_ARGS)
 
 clean-results:
 	rm -rf results/*.nc results/tables results/figures results/solutions results/meshes results/errors results/benchmarks logs

@@ -44,20 +44,29 @@ LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C
 TRACTION_LEFT = [[1000.0, 0.0, -200.0], [-200.0, 0.0, 0.0]]  # (200 (5 - y), -200) as a + b x + c y
 PROBLEMS = ("elasticity", "compliance", "friction")
 FRICTION_K = 450.0  # the paper's k_tau (m_tau = 0): every Gamma_C vertex slides
+GNU_TIME, RSS_MARK = "/usr/bin/time", "peak_rss_kib="
 SKFEM_DIRECT_MAX_DOFS = 200_000  # spsolve up to here, pyamg SA + CG above (scikit-fem's docs)
 
 
 def measured(command: list[str]) -> dict:
-    """Run a command; its wall time, peak resident memory (wait4) and exit status."""
+    """Run a command; its wall time, CPU time (user + system, wait4) and peak resident memory.
+
+    Linux carries a process' peak RSS across fork and exec, so wait4 alone would report at least
+    this script's own RSS: the peak comes from GNU time (``%M``, the command forked from a small
+    process) when /usr/bin/time exists, else from wait4 (then an upper bound).
+    """
+    wrapped = [GNU_TIME, "-f", f"{RSS_MARK}%M", *command] if Path(GNU_TIME).exists() else command
     start = time.perf_counter()
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process = subprocess.Popen(wrapped, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(process.pid, 0)
     wall = time.perf_counter() - start
     stderr = process.stderr.read().decode()
     process.returncode = os.waitstatus_to_exitcode(status)
     if process.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed: {stderr.strip()[-2000:]}")
-    return {"wall_s": wall, "max_rss_mib": usage.ru_maxrss / 1024.0}
+    marked = [line for line in stderr.splitlines() if line.startswith(RSS_MARK)]
+    rss_kib = int(marked[-1][len(RSS_MARK) :]) if marked else usage.ru_maxrss
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "max_rss_mib": rss_kib / 1024.0}
 
 
 def getfem_missing() -> str | None:

@@ -20,9 +20,15 @@ from skfem.models.elasticity import linear_elasticity
 
 
 def facets_of(mesh, edges):
-    """The facet numbers of the given vertex pairs (any order)."""
-    key = {tuple(sorted(pair)): f for f, pair in enumerate(mesh.facets.T)}
-    return np.array([key[tuple(sorted(pair))] for pair in edges], dtype=np.int64)
+    """The facet numbers of the given vertex pairs (any order), by sorted keys (no Python loop)."""
+    n = mesh.p.shape[1]
+    facets = np.sort(mesh.facets, axis=0).astype(np.int64)  # int64: the keys exceed int32 from n ~ 46 000
+    pairs = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
+    keys, wanted = facets[0] * n + facets[1], pairs[:, 0] * n + pairs[:, 1]
+    order = np.argsort(keys)
+    found = order[np.minimum(np.searchsorted(keys, wanted, sorter=order), keys.size - 1)]
+    assert np.array_equal(keys[found], wanted), "a side edge is not a facet of the mesh"
+    return found
 
 
 def assemble(case, p):
@@ -47,13 +53,14 @@ def assemble(case, p):
 
 
 def rigid_modes(basis):
-    """The translations and the rotation (-y, x), in the basis' dof numbering."""
-    x, y = basis.mesh.p
-    first, second = basis.nodal_dofs
+    """The translations and the rotation (-y, x), in the basis' dof numbering (any Lagrange
+    element: the dofs are point values at ``basis.doflocs``)."""
+    x, y = basis.doflocs
+    first, second = basis.split_indices()
     modes = np.zeros((basis.N, 3))
     modes[first, 0] = 1.0
     modes[second, 1] = 1.0
-    modes[first, 2], modes[second, 2] = -y, x
+    modes[first, 2], modes[second, 2] = -y[first], x[second]
     return modes
 
 
