@@ -96,9 +96,14 @@ class Mesh:
         return self._edge_table[0]
 
     @cached_property
+    def edge_first_half_edges(self) -> np.ndarray:
+        """``(E,)`` the first (smallest) index of every edge's half-edges."""
+        return self._edge_table[1]
+
+    @cached_property
     def edges(self) -> np.ndarray:
         """``(E, 2)`` undirected edges, each oriented as in its first cell."""
-        return self.half_edges[self._edge_table[1]]
+        return self.half_edges[self.edge_first_half_edges]
 
     @cached_property
     def edge_cells(self) -> np.ndarray:
@@ -108,7 +113,7 @@ class Mesh:
         """
         ne = self.edges.shape[0]
         out = np.full((ne, 2), -1, dtype=np.int64)
-        first = self._edge_table[1]
+        first = self.edge_first_half_edges
         out[:, 0] = self.half_edge_cells[first]
         other = np.ones(self.half_edges.shape[0], dtype=bool)
         other[first] = False
