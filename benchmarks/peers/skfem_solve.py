@@ -20,9 +20,17 @@ from skfem.models.elasticity import linear_elasticity
 
 
 def facets_of(mesh, edges):
-    """The facet numbers of the given vertex pairs (any order)."""
-    key = {tuple(sorted(pair)): f for f, pair in enumerate(mesh.facets.T)}
-    return np.array([key[tuple(sorted(pair))] for pair in edges], dtype=np.int64)
+    """The facet numbers of the given vertex pairs (any order), vectorised as a careful user would
+    (a Python dict over all facets cost 0.5 s at 5e5 DOFs): scikit-fem stores every facet with its
+    smaller vertex first, so (low, high) keys looked up in the facets' sorted keys."""
+    n = np.int64(mesh.p.shape[1])
+    keys = mesh.facets[0].astype(np.int64) * n + mesh.facets[1]
+    edges = np.sort(np.asarray(edges, dtype=np.int64), axis=1)
+    wanted = edges[:, 0] * n + edges[:, 1]
+    order = np.argsort(keys)
+    found = order[np.minimum(np.searchsorted(keys, wanted, sorter=order), keys.size - 1)]
+    assert np.array_equal(keys[found], wanted), "an edge of the case is not a facet of the mesh"
+    return found
 
 
 def assemble(case, p):
