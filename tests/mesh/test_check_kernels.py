@@ -13,7 +13,7 @@ from vemkit.mesh.check_kernels import (
 )
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families.square import square
-from vemkit.mesh.mesh import Mesh, from_polygons
+from vemkit.mesh.mesh import Mesh, edge_table, edge_table_numpy, from_polygons
 
 
 def random_soup(seed, n_vertices=60, n_cells=200, repeats=True):
@@ -92,3 +92,13 @@ def test_same_direction_edge_named_by_its_smallest_vertex_pair():
 def _csr(cells):
     mesh = Mesh(np.zeros((30, 2)), np.cumsum([0] + [len(c) for c in cells]), np.concatenate(cells), {}, {})
     return mesh.cell_offsets, mesh.cell_vertices
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_edge_table_is_the_stable_sort_of_the_vertex_pairs(seed):
+    mesh = random_soup(seed, n_vertices=40, n_cells=300)  # vertices of degree over INSERTION_SORT_MAX
+    for got, want in zip(edge_table(mesh.half_edges, mesh.n_vertices), edge_table_numpy(mesh.half_edges, 40)):
+        assert np.array_equal(got, want)
+    fine = square(9)
+    for got, want in zip(fine._edge_table, edge_table_numpy(fine.half_edges, fine.n_vertices)):
+        assert np.array_equal(got, want)
