@@ -26,6 +26,7 @@ import numba
 import numpy as np
 
 from vemkit.exceptions import MeshError
+from vemkit.mesh.check_kernels import cell_perimeters, corner_angle_sums, first_repeated_vertex
 from vemkit.mesh.close_points import close_pairs
 from vemkit.mesh.geometry import bin_boxes
 from vemkit.mesh.mesh import Mesh
@@ -77,11 +78,8 @@ def _check_arrays(mesh: Mesh) -> None:
 
 # -- cells ----------------------------------------------------------------------------------
 def _check_cells(mesh: Mesh) -> None:
-    n, cells = mesh.n_vertices, mesh.half_edge_cells
-    key = np.sort(cells * np.int64(n) + mesh.cell_vertices)
-    rep = np.flatnonzero(key[1:] == key[:-1])
-    if rep.size:
-        k, vtx = divmod(int(key[rep[0]]), n)
+    k, vtx = first_repeated_vertex(mesh.cell_offsets, mesh.cell_vertices)
+    if k >= 0:
         raise MeshError(f"cell {k} lists vertex {vtx} more than once; list every vertex of a polygon once")
     k, i, j = _first_self_intersection(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices)
     if k >= 0:
@@ -91,9 +89,7 @@ def _check_cells(mesh: Mesh) -> None:
             f"cell {k} is self-intersecting: its edges ({c[i]}, {c[(i + 1) % m]}) and "
             f"({c[j]}, {c[(j + 1) % m]}) meet; order its vertices along its boundary"
         )
-    he = mesh.half_edges
-    p, q = mesh.vertices[he[:, 0]], mesh.vertices[he[:, 1]]
-    perimeter = np.add.reduceat(np.linalg.norm(q - p, axis=1), mesh.cell_offsets[:-1])
+    perimeter = cell_perimeters(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices)
     area = mesh.cell_areas
     flat = np.abs(area) <= 1e-12 * perimeter**2
     if flat.any():
@@ -146,6 +142,8 @@ def _first_self_intersection(vertices, offsets, cell_vertices):
     """First cell in which two non-adjacent edges meet: (cell, i, j) edge starts, or (-1, -1, -1)."""
     for k in range(offsets.size - 1):
         s, m = offsets[k], offsets[k + 1] - offsets[k]
+        if m <= 3:
+            continue  # a triangle's edges are all adjacent
         for i in range(m):
             a, b = vertices[cell_vertices[s + i]], vertices[cell_vertices[s + (i + 1) % m]]
             for j in range(i + 2, m):
@@ -183,11 +181,18 @@ def _check_edges(mesh: Mesh) -> None:
         raise MeshError(
             f"edge ({a}, {b}) belongs to {counts[e]} cells {owners.tolist()}; an edge is shared by at most 2 cells"
         )
-    key = he[:, 0] * np.int64(mesh.n_vertices) + he[:, 1]
-    order = np.argsort(key, kind="stable")
-    twice = np.flatnonzero(key[order][1:] == key[order][:-1])
-    if twice.size:
-        h0, h1 = order[twice[0]], order[twice[0] + 1]
+    # at most two half-edges per edge: its first (the smaller index) and its second, if any
+    first = mesh.edge_first_half_edges
+    second = np.ones(he.shape[0], dtype=bool)
+    second[first] = False
+    h1 = np.flatnonzero(second)
+    h0 = first[mesh.half_edge_edge[h1]]
+    same = np.flatnonzero(he[h0, 0] == he[h1, 0])
+    if same.size:
+        key = he[h0[same], 0] * np.int64(mesh.n_vertices) + he[h0[same], 1]
+        h0, h1 = h0[same], h1[same]
+        pick = int(np.argmin(key))  # the smallest directed (a, b) of all, as a sort by it names
+        h0, h1 = h0[pick], h1[pick]
         a, b = he[h0]
         raise MeshError(
             f"edge ({a}, {b}) is traversed in the same direction by cells {cells[h0]} and {cells[h1]}; "
@@ -235,12 +240,7 @@ def _corner_angles(p, v, q):
 
 def _check_angle_sums(mesh: Mesh, be: np.ndarray, out_deg: np.ndarray) -> None:
     v = mesh.vertices
-    he = mesh.half_edges
-    prev = np.empty(he.shape[0], dtype=np.int64)
-    prev[1:] = he[:-1, 0]
-    prev[mesh.cell_offsets[:-1]] = he[mesh.cell_offsets[1:] - 1, 0]
-    corner = _corner_angles(v[prev], v[he[:, 0]], v[he[:, 1]])
-    total = np.bincount(he[:, 0], weights=corner, minlength=mesh.n_vertices)
+    total = corner_angle_sums(v, mesh.cell_offsets, mesh.cell_vertices)
     expected = np.full(mesh.n_vertices, 2 * np.pi)
     simple = out_deg[be[:, 0]] == 1
     arrive_from = np.full(mesh.n_vertices, -1, dtype=np.int64)

@@ -37,6 +37,7 @@ from vemkit.config.domain import SIDE_NAME
 from vemkit.config.limits import check_resources, estimate_resources, memory_budget
 from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
 from vemkit.exceptions import MeshError
+from vemkit.mesh.check_kernels import worst_coordinate_over_edge
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.geometry import counter_clockwise
@@ -264,15 +265,11 @@ def _check_precision(mesh: Mesh, path: Path) -> None:
         or mesh.cell_sizes.min() < 3
     ):
         return  # validate_mesh names the vertex or the cell
-    half = mesh.half_edges
-    length = np.hypot(*(v[half[:, 1]] - v[half[:, 0]]).T)
-    reach = np.abs(v[half[:, 0]]).max(axis=1)
-    ratio = np.divide(reach, length, out=np.zeros_like(reach), where=length > 0)
-    worst = int(np.argmax(ratio))
-    if ratio[worst] > MAX_FILE_COORDINATE_OVER_EDGE:
-        a, b = half[worst]
+    worst, ratio, length, reach = worst_coordinate_over_edge(v, mesh.cell_offsets, refs)
+    if ratio > MAX_FILE_COORDINATE_OVER_EDGE:
+        a, b = mesh.half_edges[worst]
         raise MeshError(
-            f"{path.name}: edge ({a}, {b}) is {length[worst]:.3g} long at |x|, |y| = {reach[worst]:.3g}, more "
+            f"{path.name}: edge ({a}, {b}) is {length:.3g} long at |x|, |y| = {reach:.3g}, more "
             f"than {MAX_FILE_COORDINATE_OVER_EDGE:.0e} times shorter than its distance from the origin: too "
             "small for double precision there; shift the mesh near the origin",
             key=str(path),

@@ -78,6 +78,12 @@ AMG_OPTIONS = dict(
 #: solve 0.45 -> 0.20 s; the contact solver refactors it at every Newton step, vemkit.solvers.amg_update)
 BLOCK_MAX_COARSE = 600
 FINEST_OWN = 2000  # above this many unknowns the finest level is vemkit.solvers.amg_setup's
+#: 2D: the strength on the levels below vemkit's finest (3 x 3 blocks). theta = 0 (every block strong)
+#: made the second level's aggregates too coarse: CG to 1e-12 on structured triangles at 5.3e5 DOFs
+#: took 64 iterations, with 0.08 38 (CG 7.7 -> 4.7 s CPU, set-up 1.3 -> 0.8 s; operator complexity
+#: 1.43 -> 1.45); paper squares 5.3e5: 29 -> 24, Delaunay 1.3e5: 40 -> 32, Voronoi 6.5e4: 26 both;
+#: 0.15: 27 iterations but a 4767-unknown coarsest LU; 0.25: 1198 iterations (benchmarks/peers.py meshes)
+COARSE_STRENGTH_2D = ("symmetric", {"theta": 0.08})
 
 
 def smoothed_aggregation(A, near_nullspace=None):
@@ -106,6 +112,7 @@ def smoothed_aggregation(A, near_nullspace=None):
     P, R, A_coarse, B_coarse = finest_level(A, near_nullspace, omega=options["smooth"][1]["omega"])
     presmoother, postsmoother = options.pop("presmoother"), options.pop("postsmoother")
     coarse_solver = options.pop("coarse_solver")
+    options["strength"] = COARSE_STRENGTH_2D
     coarse = pyamg.smoothed_aggregation_solver(
         A_coarse, B=B_coarse, presmoother=presmoother, postsmoother=postsmoother, coarse_solver=coarse_solver, **options
     )
