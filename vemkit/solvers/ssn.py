@@ -18,7 +18,10 @@ made the sets of mixed stick/slip cases flip-flop: 8 -> 19 iterations from 2^-4 
 5-7 -> 7-9 with this one); in 3D the same formula without h (kd / (|Gamma_C| b_ref) ~ h) let q follow
 the old lambda ever more closely: 7, 8, 9, 11, 13-17, 14, 29 Newton iterations at n = 8 ... 86 on
 the sheared box (config/scenes/3d/sheared_box.yaml), against 7 at n = 16, 8 at 32, 9 at 48 and 64
-with h. Start: u = the plain linear solution,
+with h. 3D with m_tau > 0 (Coulomb's coupled law): the local gamma_c = kd_c / (w_c b_c), b_c the
+vertex's own bound at the start (vemkit.solvers.ssn_disk.coupled_gamma; the global one left
+gamma |u_tau| ~ 1e-6 at the sliding vertices of the Mindlin sphere, so q did not see the slip
+direction). Start: u = the plain linear solution,
 lambda = P(kd u_tau / (w b_ref)) (the local trial multiplier, which finds the slip zone at once);
 or, given ``initial = (u0, lambda0)`` (a warm start, e.g. the previous adaptive step's solution
 prolongated to the refined mesh), (u0, P(lambda0)) when its residual merit theta is below that of
@@ -289,6 +292,10 @@ def _prepare(newton, t):
     b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
+    if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
+        from vemkit.solvers.ssn_disk import coupled_gamma
+
+        newton.gamma = coupled_gamma(newton.kd_tau, cb.weight, b_lin, newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
 
 
