@@ -160,16 +160,22 @@ def run_vemkit(problem: str, mesh_path: Path, work: Path) -> tuple[np.ndarray, d
     return u, record | {"node_xy": xy}
 
 
+def peer_process(peer: str, script: str, params: dict, case: dict, stem: Path):
+    """(the process record, the arrays it wrote) of one peer script on the case (``stem``-case.npz in,
+    ``stem``.npz out); GetFEM under the system python."""
+    case_path, out = stem.with_name(stem.name + "-case.npz"), stem.with_suffix(".npz")
+    np.savez(case_path, params=json.dumps(params), **case)
+    python = SYSTEM_PYTHON if peer == "getfem" else sys.executable
+    record = measured([python, str(PEERS / script), str(case_path), str(out)])
+    with np.load(out) as result:
+        return record, {key: result[key] for key in result.files}
+
+
 def run_peer(peer: str, problem: str, case: dict, work: Path, params: dict | None = None):
     """u at the case's vertices and the process record of one peer's solve."""
     params = params or peer_params(problem, 2 * len(case["vertices"]))
-    case_path, out = work / f"{problem}-{peer}-case.npz", work / f"{problem}-{peer}.npz"
-    np.savez(case_path, params=json.dumps(params), **case)
-    python = SYSTEM_PYTHON if peer == "getfem" else sys.executable
-    record = measured([python, str(PEERS / f"{peer}_solve.py"), str(case_path), str(out)])
-    with np.load(out) as result:
-        info = json.loads(str(result["info"]))
-        u = result["u"]
+    record, result = peer_process(peer, f"{peer}_solve.py", params, case, work / f"{problem}-{peer}")
+    info, u = json.loads(str(result["info"])), result["u"]
     record.update(
         assembly_s=info["setup_s"],
         solve_s=info["solve_s"],

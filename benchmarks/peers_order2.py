@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from peers import PEERS, SKFEM_DIRECT_MAX_DOFS, SYSTEM_PYTHON, VEMKIT, getfem_missing, measured, mesh_case, write_mesh
+from peers import PEERS, SKFEM_DIRECT_MAX_DOFS, VEMKIT, getfem_missing, measured, mesh_case, peer_process, write_mesh
 
 from _common import MACHINE, OUT, write_report
 
@@ -123,12 +123,8 @@ def run_peer(peer: str, order: int, case: dict, problem: dict, work: Path) -> di
         "max_res": 1e-9,
         "error_order": ERROR_ORDER,
     }
-    case_path, out = work / f"{peer}-p{order}-case.npz", work / f"{peer}-p{order}.npz"
-    np.savez(case_path, params=json.dumps(params), **case)
-    python = SYSTEM_PYTHON if peer == "getfem" else sys.executable
-    record = measured([python, str(PEERS / f"{peer}_manufactured.py"), str(case_path), str(out)])
-    with np.load(out) as result:
-        info = json.loads(str(result["info"]))
+    record, result = peer_process(peer, f"{peer}_manufactured.py", params, case, work / f"{peer}-p{order}")
+    info = json.loads(str(result["info"]))
     return record | {
         "dofs": info["n_dofs"],
         "unknowns": info["n_dofs"],
