@@ -7,8 +7,8 @@ scene is refused on the command line with the same one-line message, naming ``--
 
 from __future__ import annotations
 
-from vemkit.config import scene as _scene
 from vemkit.config.safe_yaml import parse_yaml
+from vemkit.config.scene_schema import check_finite, first_problem, normalized, schema_error_message, schema_root
 from vemkit.exceptions import SceneError
 
 __all__ = ["mesh_request", "validate_mesh_options"]
@@ -25,7 +25,7 @@ def _cli_fix(key: str | None) -> str:
 
 
 def _mesh_schema() -> dict:
-    root = _scene._validator().schema
+    root = schema_root()
     node = root["properties"]["discretization"]["properties"]["mesh"]
     return {**node, "$defs": root["$defs"]}
 
@@ -35,19 +35,19 @@ def validate_mesh_options(data: dict, fix=_cli_fix) -> dict:
     import jsonschema
 
     try:
-        _scene._check_finite(data, [], fix)
+        check_finite(data, [], fix)
     except SceneError as error:
         prefix = "" if error.key in ("family", "n") else "--option "
         raise SceneError(prefix + str(error), key=error.key) from None
     validator = jsonschema.Draft202012Validator(_mesh_schema())
     errors = list(validator.iter_errors(data))
     if errors:
-        first = min(errors, key=lambda e: (_scene._document_order(data, e), e.validator != "type"))
-        message = _scene._schema_error_message(first, fix)
+        first = first_problem(errors, data)
+        message = schema_error_message(first, fix)
         key = next(iter(first.absolute_path), None)
         prefix = "" if key in ("family", "n") or first.validator == "required" else "--option "
         raise SceneError(prefix + message, key=str(key))
-    return _scene._normalized(data, _mesh_schema())
+    return normalized(data, _mesh_schema())
 
 
 def mesh_request(family: str, n, options=()) -> dict:

@@ -1,7 +1,8 @@
 """Scene files (SPEC §6): read the YAML, apply ``--set`` overrides, validate, fill the defaults.
 
 One source of truth: ``vemkit/config/schemas/scene.schema.json`` holds the keys, the bounds and the
-``default`` values; this module walks it. Every problem is a :class:`SceneError` (a ``ValueError``)
+``default`` values (:mod:`vemkit.config.scene_schema` walks it, :mod:`vemkit.config.overrides` applies
+``--set``); this module adds the checks beyond the schema and the :class:`Scene`. Every problem is a :class:`SceneError` (a ``ValueError``)
 with a one-line message naming the offending key, e.g.
 ``material.nu = 0.7: must be < 0.5 (Poisson ratio of plane stress); fix the scene or --set material.nu=...``
 """
@@ -9,16 +10,10 @@ with a one-line message naming the offending key, e.g.
 from __future__ import annotations
 
 import copy
-import difflib
-import json
-import re
-import sys
-from functools import lru_cache, partial
-from importlib.resources import files
+from functools import partial
 from pathlib import Path
 from typing import NamedTuple
 
-import jsonschema
 import yaml
 
 from vemkit.config.boundary_conditions import (
@@ -37,23 +32,14 @@ from vemkit.config.expressions import Expression
 from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.config.material import lame_parameters
 from vemkit.config.mesh_resolution import check_mesh_resolution
+from vemkit.config.overrides import apply_override
 from vemkit.config.safe_yaml import SceneDumper, read_user_file
 from vemkit.config.safe_yaml import parse_yaml as _parse_yaml
 from vemkit.config.scene3d import check_model_domain, semantic_checks_3d
+from vemkit.config.scene_schema import normalized, scene_schema, schema_root, show, validate
 from vemkit.exceptions import SceneError
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml", "scene_schema"]
-
-NO_DIRICHLET = "no Dirichlet part: the body is not held; add boundary.dirichlet: [right]"
-_TYPE_NAMES = {
-    "number": "a number",
-    "integer": "an integer",
-    "string": "a string",
-    "object": "a mapping",
-    "array": "a list",
-    "null": "null",
-    "boolean": "true/false",
-}
 
 
 class PowerLaw(NamedTuple):
@@ -61,296 +47,6 @@ class PowerLaw(NamedTuple):
 
     k: float
     m: float
-
-
-# -- the schema ----------------------------------------------------------------------------------
-def scene_schema() -> dict:
-    """The scene JSON Schema (draft 2020-12), read from the package data (a fresh copy)."""
-    return json.loads((files("vemkit.config") / "schemas" / "scene.schema.json").read_text(encoding="utf-8"))
-
-
-@lru_cache(maxsize=1)
-def _validator() -> jsonschema.Draft202012Validator:
-    return jsonschema.Draft202012Validator(scene_schema())
-
-
-def _schema() -> dict:
-    """The validator's schema: the dict of :func:`scene_schema`, read once."""
-    return _validator().schema  # type: ignore[return-value]  # typed as a bool or a Mapping
-
-
-def _resolve(node: dict) -> dict:
-    """``node`` with a local ``$ref`` merged in (sibling keywords win)."""
-    while "$ref" in node:
-        target = _schema()["$defs"][node["$ref"].rsplit("/", 1)[-1]]
-        node = {**target, **{k: v for k, v in node.items() if k != "$ref"}}
-    return node
-
-
-def _key(path) -> str:
-    text = ""
-    for part in path:
-        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
-    return text or "(scene)"
-
-
-def _show(value) -> str:
-    try:
-        text = repr(value) if isinstance(value, str) else json.dumps(value, default=str, ensure_ascii=False)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-#: an override of discretization.mesh.KEY removes these keys: one size (SPEC §7), or a file
-_MESH_SIZE_KEYS = {
-    "n": ("h", "cells", "file"),
-    "h": ("n", "cells", "file"),
-    "cells": ("n", "h", "file"),
-    "file": ("n", "h", "cells", "family"),
-}
-
-
-# -- overrides -----------------------------------------------------------------------------------
-def _branch_for(node: dict, segment: str) -> dict:
-    """The alternative of a oneOf (``domain``: unit_square or a mapping) that has ``segment``."""
-    for branch in map(_resolve, node.get("oneOf", ())):
-        if ("items" in branch) if segment.isdigit() else ("properties" in branch):
-            return branch
-    return node
-
-
-_KEY_PATH = re.compile(r"[\w-]+(?:\.[\w-]+|\[\d+\])*")
-_KEY_SEGMENT = re.compile(r"\.?([\w-]+)|\[(\d+)\]")
-
-
-def _key_segments(override: str, key_text: str) -> list:
-    """``a.b[0].c`` as ["a", "b", 0, "c"]; an empty component or a bad index is a true message."""
-    if _KEY_PATH.fullmatch(key_text):
-        return [int(m[2]) if m[2] is not None else m[1] for m in _KEY_SEGMENT.finditer(key_text)]
-    if re.search(r"\.\.|^\.|\.$|\.\[", key_text):
-        problem = "a key component is empty (two dots, or a dot at an end)"
-    elif (
-        re.search(r"\[[^\]]*\]", key_text)
-        and not re.search(r"\[\d+\]", key_text)
-        or re.search(r"\[(?!\d+\])", key_text)
-    ):
-        problem = "a list index is a whole number from 0 in brackets, e.g. boundary.dirichlet[0]"
-    else:
-        problem = "a key is letters, digits, _ and -, joined by dots"
-    raise SceneError(
-        f"--set {override}: {problem}; expected key.path=value, e.g. --set solver.method=uzawa", key=key_text
-    )
-
-
-def _schema_step(node: dict, segment, container, override: str, path: list) -> dict:
-    """The schema of ``container[segment]`` (``container`` the value at ``path``)."""
-    node = _branch_for(node, str(segment))
-    if isinstance(segment, int):
-        if not isinstance(container, list) or "items" not in node:
-            raise SceneError(
-                f"--set {override}: {_key(path)} = {_show(container)} is not a list; drop [{segment}]", key=_key(path)
-            )
-        if segment >= len(container):
-            count = len(container)
-            indices = {0: "no index", 1: "the index 0"}.get(count, f"an index 0 ... {count - 1}")
-            raise SceneError(
-                f"--set {override}: {_key(path)} = {_show(container)} has {count} "
-                f"entr{'y' if count == 1 else 'ies'}: give {indices}, or set the whole list, "
-                f"e.g. --set '{_key(path)}=[...]'",
-                key=_key(path),
-            )
-        return _resolve(node["items"])
-    if isinstance(container, list):
-        raise SceneError(
-            f"--set {override}: {_key(path)} = {_show(container)} is a list: index it "
-            f"({_key(path)}[0]) or set the whole value, e.g. --set '{_key(path)}={{{segment}: ...}}'",
-            key=_key(path),
-        )
-    if not isinstance(container, dict):
-        raise SceneError(
-            f"--set {override}: {_key(path)} = {_show(container)} has no entry {segment!r}", key=_key(path)
-        )
-    if "properties" in node:
-        if segment not in node["properties"]:
-            raise SceneError(
-                f"--set {override}: unknown key {_key([*path, segment])!r}{_suggest(segment, node['properties'])}",
-                key=_key([*path, segment]),
-            )
-        return _resolve(node["properties"][segment])
-    if isinstance(node.get("additionalProperties"), dict):  # a map: side name -> entry
-        return _resolve(node["additionalProperties"])
-    raise SceneError(f"--set {override}: {_key(path)!r} has no key {segment!r}", key=_key(path))
-
-
-def _apply_override(data: dict, override: str) -> None:
-    """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema, every index in
-    the list it indexes."""
-    key_text, separator, value_text = str(override).partition("=")
-    if not separator or not key_text.strip():
-        raise SceneError(f"--set {override}: expected key.path=value, e.g. --set solver.method=uzawa")
-    segments = _key_segments(override, key_text.strip())
-    value = _parse_yaml(value_text, f"--set {override}")
-    node, container, path = _resolve(_schema()), data, list[str | int]()
-    for position, segment in enumerate(segments):
-        node = _schema_step(node, segment, container, override, path)
-        last = position == len(segments) - 1
-        if isinstance(segment, str) and not last:
-            container.setdefault(segment, copy.deepcopy(node.get("default", {})))
-        path.append(segment)
-        if not last:
-            container = container[segment]
-        else:
-            if path[:2] == ["discretization", "mesh"] and segment in _MESH_SIZE_KEYS:
-                for other in _MESH_SIZE_KEYS[segment]:  # a new size replaces the scene's own
-                    container.pop(other, None)
-            container[segment] = value
-
-
-# -- validation ----------------------------------------------------------------------------------
-def _suggest(word, choices) -> str:
-    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1)
-    allowed = ", ".join(str(c) for c in choices)
-    return f" (did you mean {close[0]!r}?); allowed here: {allowed}" if close else f"; allowed here: {allowed}"
-
-
-def _scene_fix(key: str | None) -> str:
-    """The fix a message suggests for ``key`` (None: an unknown key)."""
-    return "fix the scene" if key is None else f"fix the scene or --set {key}=..."
-
-
-def _check_finite(value, path, fix=_scene_fix) -> None:
-    if (
-        isinstance(value, (int, float)) and not isinstance(value, bool) and not abs(value) <= sys.float_info.max
-    ):  # nan, inf, ints beyond the float range
-        raise SceneError(f"{_key(path)} = {value}: must be a finite number; {fix(_key(path))}", key=_key(path))
-    children = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
-    for key, child in children:
-        _check_finite(child, [*path, key], fix)
-
-
-def _document_order(data, error) -> tuple:
-    """Position of ``error`` in the scene, so that the first problem in file order is reported."""
-    position, node = [], data
-    for part in error.absolute_path:
-        keys = list(node) if isinstance(node, dict) else list(range(len(node)))
-        position.append(keys.index(part) if part in keys else len(keys))
-        node = node[part]
-    if error.validator == "required" and isinstance(node, dict):
-        position.append(len(node))
-    elif error.validator == "additionalProperties" and isinstance(node, dict):
-        allowed = _resolve(error.schema).get("properties", {})
-        position.append(min((i for i, k in enumerate(node) if k not in allowed), default=0))
-    return tuple(position)
-
-
-def _branch_names(branches) -> str:
-    """What the alternatives of a oneOf accept, in words."""
-    names = []
-    for branch in map(_resolve, branches):
-        if "enum" in branch:
-            names += [str(v) for v in branch["enum"]]
-        elif branch.get("type") == "object" and branch.get("required"):
-            names.append(f"a mapping with {', '.join(branch['required'])}")
-        else:
-            types = branch.get("type", [])
-            names += [_TYPE_NAMES.get(t, t) for t in ([types] if isinstance(types, str) else types)]
-    return " or ".join(names)
-
-
-def _took_branch(value, branch: dict) -> bool:
-    """Whether a mapping has every key a oneOf branch requires (and no key it does not know)."""
-    branch = _resolve(branch)
-    if not isinstance(value, dict) or "properties" not in branch:
-        return False
-    return set(branch.get("required", ())) <= set(value) and set(value) <= set(branch["properties"])
-
-
-def _schema_error_message(error, fix=_scene_fix) -> str:
-    path, keyword, schema = list(error.absolute_path), error.validator, _resolve(error.schema)
-    key, value = _key(path), error.instance
-    if keyword == "oneOf":  # the value took one branch when the problem lies inside it: report that
-        deeper = [e for e in error.context or () if len(e.absolute_path) > len(path)]
-        taken = [e for e in deeper if _took_branch(value, error.validator_value[e.relative_schema_path[0]])]
-        deeper = taken or deeper  # a mapping with a branch's required keys took that branch (domain: polygon, box)
-        if deeper:
-            return _schema_error_message(jsonschema.exceptions.best_match(deeper), fix)
-        title = f" ({schema['title']})" if "title" in schema else ""
-        return f"{key} = {_show(value)}: must be {_branch_names(error.validator_value)}{title}; {fix(key)}"
-    if "propertyNames" in error.absolute_schema_path:
-        return f"{key}: {_show(value)} is not a side name (letters, digits, _ and -); fix the scene"
-    if keyword == "minProperties":
-        return (
-            f"{key} = {{}}: {NO_DIRICHLET}"
-            if key == "boundary.dirichlet"
-            else f"{key} = {{}}: must have at least {error.validator_value} entries; {fix(key)}"
-        )
-    if keyword == "additionalProperties":
-        allowed = list(schema.get("properties", {}))
-        extra = next(k for k in value if k not in allowed)
-        return f"{_key([*path, extra])}: unknown key{_suggest(extra, allowed)}; {fix(None)}"
-    if keyword == "required":
-        missing = next(k for k in error.validator_value if k not in value)
-        title = _resolve(schema["properties"][missing]).get("title", "")
-        if _key([*path, missing]) == "boundary.dirichlet":
-            return f"boundary.dirichlet is missing: {NO_DIRICHLET}"
-        return (
-            f"{_key([*path, missing])} is missing ({title}); add it to the scene or --set {_key([*path, missing])}=..."
-        )
-    if keyword == "minItems" and key == "boundary.dirichlet":
-        return f"boundary.dirichlet = []: {NO_DIRICHLET}"
-    if keyword == "pattern" and schema == _schema()["$defs"]["side"]:
-        return f"{key} = {_show(value)}: not a side name (letters, digits, _ and -); fix the scene"
-    bound = error.validator_value
-    if keyword == "type":
-        types = [bound] if isinstance(bound, str) else bound
-        need = "must be " + " or ".join(_TYPE_NAMES.get(t, t) for t in types)
-    elif keyword in ("enum", "const"):
-        need = "must be one of " + ", ".join(map(str, bound if keyword == "enum" else [bound]))
-    else:
-        need = {
-            "exclusiveMinimum": f"must be > {bound}",
-            "minimum": f"must be >= {bound}",
-            "exclusiveMaximum": f"must be < {bound}",
-            "maximum": f"must be <= {bound}",
-            "minItems": f"must have at least {bound} entries",
-            "maxItems": f"must have at most {bound} entries",
-            "uniqueItems": "lists an entry twice",
-            "minLength": "must not be empty",
-            "maxLength": f"must be at most {bound} characters",
-        }.get(keyword, error.message)
-    title = f" ({schema['title']})" if "title" in schema else ""
-    return f"{key} = {_show(value)}: {need}{title}; {fix(key)}"
-
-
-def _validate(data) -> None:
-    if not isinstance(data, dict):
-        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {_show(data)}")
-    _check_finite(data, [])
-    errors = list(_validator().iter_errors(data))
-    if errors:
-        first = min(errors, key=lambda e: (_document_order(data, e), e.validator != "type"))
-        raise SceneError(_schema_error_message(first))
-
-
-def _normalized(value, node: dict):
-    """Defaults filled, keys in schema order, numbers as float and integers as int."""
-    node = _resolve(node)
-    types = node.get("type")
-    types = [types] if isinstance(types, str) else (types or [])
-    if isinstance(value, dict) and "properties" in node:
-        result = {}
-        for name, child in node["properties"].items():
-            if name in value:
-                result[name] = _normalized(value[name], child)
-            elif "default" in _resolve(child):
-                result[name] = _normalized(copy.deepcopy(_resolve(child)["default"]), child)
-        return result
-    if isinstance(value, list) and "items" in node:
-        return [_normalized(item, node["items"]) for item in value]
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return int(value) if "integer" in types else float(value)
-    return value
 
 
 def _check_order_options(discretization: dict) -> None:
@@ -566,17 +262,17 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
     if isinstance(overrides, str):
         overrides = [overrides]
     if not isinstance(data, dict):
-        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {_show(data)}")
+        raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {show(data)}")
     data = copy.deepcopy(data)
     for override in overrides:
-        _apply_override(data, override)
-    _validate(data)
-    normalized = _normalized(data, _schema())
-    contact = normalized.get("contact")
+        apply_override(data, override)
+    validate(data)
+    filled = normalized(data, schema_root())
+    contact = filled.get("contact")
     if contact and "foundation" in contact and "gap" not in data.get("contact", {}):
         del contact["gap"]  # the foundation defines the gap: no default beside it (the scene reads back)
-    expressions = _semantic_checks(normalized, data)
-    return Scene(normalized, expressions, source)
+    expressions = _semantic_checks(filled, data)
+    return Scene(filled, expressions, source)
 
 
 def scene_from_yaml(text: str, overrides=(), *, source: str = "<string>") -> Scene:
