@@ -10,12 +10,11 @@ from vemkit.io.solution_file import write_netcdf
 from vemkit.report.study_figures import pareto_figure
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
-from vemkit.studies.tradeoff import (
+from vemkit.studies.tradeoff import check_reference_scene, run_family
+from vemkit.studies.tradeoff_answers import (
     cheapest_for_targets,
-    check_reference_scene,
     pareto_front,
     refinement_gain,
-    run_family,
     tradeoff_dataset,
     tradeoff_markdown,
 )

@@ -11,7 +11,8 @@ from vemkit.io.solution_file import write_netcdf
 from vemkit.mesh.families import build_mesh
 from vemkit.studies.convergence import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
-from vemkit.studies.tradeoff import family_order, run_family, tradeoff_dataset, tradeoff_markdown
+from vemkit.studies.tradeoff import family_order, run_family
+from vemkit.studies.tradeoff_answers import tradeoff_dataset, tradeoff_markdown
 from vemkit.vem.elements.k1_fields import projected_solution
 from vemkit.vem.norms import projection_error
 from vemkit.vem.quadrature import reference_quadrature

@@ -9,13 +9,13 @@ with logged(smk):
     from vemkit.config.scene import load_scene
     from vemkit.report.figures import save
     from vemkit.report.study_figures import pareto_figure
-    from vemkit.studies import tradeoff
+    from vemkit.studies import tradeoff_answers
     from vemkit.studies.convergence import read_records
     from vemkit.studies.sweeps import write_dataset
 
     s = smk.params.settings
     scene = load_scene(s["scene"], s["overrides"])
-    ds = tradeoff.tradeoff_dataset(
+    ds = tradeoff_answers.tradeoff_dataset(
         read_records(smk.input),
         targets=s["targets"],
         gains=s["refinement_gain"],
@@ -23,7 +23,7 @@ with logged(smk):
         settings=s,
     )
     write_dataset(ds, smk.output.nc)
-    text = tradeoff.tradeoff_markdown(ds)
+    text = tradeoff_answers.tradeoff_markdown(ds)
     with open(smk.output.md, "w", encoding="utf-8") as stream:
         stream.write(text)
     save(pareto_figure(ds, ds.attrs["error"], s["targets"]), smk.output.png)
