@@ -30,6 +30,7 @@ from vemkit.solvers.verification import verify_solution
 from vemkit.studies.hertz import hertz_peak_pressure
 
 STICK_LEVEL = 1.0 - 1e-6  # |lambda| below this: a stick vertex
+C_TOLERANCE = 0.05  # issue 21 item 4: the stick radius c within 5 % of Mindlin's
 
 
 def loading_in_steps(problem_at, shifts, solver: dict, *, frictionless_normal_step: bool = False):
@@ -66,8 +67,9 @@ def mindlin_shear(r, a: float, c: float, mu: float, P: float):
 
 def mindlin_measures(problem, solution, reference, mu: float, axis: int = 2, symmetry: float = 2.0) -> dict:
     """P, Q (along ``axis``), a and c (sqrt(symmetry A / pi) from the nodal weights of the contact and
-    stick vertices), Mindlin's c at the measured Q/(mu P), and the shear traction against q(r)
-    (its RMS misfit over the contact vertices relative to mu p0)."""
+    stick vertices), Mindlin's c at the measured Q/(mu P) (``c_within``: |c / c_Mindlin - 1| <=
+    C_TOLERANCE), and the shear traction against q(r) (its RMS misfit over the contact vertices
+    relative to mu p0)."""
     cb = problem.contact
     state = contact_state(problem, solution.u, solution.multiplier, slip_reference=reference)
     p = state.normal_pressure
@@ -93,6 +95,7 @@ def mindlin_measures(problem, solution, reference, mu: float, axis: int = 2, sym
         "c_max": float(r[stick].max()) if stick.any() else 0.0,
         "c_mindlin": c_mindlin,
         "err_c": c / c_mindlin - 1.0 if c_mindlin > 0 else float("nan"),
+        "c_within": bool(c_mindlin > 0 and abs(c / c_mindlin - 1.0) <= C_TOLERANCE),
         "q_rms_misfit": float(np.sqrt(np.mean((q[on] - q_mindlin[on]) ** 2)) / (mu * p0)),
         "stick_vertices": int(stick.sum()),
         "slip_vertices": int((on & ~stick).sum()),
