@@ -12,6 +12,7 @@ from vemkit.config.scene import scene_from_dict
 from vemkit.contact.problem import scene_problem
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import SLIP, STICK, contact_state
+from vemkit.solvers.uzawa import solve_uzawa
 from vemkit.solvers.verification import verify_solution
 
 UZAWA, SSN = AGREEMENT_SOLVERS["uzawa"], AGREEMENT_SOLVERS["ssn"]
@@ -88,3 +89,18 @@ def test_ssn_with_amg_is_the_direct_solution_and_newton_stays_bounded():
         assert verify_solution(problem, a.u, a.multiplier, tol=1e-10)["passed"]
         iterations.append(a.iterations)
     assert max(iterations) <= 9, iterations
+
+
+def test_uzawa_with_amg_solves_finer_than_tol_where_the_load_moves_less_than_tol():
+    """AMG-CG solved to tol alone returned its warm start unchanged once the right-hand side moved by
+    less than tol per iteration: |Δu| = 0 fired the stop while lambda still moved, on a residual
+    of 3.8e-9 > the accepted 1e-9 (inaccurate_stop at n = 8, tol 1e-10, eps 1e-12). The solves now
+    tighten to inner_floor: no |Δu| = 0, the stop accepted, ssn's solution."""
+    problem = sheared_box("hex", 8, 3.0)
+    a = solve_uzawa(problem, linear="amg", tol=1e-10, eps_u=1e-12, eps_lambda=1e-12, max_iterations=5000)
+    assert a.info["linear"] == "amg" and a.info["residual"]["worst"] <= 1e-9
+    assert np.all(a.history["du"][1:] > 0.0)
+    b = solve(problem, SSN)
+    assert np.max(np.abs(a.u - b.u)) / np.max(np.abs(b.u)) < 1e-9
+    assert np.max(np.abs(a.multiplier - b.multiplier)) < 1e-7
+    assert verify_solution(problem, a.u, a.multiplier, tol=1e-9)["passed"]
