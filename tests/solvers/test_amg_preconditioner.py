@@ -1,10 +1,14 @@
 """The AMG V-cycle preconditioner of vemkit.solvers.linear: what CG needs of it (symmetric, positive
 definite) and agreement with pyamg's own cycle on the same hierarchy; AMG-CG meets its tolerance."""
 
+from pathlib import Path
+
 import numpy as np
 from conftest import family_mesh, paper_problem
 
 from vemkit.solvers.linear import AMGSolver, linear_solver
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _amg(n):
@@ -31,3 +35,19 @@ def test_amg_cg_meets_its_tolerance_and_agrees_with_the_direct_solve():
     assert amg.residual <= 2e-10 and 0 < amg.iterations < 100
     direct = linear_solver(problem.stiffness, "direct").solve(problem.load)
     assert np.linalg.norm(u - direct) <= 1e-8 * np.linalg.norm(direct)
+
+
+def test_auto_solves_a_3d_body_by_amg_from_a_few_thousand_unknowns_and_agrees_with_direct():
+    """``auto`` in 3D switches at DIRECT_LIMIT_3D (a 2D body of the same size is solved directly),
+    and the two solvers give the same displacement."""
+    from vemkit.config.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+    from vemkit.solvers.linear import DIRECT_LIMIT, DIRECT_LIMIT_3D
+
+    box = scene_problem(load_scene(ROOT / "config/scenes/3d/sheared_box.yaml", ["discretization.mesh.n=10"]))
+    assert DIRECT_LIMIT_3D < box.n_dofs < DIRECT_LIMIT
+    auto = linear_solver(box.stiffness, "auto", near_nullspace=box.near_nullspace, tol=1e-12)
+    assert auto.method == "amg"
+    assert linear_solver(box.stiffness, "auto").method == "direct"  # no 3D near-nullspace: the 2D limit
+    direct = linear_solver(box.stiffness, "direct").solve(box.load)
+    assert np.linalg.norm(auto.solve(box.load) - direct) <= 1e-10 * np.linalg.norm(direct)

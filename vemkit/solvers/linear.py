@@ -14,7 +14,11 @@ import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import InputError, LinearSolveError, SceneError
 
-DIRECT_LIMIT = 20_000  # "auto" picks the direct solver below this many unknowns (measured crossover)
+DIRECT_LIMIT = 20_000  # "auto" picks the direct solver up to this many unknowns (measured crossover, 2D)
+#: the same in 3D, where LU's fill grows much faster: the sheared box (config/scenes/3d/sheared_box.yaml),
+#: ssn solve seconds direct / AMG: 1 254 DOFs 0.06 / 0.11, 3 198: 0.33 / 0.18, 13 629: 12.5 / 0.60
+DIRECT_LIMIT_3D = 2_000
+RIGID_MODES_3D = 6  # columns of a 3D body's near-nullspace (three translations, three rotations)
 
 
 def v_cycle(levels, coarse_solver, level, b):
@@ -220,6 +224,13 @@ class DirectSolver:
         return x
 
 
+def direct_limit(near_nullspace) -> int:
+    """The most unknowns ``auto`` solves directly: :data:`DIRECT_LIMIT_3D` for a 3D body (its
+    near-nullspace holds the six rigid motions), :data:`DIRECT_LIMIT` otherwise."""
+    three_d = near_nullspace is not None and np.shape(near_nullspace)[1] == RIGID_MODES_3D
+    return DIRECT_LIMIT_3D if three_d else DIRECT_LIMIT
+
+
 def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000):
     """One solver object for repeated solves with A: ``method`` is amg, direct or auto.
 
@@ -231,7 +242,7 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
             raise InputError("the prebuilt linear solver was made for another stiffness matrix", key="linear")
         return method
     if method == "auto":
-        method = "direct" if A.shape[0] <= DIRECT_LIMIT else "amg"
+        method = "direct" if A.shape[0] <= direct_limit(near_nullspace) else "amg"
     if method == "amg":
         return AMGSolver(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter)
     if method == "direct":
