@@ -56,6 +56,7 @@ def measured(command: list[str]) -> dict:
     process) when /usr/bin/time exists, else from wait4 (then an upper bound).
     """
     wrapped = [GNU_TIME, "-f", f"{RSS_MARK}%M", *command] if Path(GNU_TIME).exists() else command
+    load = os.getloadavg()[0]  # the 2 cores are shared: the 1-minute load when the process starts
     start = time.perf_counter()
     process = subprocess.Popen(wrapped, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(process.pid, 0)
@@ -66,7 +67,8 @@ def measured(command: list[str]) -> dict:
         raise RuntimeError(f"{' '.join(command)} failed: {stderr.strip()[-2000:]}")
     marked = [line for line in stderr.splitlines() if line.startswith(RSS_MARK)]
     rss_kib = int(marked[-1][len(RSS_MARK) :]) if marked else usage.ru_maxrss
-    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "max_rss_mib": rss_kib / 1024.0}
+    cpu = usage.ru_utime + usage.ru_stime
+    return {"wall_s": wall, "cpu_s": cpu, "max_rss_mib": rss_kib / 1024.0, "load_1min": load}
 
 
 def getfem_missing() -> str | None:
@@ -223,8 +225,8 @@ def warm_up(work: Path, problems) -> None:
 def table_lines(rows: list[dict], header: list[str]) -> list[str]:
     lines = [
         "| mesh | n | DOFs | problem | code | solver | rel. diff. to vemkit | wall s | max RSS MiB "
-        "| assembly s | solve s | vemkit/peer wall |",
-        "|" + "---|" * 12,
+        "| assembly s | solve s | vemkit/peer wall | load |",
+        "|" + "---|" * 13,
     ]
     for r in rows:
         diff = f"{r['rel_diff_to_vemkit']:.1e}" if "rel_diff_to_vemkit" in r else "–"
@@ -232,7 +234,7 @@ def table_lines(rows: list[dict], header: list[str]) -> list[str]:
         lines.append(
             f"| {r['mesh']} | {r['n']} | {r['dofs']:,} | {r['problem']} | {r['code']} | "
             f"{r['solver']} | {diff} | {r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | "
-            f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {ratio} |"
+            f"{r['assembly_s']:.2f} | {r['solve_s']:.2f} | {ratio} | {r.get('load_1min', float('nan')):.1f} |"
         )
     return header + lines
 

@@ -232,8 +232,8 @@ def report(rows: list[dict], getfem_reason: str | None, quiet: bool = False) -> 
         "GetFEM: " + (getfem_reason or "python3-getfem under /usr/bin/python3, Newton with MUMPS."),
         "",
         "| n | cells | DOFs | problem | code | solver | Newton steps | rel. diff. | wall s | max RSS MiB "
-        "| assembly s | solve s | vemkit/peer wall |",
-        "|" + "---|" * 13,
+        "| assembly s | solve s | vemkit/peer wall | load |",
+        "|" + "---|" * 14,
     ]
     for r in rows:
         diff = f"{r['rel_diff_to_vemkit']:.1e}" if "rel_diff_to_vemkit" in r else "–"
@@ -242,7 +242,7 @@ def report(rows: list[dict], getfem_reason: str | None, quiet: bool = False) -> 
         lines.append(
             f"| {r['n']} | {r['cells']:,} | {r['dofs']:,} | {r['problem']} | {r['code']} | {r['solver']} | "
             f"{steps} | {diff} | {r['wall_s']:.2f} | {r['max_rss_mib']:.0f} | {r['assembly_s']:.2f} | "
-            f"{r['solve_s']:.2f} | {ratio} |"
+            f"{r['solve_s']:.2f} | {ratio} | {r.get('load_1min', float('nan')):.1f} |"
         )
     record = {"machine": MACHINE, "load_average": load, "getfem": getfem_reason or "installed", "rows": rows}
     if quiet:
