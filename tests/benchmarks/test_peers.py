@@ -130,3 +130,17 @@ def test_getfem_p1_tetrahedra_solve_the_same_3d_problem(problem, tmp_path):
         assert np.any(lam < 1 - 1e-6) and np.any(lam > 1 - 1e-12), lam  # sticking and sliding
     assert np.abs(u_vem).max() > 1e-3
     assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
+
+
+def test_getfem_3d_compliance_newton_converges_from_the_dirichlet_value(tmp_path):
+    """n = 8 (2 187 DOFs): with the top's displacement imposed by multipliers, GetFEM's Newton from
+    u = 0 stalled in its line search (100 steps); started from u = the value on the side it takes
+    the steps of the eliminated problem and solves vemkit's discrete problem."""
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    peers3d = pytest.importorskip("peers3d", reason="benchmarks/peers3d.py")
+    u_vem, _, case = peers3d.run_vemkit(8, "compliance", tmp_path)
+    u_getfem, record = peers3d.run_peer("getfem", "compliance", 8, case, tmp_path)
+    assert record["iterations"] <= 6, record
+    assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
