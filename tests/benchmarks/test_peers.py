@@ -84,6 +84,22 @@ def test_getfem_friction_with_sticking_vertices(tmp_path):
     assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
 
 
+def test_getfem_dirichlet_with_multipliers_is_the_eliminated_problem(tmp_path):
+    """The peer's two ways to impose u = 0 (multipliers, the default; dof elimination) solve the
+    same discrete problem: the multiplier's boundary mass matrix is regular on the side's dofs."""
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    _, _, case = small_case("structured")
+    params = peers.peer_params("compliance", 100)
+    u_multipliers, record = peers.run_peer("getfem", "compliance", case, tmp_path, params)
+    eliminated = params | {"getfem_dirichlet": "simplification"}
+    u_eliminated, _ = peers.run_peer("getfem", "compliance", case, tmp_path, eliminated)
+    right = np.unique(case["side_right"])
+    assert np.abs(u_multipliers[right]).max() <= 1e-12 < np.abs(u_multipliers).max()
+    assert peers.relative_difference(u_multipliers, u_eliminated) <= 1e-10, record
+
+
 def test_vemkit_3d_on_tetrahedra_is_scikit_fem_p1_through_the_benchmark(tmp_path):
     """benchmarks/peers3d.py's case (issue 22 (d)): the whole path, both processes, one small mesh."""
     peers3d = pytest.importorskip("peers3d", reason="benchmarks/peers3d.py")
@@ -113,4 +129,18 @@ def test_getfem_p1_tetrahedra_solve_the_same_3d_problem(problem, tmp_path):
             lam = np.linalg.norm(ds.friction_multiplier.values, axis=1)[ds.penetration.values > 0]
         assert np.any(lam < 1 - 1e-6) and np.any(lam > 1 - 1e-12), lam  # sticking and sliding
     assert np.abs(u_vem).max() > 1e-3
+    assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
+
+
+def test_getfem_3d_compliance_newton_converges_from_the_dirichlet_value(tmp_path):
+    """n = 8 (2 187 DOFs): with the top's displacement imposed by multipliers, GetFEM's Newton from
+    u = 0 stalled in its line search (100 steps); started from u = the value on the side it takes
+    the steps of the eliminated problem and solves vemkit's discrete problem."""
+    reason = peers.getfem_missing()
+    if reason:
+        pytest.skip(reason)
+    peers3d = pytest.importorskip("peers3d", reason="benchmarks/peers3d.py")
+    u_vem, _, case = peers3d.run_vemkit(8, "compliance", tmp_path)
+    u_getfem, record = peers3d.run_peer("getfem", "compliance", 8, case, tmp_path)
+    assert record["iterations"] <= 6, record
     assert peers.relative_difference(u_getfem, u_vem) <= 1e-8, record
