@@ -1,6 +1,7 @@
 """vemkit k = 2 against P2 (scikit-fem, GetFEM) at equal error, and k = 1 against P1 (issue 22 (a)).
 
     .venv/bin/python benchmarks/peers_order2.py [--quick] [--k2-sizes 16 32 64 128 256] [--k1-sizes ...]
+        [--square-sizes 32 64 128 256] [--peers skfem getfem]
 
 On triangles the k = 2 virtual element space is not P2 (it also has a cell moment per cell), so
 the codes are compared at equal error on the manufactured problem of benchmarks/peers/exact_elasticity.py
@@ -12,10 +13,13 @@ process (wait4: wall, CPU, peak RSS):
           file's degrees of freedom (vemkit.studies.solution_order.projected_solution_file) against
           u_exact with vemkit.vem.norms.exact_errors: the H1 error of a VEM solution is that of its
           projection Pi u_h (k = 1 on triangles: u_h itself);
+          `vemkit k = 2 (squares)` (--square-sizes): the same k = 2 solve on `vemkit mesh square N`, the
+          family a careful vemkit user picks at k = 2 (about the triangles' error with 2/3 of their DOFs
+          at the same N); the peers stay on triangles (P2 is a triangle element);
   peers   scikit-fem (benchmarks/peers/skfem_manufactured.py) and GetFEM (getfem_manufactured.py):
           P1 or P2, their errors of u_h itself computed after the solve inside their process, timed
           apart and subtracted from the process time (`process s` below: neither side pays for it).
-All errors use one rule of degree ERROR_ORDER on each triangle. Writes benchmarks/out/peers_order2.{json,md,png}.
+All errors use one rule of degree ERROR_ORDER on each triangle (a square: its two triangles). Writes benchmarks/out/peers_order2.{json,md,png}.
 """
 
 from __future__ import annotations
@@ -42,6 +46,8 @@ from exact_elasticity import manufactured_problem  # noqa: E402
 ERROR_ORDER = 8  # every error integral: a degree-8 rule on every triangle (the integrands are smooth)
 LABELS = {("vemkit", 1): "vemkit k = 1", ("vemkit", 2): "vemkit k = 2", ("skfem", 1): "scikit-fem P1"}
 LABELS |= {("skfem", 2): "scikit-fem P2", ("getfem", 1): "GetFEM P1", ("getfem", 2): "GetFEM P2"}
+LABELS |= {("vemkit_square", 2): "vemkit k = 2 (squares)"}
+VEMKIT_CODES = ("vemkit", "vemkit_square")  # vemkit on triangles, on squares
 
 
 def vemkit_scene(problem: dict, mesh_path: Path, order: int) -> dict:
@@ -60,17 +66,24 @@ def vemkit_scene(problem: dict, mesh_path: Path, order: int) -> dict:
 
 
 def triangle_rule(mesh, order: int = ERROR_ORDER):
-    """(points, weights, cells) of a degree-``order`` rule on every triangle of a vemkit mesh."""
+    """(points, weights, cells) of a degree-``order`` rule on every triangle of a vemkit mesh; a
+    convex polygon (a square) is split into the fan of triangles from its first vertex."""
     from skfem.quadrature import get_quadrature
     from skfem.refdom import RefTri
 
     reference, weights = get_quadrature(RefTri, order)  # (2, q) on (0,0), (1,0), (0,1); sum 1/2
-    corners = mesh.vertices[mesh.cell_vertices.reshape(-1, 3)]  # (m, 3, 2)
-    a, b, c = corners[:, 0], corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    points = a[:, None] + reference[0][None, :, None] * b[:, None] + reference[1][None, :, None] * c[:, None]
-    jacobian = np.abs(b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
-    cells = np.repeat(np.arange(len(corners)), len(weights))
-    return points.reshape(-1, 2), (jacobian[:, None] * weights[None]).ravel(), cells
+    sizes, parts = mesh.cell_sizes, []
+    for size in np.unique(sizes):
+        own = np.flatnonzero(sizes == size)
+        corners = mesh.vertices[mesh.cell_vertices[mesh.cell_offsets[own][:, None] + np.arange(size)]]
+        for j in range(1, size - 1):  # the fan triangle (0, j, j + 1)
+            a, b, c = corners[:, 0], corners[:, j] - corners[:, 0], corners[:, j + 1] - corners[:, 0]
+            points = a[:, None] + reference[0][None, :, None] * b[:, None] + reference[1][None, :, None] * c[:, None]
+            jacobian = np.abs(b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
+            parts.append(
+                (points.reshape(-1, 2), (jacobian[:, None] * weights[None]).ravel(), np.repeat(own, len(weights)))
+            )
+    return tuple(np.concatenate(part) for part in zip(*parts))
 
 
 def vemkit_errors(solution_path: Path, problem: dict) -> dict:
@@ -168,6 +181,19 @@ def run_size(n: int, orders, peers, problem: dict, work: Path, getfem_max_dofs: 
     return rows
 
 
+def run_squares(n: int, problem: dict, work: Path) -> dict:
+    """vemkit k = 2 on the n x n squares of `vemkit mesh square n` (the peers stay on triangles)."""
+    mesh_path = work / f"squares-{n}.nc"
+    subprocess.run([str(VEMKIT), "mesh", "square", str(n), "-o", str(mesh_path), "-q"], check=True)
+    row = {"n": n, "order": 2, "code": "vemkit_square"} | run_vemkit(2, mesh_path, problem, work)
+    print(
+        f"n = {n}: {LABELS['vemkit_square', 2]}: {row['dofs']} DOFs, |e|_1 = {row['error_h1_semi']:.3e}, "
+        f"process {row['process_s']:.2f} s",
+        flush=True,
+    )
+    return row
+
+
 def curve(rows, code, order, x="process_s", y="error_h1_semi"):
     own = sorted((r for r in rows if r["code"] == code and r["order"] == order), key=lambda r: r["dofs"])
     return np.array([r[x] for r in own], float), np.array([r[y] for r in own], float)
@@ -183,20 +209,22 @@ def time_at_error(rows, code, order, error, y="error_h1_semi") -> float | None:
 
 
 def equal_error_lines(rows, peers, y="error_h1_semi", min_dofs=10**5) -> list[str]:
-    """At the error of every vemkit k = 2 run of at least ``min_dofs`` DOFs: each code's time."""
+    """At the error of every vemkit k = 2 run (triangles or squares) of at least ``min_dofs`` DOFs:
+    each code's time there and every P2 peer's time over each vemkit k = 2 family's."""
+    families = [c for c in VEMKIT_CODES if any(r["code"] == c for r in rows)]
+    codes = [(c, 2) for c in families] + [(p, 2) for p in peers] + [("vemkit", 1)] + [(p, 1) for p in peers]
+    pairs = [(p, c) for p in peers for c in families]
+    anchors = [r for r in rows if r["code"] in families and r["order"] == 2 and r["dofs"] >= min_dofs]
     lines = []
-    codes = [("vemkit", 2)] + [(p, 2) for p in peers] + [("vemkit", 1)] + [(p, 1) for p in peers]
-    for r in (r for r in rows if r["code"] == "vemkit" and r["order"] == 2 and r["dofs"] >= min_dofs):
-        times = {c: time_at_error(rows, *c, r[y], y) for c in codes}
+    for r in sorted(anchors, key=lambda r: -r[y]):
+        times = {c: time_at_error(rows, *c, r[y], y) for c in codes} | {(r["code"], 2): r["process_s"]}
         cells = [f"{times[c]:.2f}" if times[c] else "–" for c in codes]
-        ratios = [f"{times[c] / r['process_s']:.1f}×" if times[c] else "–" for c in codes[1 : 1 + len(peers)]]
-        lines.append(f"| {r[y]:.3e} | {r['dofs']:,} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |")
-    head = " | ".join(LABELS[c] + " s" for c in codes)
-    ratio_head = " | ".join(f"{LABELS[p, 2]} / vemkit k = 2" for p in peers)
-    return [
-        f"| {y} | vemkit k = 2 DOFs | {head} | {ratio_head} |",
-        "|" + "---|" * (2 + len(codes) + len(peers)),
-    ] + lines
+        ratios = [f"{times[p, 2] / times[c, 2]:.2f}×" if times[p, 2] and times[c, 2] else "–" for p, c in pairs]
+        lines.append(
+            f"| {r[y]:.3e} | {LABELS[r['code'], 2]}, {r['dofs']:,} DOFs | " + " | ".join(cells + ratios) + " |"
+        )
+    head = " | ".join([LABELS[c] + " s" for c in codes] + [f"{LABELS[p, 2]} / {LABELS[c, 2]}" for p, c in pairs])
+    return [f"| {y} | at the run | {head} |", "|" + "---|" * (2 + len(codes) + len(pairs))] + lines
 
 
 def table_lines(rows: list[dict]) -> list[str]:
@@ -228,8 +256,9 @@ def figure(rows: list[dict], path: Path) -> None:
         for (code, order), label in LABELS.items():
             xs, ys = curve(rows, code, order, x, y)
             if len(xs):
-                style = {"vemkit": "o-", "skfem": "s--", "getfem": "^:"}[code]
-                ax.loglog(xs, ys, style, color=f"C{order - 1}" if code == "vemkit" else None, label=label)
+                style = {"vemkit": "o-", "vemkit_square": "D-", "skfem": "s--", "getfem": "^:"}[code]
+                color = {"vemkit": f"C{order - 1}", "vemkit_square": "C4"}.get(code)
+                ax.loglog(xs, ys, style, color=color, label=label)
         ax.set_xlabel(xlabel)
         ax.set_ylabel({"error_h1_semi": "|u - u_h|_H1 (vemkit: Pi u_h)", "error_l2": "||u - u_h||_L2"}[y])
         ax.grid(True, which="both", alpha=0.3)
@@ -246,22 +275,28 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="n = 8, 16 only (a smoke test)")
     parser.add_argument("--k2-sizes", type=int, nargs="*", default=[16, 32, 64, 128, 256])
     parser.add_argument("--k1-sizes", type=int, nargs="*", default=[16, 32, 64, 128, 256, 512])
+    parser.add_argument(
+        "--square-sizes", type=int, nargs="*", default=[32, 64, 128, 256], help="vemkit k = 2 on squares"
+    )
+    parser.add_argument("--peers", nargs="*", default=["skfem", "getfem"], help="of skfem, getfem")
     parser.add_argument("--getfem-max-dofs", type=float, default=np.inf, help="no GetFEM solve above this")
     parser.add_argument("--keep", type=Path, help="keep the meshes and cases in this folder")
     parser.add_argument("--resume", action="store_true", help="keep the runs of benchmarks/out/peers_order2.json")
     args = parser.parse_args()
-    k2, k1 = ([8, 16], [8, 16]) if args.quick else (args.k2_sizes, args.k1_sizes)
-    getfem_reason = getfem_missing()
-    peers = ["skfem"] + ([] if getfem_reason else ["getfem"])
+    k2, k1, squares = ([8, 16], [8, 16], [8, 16]) if args.quick else (args.k2_sizes, args.k1_sizes, args.square_sizes)
+    getfem_reason = getfem_missing() if "getfem" in args.peers else "not asked for (--peers)"
+    peers = [p for p in args.peers if p == "skfem" or not getfem_reason]
     problem = manufactured_problem()
     work = Path(args.keep or tempfile.mkdtemp(prefix="vemkit-peers-order2-"))
     work.mkdir(parents=True, exist_ok=True)
     warm_up(problem, work)
     rows = json.loads((OUT / "peers_order2.json").read_text())["rows"] if args.resume else []
-    done = {(r["n"], r["order"]) for r in rows}
-    for n in sorted(set(k1) | set(k2)):
+    done = {(r["n"], r["order"]) for r in rows if r["code"] != "vemkit_square"}
+    for n in sorted(set(k1) | set(k2) | set(squares)):
         orders = [o for o, sizes in ((1, k1), (2, k2)) if n in sizes and (n, o) not in done]
-        rows += run_size(n, orders, peers, problem, work, args.getfem_max_dofs)
+        rows += run_size(n, orders, peers, problem, work, args.getfem_max_dofs) if orders else []
+        if n in squares and not any(r["code"] == "vemkit_square" and r["n"] == n for r in rows):
+            rows.append(run_squares(n, problem, work))
         report(rows, peers, getfem_reason, quiet=True)  # after every size: a stopped run keeps its rows
     if not args.keep:
         shutil.rmtree(work)
@@ -295,7 +330,8 @@ def report(rows: list[dict], peers, getfem_reason: str | None, quiet: bool = Fal
         "those of its projection Pi u_h. `process s`: the whole process (wait4), less the peers' error "
         "evaluation (timed apart in their process; vemkit's runs after its process). DOFs: all degrees "
         "of freedom of the space (vemkit k = 2: vertices, edges and cells); unknowns: vemkit's solved "
-        "system (cell moments condensed).",
+        "system (cell moments condensed). `vemkit k = 2 (squares)`: vemkit on the n x n squares (the same "
+        "manufactured problem); every peer is on the structured triangles.",
         "",
         "## Time at equal H1 error (log-log interpolation; – outside a code's range)",
         "",

@@ -188,6 +188,23 @@ def test_body_force_loads_integrate_exactly_against_quadratics(case):
     assert body_force_k2(mesh, linear).ravel() @ v != pytest.approx(exact, rel=1e-6)
 
 
+def test_basis_moments_are_the_sums_of_the_basis_fields_against_the_weights():
+    """The written-out moments of body_force_p1_k2 are sum_p q_b(xi_p, eta_p) . wg_p per cell for
+    the 12 fields of the kernel's basis (_basis_at), on random points in 5 cells."""
+    from vemkit.vem.elements.k2_fields import _basis_at, basis_moments, cell_sums
+
+    rng = np.random.default_rng(7)
+    xi, eta, wg = rng.uniform(-1, 1, 40), rng.uniform(-1, 1, 40), rng.normal(size=(40, 2))
+    cells = rng.integers(0, 5, 40)
+    expected = np.zeros((5, 12))
+    np.add.at(expected, cells, np.einsum("pbc,pc->pb", _basis_at(xi, eta), wg))
+    assert np.allclose(basis_moments(xi, eta, wg, cells, 5), expected, rtol=0, atol=1e-14)
+    blocks = rng.normal(size=(40, 3, 2))
+    summed = np.zeros((5, 3, 2))
+    np.add.at(summed, cells, blocks)
+    assert np.allclose(cell_sums(cells, blocks, 5), summed, rtol=0, atol=1e-14)
+
+
 @pytest.mark.parametrize("case", list(FAMILY_CASES) + ["nonconvex"])
 def test_global_null_space_is_the_three_rigid_motions(case):
     """With no Dirichlet part the assembled k = 2 matrix is singular exactly on the rigid motions."""

@@ -148,6 +148,22 @@ def _basis_at(xi, eta):
     return np.stack([np.stack(first, axis=1), np.stack(second, axis=1)], axis=2)
 
 
+def cell_sums(cells, values, n_cells: int) -> np.ndarray:
+    """(M, ...): the sum of ``values`` (P, ...) over each cell's points (np.add.at, by bincount)."""
+    flat = values.reshape(values.shape[0], -1)
+    sums = [np.bincount(cells, flat[:, j], n_cells) for j in range(flat.shape[1])]
+    return np.stack(sums, axis=1).reshape((n_cells,) + values.shape[1:])
+
+
+def basis_moments(xi, eta, wg, cells, n_cells: int) -> np.ndarray:
+    """(M, 12): sum over each cell's points of q_b(xi, eta) . wg for the 12 fields of ``_basis_at``,
+    written out field by field (no (P, 12, 2) array) and summed per cell with bincount."""
+    g0, g1 = wg[:, 0], wg[:, 1]
+    x0, x1, e0, e1 = xi * g0, xi * g1, eta * g0, eta * g1
+    columns = (g0, g1, x1 - e0, x0, e1, e0 + x1, xi * x0, eta * x0, eta * e0, xi * x1, eta * x1, eta * e1)
+    return np.stack([np.bincount(cells, column, n_cells) for column in columns], axis=1)
+
+
 def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarray:
     """(n_nodes, 2): int_K P_0 f1 . v dx + int_K (P_1 f1 - P_0 f1) . Pi_2 v dx on every cell.
 
@@ -163,14 +179,11 @@ def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarra
     xi = (points[:, 0] - frame[cells, 0]) / frame[cells, 2]
     eta = (points[:, 1] - frame[cells, 1]) / frame[cells, 2]
     mono = np.stack([np.ones_like(xi), xi, eta], axis=1)  # (P, 3)
-    mass = np.zeros((mesh.n_cells, 3, 3))
-    np.add.at(mass, cells, weights[:, None, None] * mono[:, :, None] * mono[:, None, :])
-    moments_f = np.zeros((mesh.n_cells, 3, 2))
-    np.add.at(moments_f, cells, weights[:, None, None] * mono[:, :, None] * f[:, None, :])
+    mass = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * mono[:, None, :], mesh.n_cells)
+    moments_f = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * f[:, None, :], mesh.n_cells)
     p1 = np.linalg.solve(mass, moments_f)  # (M, 3, 2): P_1 f1 = p1[0] + p1[1] xi + p1[2] eta
     g = xi[:, None] * p1[cells, 1] + eta[:, None] * p1[cells, 2]  # P_1 f1 - P_0 f1 at the points
-    moments = np.zeros((mesh.n_cells, N_BASIS))
-    np.add.at(moments, cells, weights[:, None] * np.einsum("pbc,pc->pb", _basis_at(xi, eta), g))
+    moments = basis_moments(xi, eta, weights[:, None] * g, cells, mesh.n_cells)
     out = body_force_load_k2(mesh, p1[:, 0])
     _scatter_projected(mesh.vertices, offsets, nodes, float(lam), float(mu), moments, out)
     return out
