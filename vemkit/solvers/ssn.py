@@ -291,11 +291,12 @@ def _prepare(newton, t):
     b_lin = law.friction_bound(t)
     b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
-    newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
     if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
         from vemkit.solvers.ssn_disk import coupled_gamma
 
         newton.gamma = coupled_gamma(newton.kd_tau, cb.weight, b_lin, newton.b_ref)
+    else:
+        newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
 
 

@@ -317,7 +317,7 @@ def _uzawa_iteration(state):
     state.rho = _step_length(state, law.friction_bound(cb.normal_displacement(u) - cb.gap))
     rhs = problem.load - state.forces
     floor = inner_floor(tol, options["eps_u"]) if state.inexact else tol
-    lin_tol = max(floor, INNER_FRACTION * state.du) if state.inexact else tol
+    lin_tol = max(floor, INNER_FRACTION * state.du) if state.inexact else floor
     if n == 1:
         u_new, lin_its = state.u_first, 1
     else:

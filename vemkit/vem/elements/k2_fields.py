@@ -140,11 +140,17 @@ def cell_frames(mesh: Mesh) -> np.ndarray:
     return frame
 
 
+def _basis_components(xi, eta, zero, one):
+    """The kernel's 12 basis fields at scaled points: (first components, second components), with
+    ``zero`` and ``one`` as the constant entries (arrays; basis_moments passes None and 1.0)."""
+    first = [one, zero, -eta, xi, zero, eta, xi * xi, xi * eta, eta * eta, zero, zero, zero]
+    second = [zero, one, xi, zero, eta, xi, zero, zero, zero, xi * xi, xi * eta, eta * eta]
+    return first, second
+
+
 def _basis_at(xi, eta):
     """(P, 12, 2): the kernel's basis fields at scaled points."""
-    z, one = np.zeros_like(xi), np.ones_like(xi)
-    first = [one, z, -eta, xi, z, eta, xi * xi, xi * eta, eta * eta, z, z, z]
-    second = [z, one, xi, z, eta, xi, z, z, z, xi * xi, xi * eta, eta * eta]
+    first, second = _basis_components(xi, eta, np.zeros_like(xi), np.ones_like(xi))
     return np.stack([np.stack(first, axis=1), np.stack(second, axis=1)], axis=2)
 
 
@@ -157,11 +163,20 @@ def cell_sums(cells, values, n_cells: int) -> np.ndarray:
 
 def basis_moments(xi, eta, wg, cells, n_cells: int) -> np.ndarray:
     """(M, 12): sum over each cell's points of q_b(xi, eta) . wg for the 12 fields of ``_basis_at``,
-    written out field by field (no (P, 12, 2) array) and summed per cell with bincount."""
+    field by field (no (P, 12, 2) array, no products with a constant component) and summed per cell
+    with bincount."""
     g0, g1 = wg[:, 0], wg[:, 1]
-    x0, x1, e0, e1 = xi * g0, xi * g1, eta * g0, eta * g1
-    columns = (g0, g1, x1 - e0, x0, e1, e0 + x1, xi * x0, eta * x0, eta * e0, xi * x1, eta * x1, eta * e1)
+    first, second = _basis_components(xi, eta, None, 1.0)
+    columns = [_times(a, g0, _times(b, g1)) for a, b in zip(first, second, strict=True)]
     return np.stack([np.bincount(cells, column, n_cells) for column in columns], axis=1)
+
+
+def _times(component, g, plus=None):
+    """component * g (+ plus): a component None is zero, the scalar 1.0 is one (no array products)."""
+    if component is None:
+        return plus
+    term = g if isinstance(component, float) else component * g
+    return term if plus is None else term + plus
 
 
 def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarray:
