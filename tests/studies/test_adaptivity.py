@@ -163,7 +163,7 @@ def test_the_reference_error_is_exact_on_meshes_finer_than_the_reference_in_plac
     from vemkit.io.solution_file import solution_dataset
     from vemkit.mesh.families import build_mesh
     from vemkit.studies.adaptivity_errors import reference_errors
-    from vemkit.studies.convergence import ReferenceSolution
+    from vemkit.studies.error_records import ReferenceSolution
     from vemkit.vem.norms import projection_error, seminorm_squared
 
     scene = load_scene(PAPER, ["discretization.mesh.n=4"])
@@ -203,7 +203,7 @@ def test_the_reference_error_takes_the_slivers_at_a_circular_hole_finer_than_the
     leaves out. Measured both ways, ‖Π(u_A − u_B)‖ agrees (the slivers hold 0.1 % of the area)."""
     from vemkit.io.solution_file import solution_dataset
     from vemkit.studies.adaptivity_errors import reference_errors
-    from vemkit.studies.convergence import ReferenceSolution
+    from vemkit.studies.error_records import ReferenceSolution
     from vemkit.vem.norms import seminorm_squared
 
     scene = load_scene(

@@ -61,7 +61,7 @@ def test_the_adaptive_loop_enters_the_speed_accuracy_study_as_a_configuration():
 
     from vemkit.config.scene import load_scene
     from vemkit.studies.adaptivity_compare import tradeoff_records
-    from vemkit.studies.convergence import ReferenceSolution
+    from vemkit.studies.error_records import ReferenceSolution
     from vemkit.studies.scene_solve import solve_scene
     from vemkit.studies.tradeoff_answers import (
         RECORD_FLOATS,

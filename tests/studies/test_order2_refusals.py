@@ -10,9 +10,10 @@ from vemkit.config.scene import load_scene
 from vemkit.exceptions import InputError, SceneError
 from vemkit.io.solution_file import write_netcdf
 from vemkit.mesh.families import build_mesh
-from vemkit.studies.convergence import ReferenceSolution, require_order1, solved_error_records
+from vemkit.studies.error_records import ReferenceSolution, solved_error_records
 from vemkit.studies.robustness import run_case, select_cases
 from vemkit.studies.scene_solve import solve_scene
+from vemkit.studies.solution_order import require_order1
 from vemkit.studies.sweeps import run_grid
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -8,7 +8,7 @@ import pytest
 from vemkit.config.scene import load_scene
 from vemkit.io.solution_file import write_netcdf
 from vemkit.report.study_figures import pareto_figure
-from vemkit.studies.convergence import ReferenceSolution
+from vemkit.studies.error_records import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.tradeoff import check_reference_scene, run_family
 from vemkit.studies.tradeoff_answers import (

@@ -9,7 +9,7 @@ from vemkit.config.scene import load_scene
 from vemkit.exceptions import InputError
 from vemkit.io.solution_file import write_netcdf
 from vemkit.mesh.families import build_mesh
-from vemkit.studies.convergence import ReferenceSolution
+from vemkit.studies.error_records import ReferenceSolution
 from vemkit.studies.scene_solve import solve_scene
 from vemkit.studies.tradeoff import family_order, run_family
 from vemkit.studies.tradeoff_answers import tradeoff_dataset, tradeoff_markdown

@@ -16,13 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vemkit.studies.convergence import (
-    ReferenceSolution,
-    read_convergence,
-    run_record,
-    solved_error_records,
-    study_scene,
-)
+from vemkit.studies.convergence import read_convergence
+from vemkit.studies.error_records import ReferenceSolution, run_record, solved_error_records, study_scene
 from vemkit.studies.paper import PAPER_TABLE1
 
 ROOT = Path(__file__).resolve().parents[2]

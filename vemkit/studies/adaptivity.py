@@ -38,7 +38,7 @@ from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.solution import ContactSolution, contact_state
-from vemkit.studies.convergence import RECORD_KEYS
+from vemkit.studies.error_records import RECORD_KEYS
 from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
 from vemkit.vem.quadrature import cell_averages

@@ -26,7 +26,7 @@ import numpy as np
 from vemkit.config.expressions import vector_field
 from vemkit.exceptions import InputError
 from vemkit.mesh.locate import locate_points, nearest_cells
-from vemkit.studies.convergence import ReferenceSolution
+from vemkit.studies.error_records import ReferenceSolution
 from vemkit.studies.reference_file import read_reference_file
 from vemkit.studies.tradeoff import check_reference_scene
 from vemkit.vem.elements.k1_fields import projected_solution

@@ -90,7 +90,7 @@ def run_family(
 ) -> list[dict]:
     """Records of every run of one mesh family (``spec``: {family, options, order}); see the module docstring.
 
-    ``reference``: a ``vemkit.studies.convergence.ReferenceSolution``. All-triangle k = 1 families are
+    ``reference``: a ``vemkit.studies.error_records.ReferenceSolution``. All-triangle k = 1 families are
     solved with the first stabilization only (the VEM space is P1 there, the stabilization vanishes;
     not so for k = 2: the space has a cell mean beyond P2). ``max_iterations``: {solver: limit}.
     """

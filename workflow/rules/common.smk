@@ -97,7 +97,7 @@ def _check_order():
     """The paper workflow measures errors with Pi_1 of vertex values (SPEC 5): k = 1 only."""
     from vemkit.config.scene import load_scene
     from vemkit.exceptions import SceneError
-    from vemkit.studies.convergence import require_order1
+    from vemkit.studies.solution_order import require_order1
 
     try:
         require_order1(load_scene(config["scene"], config["overrides"]), "the paper workflow (Table 1, convergence)")

@@ -58,7 +58,7 @@ def write_solutions(smk):
 
     from vemkit.io.solution_file import write_netcdf
     from vemkit.mesh.files import read_ugrid
-    from vemkit.studies.convergence import study_scene
+    from vemkit.studies.error_records import study_scene
     from vemkit.studies.scene_solve import solve_scene
 
     numba.set_num_threads(max(1, min(smk.threads, numba.config.NUMBA_NUM_THREADS)))
@@ -79,13 +79,8 @@ def write_solutions(smk):
 def write_convergence_file(smk):
     """Rules table1_dataset and convergence_dataset: error records -> one convergence netCDF (with
     error_paper_gauss when the Gauss-quadrature records of table1.gauss are given)."""
-    from vemkit.studies.convergence import (
-        convergence_dataset,
-        read_records,
-        study_scene,
-        with_paper_variant,
-        write_convergence,
-    )
+    from vemkit.studies.convergence import convergence_dataset, with_paper_variant, write_convergence
+    from vemkit.studies.error_records import read_records, study_scene
 
     p = smk.params
     scene = study_scene(

@@ -10,7 +10,7 @@ with logged(smk):
     from vemkit.config.scene import load_scene
     from vemkit.studies import tradeoff
     from vemkit.studies.adaptivity_compare import tradeoff_records
-    from vemkit.studies.convergence import ReferenceSolution, write_records
+    from vemkit.studies.error_records import ReferenceSolution, write_records
 
     if NUMPY_EARLY:
         print("warning: numpy was loaded before the thread counts were set to 1", flush=True)

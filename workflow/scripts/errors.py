@@ -5,7 +5,7 @@ from _helpers import level, logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    from vemkit.studies.convergence import family_error_records, write_records
+    from vemkit.studies.error_records import family_error_records, write_records
 
     runs = [(stab, level(n), path) for stab, n, path in smk.params.runs]
     records = family_error_records(smk.wildcards.label, runs, smk.params.references)

@@ -6,7 +6,7 @@ from _helpers import logged
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
     from vemkit.mesh.files import read_ugrid
-    from vemkit.studies.convergence import solved_error_records, write_records
+    from vemkit.studies.error_records import solved_error_records, write_records
 
     p = smk.params
     meshes = [(n, read_ugrid(path)) for n, path in zip(p.levels, smk.input.meshes, strict=True)]

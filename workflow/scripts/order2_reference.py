@@ -10,7 +10,7 @@ with logged(smk):
 
     from vemkit.io.solution_file import write_netcdf
     from vemkit.mesh.families import build_mesh
-    from vemkit.studies.convergence import study_scene
+    from vemkit.studies.error_records import study_scene
     from vemkit.studies.scene_solve import solve_scene
 
     numba.set_num_threads(max(1, min(smk.threads, numba.config.NUMBA_NUM_THREADS)))

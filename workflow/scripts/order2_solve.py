@@ -9,7 +9,7 @@ smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
     from vemkit.io.solution_file import write_netcdf
     from vemkit.mesh.families import build_mesh
-    from vemkit.studies.convergence import study_scene
+    from vemkit.studies.error_records import study_scene
     from vemkit.studies.scene_solve import solve_scene
 
     s = smk.params.settings

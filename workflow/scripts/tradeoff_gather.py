@@ -10,7 +10,7 @@ with logged(smk):
     from vemkit.report.figures import save
     from vemkit.report.study_figures import pareto_figure
     from vemkit.studies import tradeoff_answers
-    from vemkit.studies.convergence import read_records
+    from vemkit.studies.error_records import read_records
     from vemkit.studies.sweeps import write_dataset
 
     s = smk.params.settings

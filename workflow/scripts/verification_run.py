@@ -5,7 +5,7 @@ from _helpers import logged
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
     from vemkit.io.solution_file import write_netcdf
-    from vemkit.studies.convergence import write_records
+    from vemkit.studies.error_records import write_records
     from vemkit.studies.verification import CASES, run_case
 
     scene, family = smk.wildcards.scene, smk.wildcards.family
