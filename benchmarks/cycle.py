@@ -46,9 +46,7 @@ def main():
     problem = scene_problem(load_scene(PAPER_SCENE, overrides))
     K, f = problem.stiffness.tocsr(), problem.load
     record = {"n": args.n, "family": args.family, "dofs": problem.n_dofs, "nnz": K.nnz}
-    record["setup_s"], amg = best(
-        args.setup_repeat, lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol)
-    )
+    record["setup_s"], amg = best(args.setup_repeat, lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol))
     x = np.random.default_rng(0).standard_normal(K.shape[0])
     for precision in (np.float64, np.float32):
         name = np.dtype(precision).name
