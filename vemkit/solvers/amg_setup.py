@@ -156,25 +156,14 @@ def finest_level(A, B, omega: float = 4.0 / 3.0):
 RAP_ROWS = 250_000  # rows of A per partial product of the Galerkin operator
 
 
-GALERKIN_THREADS = 2  # row blocks multiplied at once (scipy's sparse products release the GIL)
-
-
 def galerkin(A, P):
     """P^T A P as the sum over row blocks r of P_r^T (A_r P): A P (as large as A) is never formed
-    whole. At 2.1 M DOFs: 3.2 -> 2.3 s CPU, the set-up's peak +622 -> +174 MiB. The blocks' products
-    run on GALERKIN_THREADS threads, summed in block order as before (the same sums to the last bit):
-    4.2 -> 2.7 s wall at 2.1 M DOFs (benchmarks/cycle.py, load 2.5), one A_r P more in memory."""
-    from concurrent.futures import ThreadPoolExecutor
-
+    whole. At 2.1 M DOFs: 3.2 -> 2.3 s CPU, the set-up's peak +622 -> +174 MiB."""
     n = A.shape[0]
     chunks = max(1, n // RAP_ROWS)
-
-    def block(c):
-        lo, hi = c * n // chunks, (c + 1) * n // chunks
-        return P[lo:hi].T.tocsr() @ (A[lo:hi] @ P)
-
     total = None
-    with ThreadPoolExecutor(max_workers=min(GALERKIN_THREADS, chunks)) as pool:
-        for part in pool.map(block, range(chunks)):
-            total = part if total is None else total + part
+    for c in range(chunks):
+        lo, hi = c * n // chunks, (c + 1) * n // chunks
+        part = P[lo:hi].T.tocsr() @ (A[lo:hi] @ P)
+        total = part if total is None else total + part
     return total
