@@ -6,7 +6,14 @@ from pathlib import Path
 import numpy as np
 from conftest import family_mesh, paper_problem
 
-from vemkit.solvers.linear import AMGSolver, linear_solver
+from vemkit.solvers.linear import (
+    CYCLE_PRECISION,
+    FINEST_OWN,
+    AMGSolver,
+    linear_solver,
+    smoothed_aggregation,
+    v_cycle_preconditioner,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -17,16 +24,42 @@ def _amg(n):
 
 
 def test_v_cycle_is_symmetric_positive_definite_and_equals_pyamgs_cycle():
-    problem, amg = _amg(160)  # ~50 000 unknowns: three levels (pyamg stops at 2000 coarse blocks)
-    assert len(amg.hierarchy.levels) >= 3  # a real multilevel cycle, coarse levels included
+    """In double precision the cycle is pyamg's own, to round-off."""
+    problem = paper_problem(family_mesh("triangle-delaunay", 160))  # ~50 000 unknowns: three levels
+    hierarchy = smoothed_aggregation(problem.stiffness.tocsr(), problem.near_nullspace)
+    assert len(hierarchy.levels) >= 3  # a real multilevel cycle, coarse levels included
     rng = np.random.default_rng(0)
     x, y = rng.standard_normal((2, problem.n_dofs))
-    M = amg.preconditioner
+    M = v_cycle_preconditioner(hierarchy, np.float64)
     Mx, My = M @ x, M @ y
     assert abs(x @ My - y @ Mx) <= 1e-12 * np.linalg.norm(x) * np.linalg.norm(My)
     assert x @ Mx > 0.0 and y @ My > 0.0
-    reference = amg.hierarchy.aspreconditioner(cycle="V")  # pyamg's cycle through the same levels
+    reference = hierarchy.aspreconditioner(cycle="V")  # pyamg's cycle through the same levels
     assert np.allclose(Mx, reference @ x, rtol=0.0, atol=1e-12 * np.abs(Mx).max())
+
+
+def test_the_single_precision_cycle_is_the_double_one_to_its_rounding_and_cg_needs_as_many_iterations():
+    """The default cycle runs in float32 (CYCLE_PRECISION): the double cycle's vector to ~1e-6 (not
+    to the last bit: it is not the double cycle), symmetric and positive to that rounding, and CG, in
+    double, meets 1e-10 in the same iterations +- 1, on a mesh whose finest level is vemkit's own."""
+    assert CYCLE_PRECISION == np.float32
+    problem, amg = _amg(160)
+    assert problem.n_dofs > FINEST_OWN
+    rng = np.random.default_rng(1)
+    x, y = rng.standard_normal((2, problem.n_dofs))
+    double = v_cycle_preconditioner(smoothed_aggregation(problem.stiffness.tocsr(), problem.near_nullspace), np.float64)
+    Mx, My = amg.preconditioner @ x, amg.preconditioner @ y
+    assert Mx.dtype == np.float64
+    assert 1e-9 < np.max(np.abs(Mx - double @ x)) / np.max(np.abs(Mx)) < 1e-5
+    assert abs(x @ My - y @ Mx) <= 1e-5 * np.linalg.norm(x) * np.linalg.norm(My)
+    assert x @ Mx > 0.0 and y @ My > 0.0
+    u = amg.solve(problem.load)
+    single_iterations = amg.iterations
+    assert amg.residual <= 1e-10
+    amg.preconditioner = double
+    reference = amg.solve(problem.load)
+    assert abs(single_iterations - amg.iterations) <= 1, (single_iterations, amg.iterations)
+    assert np.linalg.norm(u - reference) <= 1e-8 * np.linalg.norm(reference)
 
 
 def test_amg_cg_meets_its_tolerance_and_agrees_with_the_direct_solve():

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from vemkit.solvers.linear import v_cycle
+from vemkit.solvers.linear import transfers_in_precision, v_cycle
 from vemkit.solvers.nodal_smoother import NodalBlocks, nodal_smoothers
 
 
@@ -136,7 +136,7 @@ class BoundaryUpdatedHierarchy:
         self.nodal_blocks = NodalBlocks(hierarchy.levels[0].A) if nodal else None
         self.presmoother = [level.presmoother for level in self.levels[:-1]]
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
-        self.transfers = [(level.P.astype(precision), level.R.astype(precision)) for level in self.levels[:-1]]
+        self.transfers = [transfers_in_precision(level, precision) for level in self.levels[:-1]]  # on P's index arrays
         self.operators = [_LevelOperator(level.A, precision) for level in self.levels]
         if support is not None and pattern_positions(self.operators[0].base, _summed(support)) is None:
             self.operators[0].widen(_summed(support))

@@ -36,7 +36,37 @@ def v_cycle(levels, coarse_solver, level, b):
     return x
 
 
-def v_cycle_preconditioner(hierarchy):
+#: the floating type of every V-cycle (2D and 3D: its operators, transfers, smoothers and coarse solve);
+#: CG stays in float64 and so reaches any tolerance. float32 halves the memory traffic of the sweeps and
+#: products for the same CG iterations (benchmarks/cycle.py; tests/solvers/test_amg_preconditioner.py).
+CYCLE_PRECISION = np.float32
+
+
+class CycleLevel:
+    """What :func:`v_cycle` reads of a level: A, the transfers P and R, the two smoothers."""
+
+    def __init__(self, A, P=None, R=None, presmoother=None, postsmoother=None):
+        self.A, self.P, self.R = A, P, R
+        self.presmoother, self.postsmoother = presmoother, postsmoother
+
+
+def in_precision(M, precision):
+    """The CSR (or CSC) matrix M with its values in ``precision`` on M's own index arrays (M itself
+    when it already is)."""
+    if M.dtype == precision:
+        return M
+    return type(M)((M.data.astype(precision), M.indices, M.indptr), shape=M.shape)
+
+
+def transfers_in_precision(here, precision):
+    """(P, R) of a level in ``precision``; R = P^T as a view of the new P when it was one of P."""
+    P = in_precision(here.P, precision)
+    if here.R.format == "csc" and np.shares_memory(here.R.data, here.P.data):
+        return P, P.T
+    return P, in_precision(here.R, precision)
+
+
+def v_cycle_preconditioner(hierarchy, precision=CYCLE_PRECISION, release=False):
     """The V-cycle of a pyamg hierarchy as a LinearOperator (symmetric: forward Gauss-Seidel before,
     backward after), the operations of ``hierarchy.aspreconditioner("V")`` without the two residual
     norms pyamg's ``solve`` adds to every application (one a product with x = 0): ~17 % of each
@@ -46,6 +76,12 @@ def v_cycle_preconditioner(hierarchy):
     triangles; the paper scene, ssn and uzawa, n = 128 ... 512). Both: CG time -32 %. The
     transfers P, R are CSR as well: a V-cycle at 2.1 M DOFs (paper scene, 1024^2) 0.246 -> 0.191 s
     CPU, the same vector to the last bit.
+
+    The cycle runs in ``precision`` (:data:`CYCLE_PRECISION`): copies of the levels' values on
+    their index arrays, b cast down, the correction cast up, the coarsest LU in float64. The
+    hierarchy's levels keep their float64 operators; ``release``: their transfers become the cycle's
+    (the float64 P of the finest level, 27 M entries at 2.1 M DOFs, is freed: nothing but the cycle
+    reads it once the set-up is done, except vemkit.solvers.amg_update's products, 3D).
     """
     levels = hierarchy.levels
     for here in levels[1:-1]:
@@ -55,9 +91,22 @@ def v_cycle_preconditioner(hierarchy):
         here.R = here.R if here.R.format == "csc" else here.R.tocsr()  # csc: P^T as a view of P
     if len(levels) == 1:
         return spla.aslinearoperator(hierarchy.aspreconditioner(cycle="V"))
-    return spla.LinearOperator(
-        levels[0].A.shape, dtype=float, matvec=lambda b: v_cycle(levels, hierarchy.coarse_solver, 0, np.ravel(b))
-    )
+    cycle = []
+    for here in levels[:-1]:
+        P, R = transfers_in_precision(here, precision)
+        if release:
+            here.P, here.R = P, R
+        cycle.append(CycleLevel(in_precision(here.A, precision), P, R, here.presmoother, here.postsmoother))
+    cycle.append(CycleLevel(levels[-1].A))
+    coarse_solver = hierarchy.coarse_solver
+
+    def coarse(A, b):  # the coarsest LU in float64 (a few thousand unknowns)
+        return coarse_solver(A, b.astype(float)).astype(precision)
+
+    def matvec(b):
+        return v_cycle(cycle, coarse, 0, np.ravel(b).astype(precision)).astype(float)
+
+    return spla.LinearOperator(levels[0].A.shape, dtype=float, matvec=matvec)
 
 
 #: pyamg's options, measured on the paper scene (benchmarks/assembly.py, contact.py): scalar CSR
@@ -153,7 +202,8 @@ class AMGSolver:
         self.tol = tol
         self.maxiter = maxiter
         self.hierarchy = smoothed_aggregation(self.A, near_nullspace)
-        self.preconditioner = v_cycle_preconditioner(self.hierarchy)
+        # 2D: only the cycle reads the transfers after the set-up; 3D: vemkit.solvers.amg_update too
+        self.preconditioner = v_cycle_preconditioner(self.hierarchy, release=not _three_d(near_nullspace))
         self.iterations = 0
         self.residual = 0.0
 
@@ -224,11 +274,15 @@ class DirectSolver:
         return x
 
 
+def _three_d(near_nullspace) -> bool:
+    """Whether the near-nullspace is a 3D body's (the six rigid motions)."""
+    return near_nullspace is not None and np.shape(near_nullspace)[1] == RIGID_MODES_3D
+
+
 def direct_limit(near_nullspace) -> int:
     """The most unknowns ``auto`` solves directly: :data:`DIRECT_LIMIT_3D` for a 3D body (its
     near-nullspace holds the six rigid motions), :data:`DIRECT_LIMIT` otherwise."""
-    three_d = near_nullspace is not None and np.shape(near_nullspace)[1] == RIGID_MODES_3D
-    return DIRECT_LIMIT_3D if three_d else DIRECT_LIMIT
+    return DIRECT_LIMIT_3D if _three_d(near_nullspace) else DIRECT_LIMIT
 
 
 def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000):

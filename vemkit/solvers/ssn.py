@@ -43,7 +43,7 @@ equilibrium, lambda_c = tau_c . (r - (K + J) Z y)_c / (w_c b_c).
   K; rebuilt for K + J (+ a penalty on stick tangents) only when CG needs REBUILD_FACTOR times the
   iterations per decade of the first solve (3D: every level follows K + J + penalty at every step,
   vemkit.solvers.amg_update, the finest smoothed by vertices and the cycle in single precision,
-  vemkit.solvers.nodal_smoother, ssn_steps.CYCLE_PRECISION). Inexact Newton: CG tolerance eta = min(ETA_MAX,
+  vemkit.solvers.nodal_smoother, linear.CYCLE_PRECISION). Inexact Newton: CG tolerance eta = min(ETA_MAX,
   0.9 (theta_k / theta_{k-1})) (Eisenstat-Walker), never tighter than needed for tol. If the
   contact is far stiffer than the body (w p_nu' / kd > AMG_CONTRAST_LIMIT at the start) or the
   inexact steps stall the line search, the Newton solves switch to direct (info["fallback"]).

@@ -14,7 +14,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import LinearSolveError
-from vemkit.solvers.linear import linear_solver
+from vemkit.solvers.linear import CYCLE_PRECISION, linear_solver
 from vemkit.solvers.sparse_ops import as_matrix, reduced_operator
 
 REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
@@ -159,11 +159,6 @@ def disk_slip_step(q, lam, gamma):
     excess = size - 1.0
     base = unit - (np.sum(e * lam, axis=1) / excess)[:, None] * e
     return base, gamma / excess, e
-
-
-# the 3D Newton steps' V-cycle in single precision: 2/3 of the memory traffic of its sweeps and products
-# (CG, in double, reaches any tolerance; the same CG iterations on the sheared box at n = 24 ... 64)
-CYCLE_PRECISION = np.float32
 
 
 class ReducedSolver:

@@ -1,0 +1,61 @@
+"""The AMG-CG pieces on one stiffness matrix, A/B in one process (issue 22): set-up, the plain CG
+solve K u = f with the V-cycle in float64 and in float32 (vemkit.solvers.linear.CYCLE_PRECISION)
+and one V-cycle in each.
+
+    .venv/bin/python benchmarks/cycle.py --n 1024 [--family square|triangle] [--repeat 3] [--tol 1e-10]
+
+Every time is the best of ``--repeat`` runs (wall seconds). Prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+
+
+def best(repeat, fn):
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--n", type=int, default=256)
+    parser.add_argument("--family", default="square")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--tol", type=float, default=1e-10)
+    parser.add_argument("--setup-repeat", type=int, default=1)
+    args = parser.parse_args()
+    from vemkit.config.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+    from vemkit.solvers import linear
+
+    overrides = [f"discretization.mesh.n={args.n}", f"discretization.mesh.family={args.family}"]
+    if args.family == "triangle":
+        overrides.append("discretization.mesh.kind=structured")
+    problem = scene_problem(load_scene(PAPER_SCENE, overrides))
+    K, f = problem.stiffness.tocsr(), problem.load
+    record = {"n": args.n, "family": args.family, "dofs": problem.n_dofs, "nnz": K.nnz}
+    record["setup_s"], amg = best(args.setup_repeat, lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol))
+    x = np.random.default_rng(0).standard_normal(K.shape[0])
+    for precision in (np.float64, np.float32):
+        name = np.dtype(precision).name
+        amg.preconditioner = linear.v_cycle_preconditioner(amg.hierarchy, precision)
+        record[f"cycle_{name}_s"], _ = best(args.repeat, lambda: amg.preconditioner @ x)
+        record[f"cg_{name}_s"], u = best(args.repeat, lambda: amg.solve(f))
+        record[f"cg_{name}_iterations"], record[f"cg_{name}_residual"] = amg.iterations, amg.residual
+    print(json.dumps(record))
+
+
+if __name__ == "__main__":
+    main()
