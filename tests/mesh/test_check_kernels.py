@@ -102,3 +102,36 @@ def test_edge_table_is_the_stable_sort_of_the_vertex_pairs(seed):
     fine = square(9)
     for got, want in zip(fine._edge_table, edge_table_numpy(fine.half_edges, fine.n_vertices)):
         assert np.array_equal(got, want)
+
+
+def brute_force_t_junction(v, seg, tol):
+    """The smallest (vertex, segment) of all pairs with the vertex within tol of the segment's interior."""
+    a, c = v[seg[:, 0]], v[seg[:, 1]]
+    d = c - a
+    length = np.hypot(d[:, 0], d[:, 1])
+    rel = v[:, None, :] - a[None, :, :]  # (vertex, segment, 2)
+    along = (rel[..., 0] * d[:, 0] + rel[..., 1] * d[:, 1]) / length
+    across = np.abs(rel[..., 0] * d[:, 1] - rel[..., 1] * d[:, 0]) / length
+    end = (seg[None, :, 0] == np.arange(len(v))[:, None]) | (seg[None, :, 1] == np.arange(len(v))[:, None])
+    hit = ~end & (across <= tol) & (tol < along) & (along < length - tol)
+    found = np.argwhere(hit)
+    return tuple(int(x) for x in found[0]) if found.size else (-1, -1)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_t_junctions_found_by_binned_points_are_the_smallest_of_all_pairs(seed):
+    from vemkit.mesh.checks import _first_t_junction, _grid_for
+
+    rng = np.random.default_rng(seed)
+    v = np.round(rng.random((80, 2)), 1) + rng.random((80, 2)) * 1e-3 * (seed % 2)
+    seg = rng.choice(80, size=(120, 2), replace=True)
+    seg = seg[seg[:, 0] != seg[:, 1]]
+    seg = seg[np.hypot(*(v[seg[:, 1]] - v[seg[:, 0]]).T) > 0]
+    on = rng.choice(seg.shape[0], 5)  # vertices put on segments: T-junctions
+    v = np.vstack([v, 0.5 * (v[seg[on, 0]] + v[seg[on, 1]])])
+    tol = 1e-9
+    expected = brute_force_t_junction(v, seg, tol)
+    assert expected != (-1, -1)
+    assert _first_t_junction(v, seg, *_grid_for(v, seg.shape[0]), tol) == expected
+    clean = v[:80]
+    assert _first_t_junction(clean, seg, *_grid_for(clean, seg.shape[0]), tol) == brute_force_t_junction(clean, seg, tol)

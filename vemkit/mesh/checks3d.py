@@ -28,7 +28,8 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.exceptions import MeshError
-from vemkit.mesh.close_points import close_pairs
+from vemkit.mesh.close_points import close_pairs, has_close_pair
+from vemkit.mesh.geometry import extents
 from vemkit.mesh.polyhedral import PolyhedralMesh
 
 #: largest distance of a face vertex from the face's plane, relative to the face's diameter
@@ -221,8 +222,9 @@ def _check_vertices(mesh: PolyhedralMesh, tol: float) -> None:
     unused = np.flatnonzero(used == 0)
     if unused.size:
         raise MeshError(f"vertex {unused[0]} belongs to no face; remove it (and renumber)")
-    extent = float(np.max(np.ptp(mesh.vertices, axis=0)))
-    pairs = close_pairs(mesh.vertices, tol * max(extent, np.finfo(float).tiny))
+    extent = float(np.max(extents(mesh.vertices)))
+    radius = tol * max(extent, np.finfo(float).tiny)
+    pairs = close_pairs(mesh.vertices, radius) if has_close_pair(mesh.vertices, radius) else np.zeros((0, 2))
     if pairs.size:
         a, b = sorted(int(x) for x in pairs[np.argmin(pairs.min(axis=1))])
         where = tuple(mesh.vertices[a].tolist())
