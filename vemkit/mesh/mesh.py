@@ -21,7 +21,7 @@ import numba
 import numpy as np
 
 from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
-from vemkit.mesh.geometry import polygon_areas
+from vemkit.mesh.geometry import indexed_polygon_areas
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,7 +123,7 @@ class Mesh:
     @cached_property
     def cell_areas(self) -> np.ndarray:
         """Signed (shoelace) area of every cell: positive for counter-clockwise polygons."""
-        return polygon_areas(self.vertices[self.cell_vertices], self.cell_offsets)
+        return indexed_polygon_areas(self.vertices, self.cell_offsets, self.cell_vertices)
 
     @cached_property
     def cell_diameters(self) -> np.ndarray:
