@@ -134,4 +134,6 @@ def test_t_junctions_found_by_binned_points_are_the_smallest_of_all_pairs(seed):
     assert expected != (-1, -1)
     assert _first_t_junction(v, seg, *_grid_for(v, seg.shape[0]), tol) == expected
     clean = v[:80]
-    assert _first_t_junction(clean, seg, *_grid_for(clean, seg.shape[0]), tol) == brute_force_t_junction(clean, seg, tol)
+    assert _first_t_junction(clean, seg, *_grid_for(clean, seg.shape[0]), tol) == brute_force_t_junction(
+        clean, seg, tol
+    )

@@ -57,7 +57,9 @@ def test_indexed_areas_keep_the_bits_of_the_gathered_areas():
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     points = rng.normal(size=(500, 2)) * 10.0 ** rng.integers(-6, 4, (500, 1)) + [250.0, -3.0]
     refs = rng.integers(0, 500, offsets[-1])
-    np.testing.assert_array_equal(indexed_polygon_areas(points, offsets, refs), areas_centroids_numpy(points[refs], offsets)[0])
+    np.testing.assert_array_equal(
+        indexed_polygon_areas(points, offsets, refs), areas_centroids_numpy(points[refs], offsets)[0]
+    )
 
 
 def test_fan_cells_keep_the_argsort_order_and_the_bits_of_areas():

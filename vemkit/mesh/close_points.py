@@ -51,7 +51,9 @@ def has_close_pair(points: np.ndarray, radius: float) -> bool:
     keys, weights = _cell_keys(points, radius)
     order = np.argsort(keys)
     shifts = np.array([int(np.dot(shift, weights)) for shift in _forward_neighbours(dimension)], dtype=np.int64)
-    return bool(_any_close_pair(np.ascontiguousarray(points), keys[order], order, shifts, float(radius) ** 2 * (1 + 1e-12)))
+    return bool(
+        _any_close_pair(np.ascontiguousarray(points), keys[order], order, shifts, float(radius) ** 2 * (1 + 1e-12))
+    )
 
 
 def _cell_keys(points: np.ndarray, radius: float):
