@@ -137,3 +137,20 @@ def test_t_junctions_found_by_binned_points_are_the_smallest_of_all_pairs(seed):
     assert _first_t_junction(clean, seg, *_grid_for(clean, seg.shape[0]), tol) == brute_force_t_junction(
         clean, seg, tol
     )
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_edge_screen_passes_exactly_the_meshes_the_edge_checks_pass(seed):
+    from vemkit.mesh.check_kernels import edges_shared_properly
+    from vemkit.mesh.checks import _name_edge_defect
+
+    outcomes = set()
+    for mesh in (random_soup(seed, n_vertices=400, n_cells=8), random_soup(seed), square(3 + seed)):
+        try:
+            _name_edge_defect(mesh)
+            passed = True
+        except MeshError:
+            passed = False
+        assert edges_shared_properly(mesh.half_edges, mesh.half_edge_edge, mesh.edge_first_half_edges) == passed
+        outcomes.add(passed)
+    assert outcomes == {True, False}

@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from vemkit.exceptions import MeshError
-from vemkit.mesh.check_kernels import cell_perimeters, corner_angle_sums, first_repeated_vertex
+from vemkit.mesh.check_kernels import cell_perimeters, corner_angle_sums, edges_shared_properly, first_repeated_vertex
 from vemkit.mesh.close_points import close_pairs, has_close_pair
 from vemkit.mesh.geometry import bin_boxes, bounds, extents
 from vemkit.mesh.mesh import Mesh
@@ -171,6 +171,13 @@ def _check_vertices(mesh: Mesh, length_tol: float) -> None:
 
 # -- edges ----------------------------------------------------------------------------------
 def _check_edges(mesh: Mesh) -> None:
+    if not edges_shared_properly(mesh.half_edges, mesh.half_edge_edge, mesh.edge_first_half_edges):
+        _name_edge_defect(mesh)
+
+
+def _name_edge_defect(mesh: Mesh) -> None:
+    """The edge checks in numpy (``edges_shared_properly`` is their screen): the first edge in more
+    than two cells, or the smallest directed pair traversed twice the same way."""
     he, cells = mesh.half_edges, mesh.half_edge_cells
     counts = np.bincount(mesh.half_edge_edge)
     crowded = np.flatnonzero(counts > 2)

@@ -67,9 +67,17 @@ class Mesh:
     @cached_property
     def half_edges(self) -> np.ndarray:
         """``(H, 2)`` directed edges ``(a, b)`` of every cell, in cell order (CCW)."""
-        nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)
-        last = self.cell_offsets[1:] - 1
-        nxt[last] = self.cell_offsets[:-1]
+        offsets = self.cell_offsets
+        if (
+            offsets.size > 1
+            and offsets[0] == 0
+            and offsets[-1] == self.cell_vertices.size
+            and (offsets[1:] > offsets[:-1]).all()
+        ):
+            return half_edge_pairs(offsets, self.cell_vertices)
+        nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)  # validate_mesh names the bad offsets
+        last = offsets[1:] - 1
+        nxt[last] = offsets[:-1]
         return np.stack([self.cell_vertices, self.cell_vertices[nxt]], axis=1)
 
     @cached_property
@@ -203,6 +211,19 @@ def edge_table_numpy(half_edges: np.ndarray, n_vertices: int):
     half_edge_edge = np.empty_like(edge_of_sorted)
     half_edge_edge[order] = edge_of_sorted
     return half_edge_edge, order[first]
+
+
+@numba.njit(cache=True)
+def half_edge_pairs(offsets, cell_vertices):
+    """``Mesh.half_edges`` of CSR cells (offsets from 0 to len(cell_vertices), increasing): each
+    vertex paired with the next of its cell, the last with the first."""
+    out = np.empty((cell_vertices.shape[0], 2), dtype=np.int64)
+    for k in range(offsets.shape[0] - 1):
+        s, e = offsets[k], offsets[k + 1]
+        for h in range(s, e):
+            out[h, 0] = cell_vertices[h]
+            out[h, 1] = cell_vertices[h + 1 if h + 1 < e else s]
+    return out
 
 
 #: a vertex's half-edges are ordered by insertion up to this many, by a merge sort above
