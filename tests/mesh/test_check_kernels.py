@@ -154,3 +154,23 @@ def test_the_edge_screen_passes_exactly_the_meshes_the_edge_checks_pass(seed):
         assert edges_shared_properly(mesh.half_edges, mesh.half_edge_edge, mesh.edge_first_half_edges) == passed
         outcomes.add(passed)
     assert outcomes == {True, False}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_topology_kernels_are_the_numpy_forms(seed):
+    from vemkit.mesh.mesh import cells_of_edges, half_edge_pairs
+
+    for mesh in (random_soup(seed), square(3 + seed)):
+        nxt = np.arange(1, mesh.cell_vertices.size + 1)
+        nxt[mesh.cell_offsets[1:] - 1] = mesh.cell_offsets[:-1]
+        np.testing.assert_array_equal(
+            half_edge_pairs(mesh.cell_offsets, mesh.cell_vertices),
+            np.stack([mesh.cell_vertices, mesh.cell_vertices[nxt]], 1),
+        )
+        first = mesh.edge_first_half_edges
+        want = np.full((first.size, 2), -1)
+        want[:, 0] = mesh.half_edge_cells[first]
+        other = np.ones(mesh.half_edges.shape[0], bool)
+        other[first] = False
+        want[mesh.half_edge_edge[other], 1] = mesh.half_edge_cells[other]  # crowded edges: the last
+        np.testing.assert_array_equal(cells_of_edges(mesh.cell_offsets, mesh.half_edge_edge, first), want)

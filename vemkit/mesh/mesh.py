@@ -65,15 +65,17 @@ class Mesh:
 
     # -- derived topology --------------------------------------------------------------------
     @cached_property
+    def _plain_offsets(self) -> bool:
+        """Whether the offsets are a plain CSR of all the cell vertices (from 0, increasing, to the end):
+        the topology kernels' condition (``validate_mesh`` names what is wrong otherwise)."""
+        o = self.cell_offsets
+        return bool(o.size > 1 and o[0] == 0 and o[-1] == self.cell_vertices.size and (o[1:] > o[:-1]).all())
+
+    @cached_property
     def half_edges(self) -> np.ndarray:
         """``(H, 2)`` directed edges ``(a, b)`` of every cell, in cell order (CCW)."""
         offsets = self.cell_offsets
-        if (
-            offsets.size > 1
-            and offsets[0] == 0
-            and offsets[-1] == self.cell_vertices.size
-            and (offsets[1:] > offsets[:-1]).all()
-        ):
+        if self._plain_offsets:
             return half_edge_pairs(offsets, self.cell_vertices)
         nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)  # validate_mesh names the bad offsets
         last = offsets[1:] - 1
@@ -113,9 +115,10 @@ class Mesh:
 
         Column 0 is the cell in which the edge runs as in ``edges``.
         """
-        ne = self.edges.shape[0]
-        out = np.full((ne, 2), -1, dtype=np.int64)
         first = self.edge_first_half_edges
+        if self._plain_offsets:
+            return cells_of_edges(self.cell_offsets, self.half_edge_edge, first)
+        out = np.full((first.shape[0], 2), -1, dtype=np.int64)
         out[:, 0] = self.half_edge_cells[first]
         other = np.ones(self.half_edges.shape[0], dtype=bool)
         other[first] = False
@@ -223,6 +226,18 @@ def half_edge_pairs(offsets, cell_vertices):
         for h in range(s, e):
             out[h, 0] = cell_vertices[h]
             out[h, 1] = cell_vertices[h + 1 if h + 1 < e else s]
+    return out
+
+
+@numba.njit(cache=True)
+def cells_of_edges(offsets, half_edge_edge, edge_first_half_edges):
+    """``Mesh.edge_cells`` of plain CSR cells: column 0 the cell of an edge's first half-edge, column 1
+    the cell of its other one (the last, if more), -1 if none."""
+    out = np.full((edge_first_half_edges.shape[0], 2), -1, dtype=np.int64)
+    for k in range(offsets.shape[0] - 1):
+        for h in range(offsets[k], offsets[k + 1]):
+            e = half_edge_edge[h]
+            out[e, 0 if edge_first_half_edges[e] == h else 1] = k
     return out
 
 
