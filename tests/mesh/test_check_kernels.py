@@ -102,3 +102,75 @@ def test_edge_table_is_the_stable_sort_of_the_vertex_pairs(seed):
     fine = square(9)
     for got, want in zip(fine._edge_table, edge_table_numpy(fine.half_edges, fine.n_vertices)):
         assert np.array_equal(got, want)
+
+
+def brute_force_t_junction(v, seg, tol):
+    """The smallest (vertex, segment) of all pairs with the vertex within tol of the segment's interior."""
+    a, c = v[seg[:, 0]], v[seg[:, 1]]
+    d = c - a
+    length = np.hypot(d[:, 0], d[:, 1])
+    rel = v[:, None, :] - a[None, :, :]  # (vertex, segment, 2)
+    along = (rel[..., 0] * d[:, 0] + rel[..., 1] * d[:, 1]) / length
+    across = np.abs(rel[..., 0] * d[:, 1] - rel[..., 1] * d[:, 0]) / length
+    end = (seg[None, :, 0] == np.arange(len(v))[:, None]) | (seg[None, :, 1] == np.arange(len(v))[:, None])
+    hit = ~end & (across <= tol) & (tol < along) & (along < length - tol)
+    found = np.argwhere(hit)
+    return tuple(int(x) for x in found[0]) if found.size else (-1, -1)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_t_junctions_found_by_binned_points_are_the_smallest_of_all_pairs(seed):
+    from vemkit.mesh.checks import _first_t_junction, _grid_for
+
+    rng = np.random.default_rng(seed)
+    v = np.round(rng.random((80, 2)), 1) + rng.random((80, 2)) * 1e-3 * (seed % 2)
+    seg = rng.choice(80, size=(120, 2), replace=True)
+    seg = seg[seg[:, 0] != seg[:, 1]]
+    seg = seg[np.hypot(*(v[seg[:, 1]] - v[seg[:, 0]]).T) > 0]
+    on = rng.choice(seg.shape[0], 5)  # vertices put on segments: T-junctions
+    v = np.vstack([v, 0.5 * (v[seg[on, 0]] + v[seg[on, 1]])])
+    tol = 1e-9
+    expected = brute_force_t_junction(v, seg, tol)
+    assert expected != (-1, -1)
+    assert _first_t_junction(v, seg, *_grid_for(v, seg.shape[0]), tol) == expected
+    clean = v[:80]
+    assert _first_t_junction(clean, seg, *_grid_for(clean, seg.shape[0]), tol) == brute_force_t_junction(
+        clean, seg, tol
+    )
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_edge_screen_passes_exactly_the_meshes_the_edge_checks_pass(seed):
+    from vemkit.mesh.check_kernels import edges_shared_properly
+    from vemkit.mesh.checks import _name_edge_defect
+
+    outcomes = set()
+    for mesh in (random_soup(seed, n_vertices=400, n_cells=8), random_soup(seed), square(3 + seed)):
+        try:
+            _name_edge_defect(mesh)
+            passed = True
+        except MeshError:
+            passed = False
+        assert edges_shared_properly(mesh.half_edges, mesh.half_edge_edge, mesh.edge_first_half_edges) == passed
+        outcomes.add(passed)
+    assert outcomes == {True, False}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_topology_kernels_are_the_numpy_forms(seed):
+    from vemkit.mesh.mesh import cells_of_edges, half_edge_pairs
+
+    for mesh in (random_soup(seed), square(3 + seed)):
+        nxt = np.arange(1, mesh.cell_vertices.size + 1)
+        nxt[mesh.cell_offsets[1:] - 1] = mesh.cell_offsets[:-1]
+        np.testing.assert_array_equal(
+            half_edge_pairs(mesh.cell_offsets, mesh.cell_vertices),
+            np.stack([mesh.cell_vertices, mesh.cell_vertices[nxt]], 1),
+        )
+        first = mesh.edge_first_half_edges
+        want = np.full((first.size, 2), -1)
+        want[:, 0] = mesh.half_edge_cells[first]
+        other = np.ones(mesh.half_edges.shape[0], bool)
+        other[first] = False
+        want[mesh.half_edge_edge[other], 1] = mesh.half_edge_cells[other]  # crowded edges: the last
+        np.testing.assert_array_equal(cells_of_edges(mesh.cell_offsets, mesh.half_edge_edge, first), want)

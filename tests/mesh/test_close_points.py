@@ -8,7 +8,7 @@ from scipy.spatial import cKDTree
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
-from vemkit.mesh.close_points import close_pairs
+from vemkit.mesh.close_points import close_pairs, has_close_pair
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.mesh import Mesh
 
@@ -45,3 +45,20 @@ def test_a_duplicated_vertex_is_still_refused():
     broken = Mesh(vertices, mesh.cell_offsets, cells, mesh.boundary, mesh.meta)
     with pytest.raises(MeshError, match=f"vertices 4 and {len(vertices) - 1} have the same coordinates"):
         validate_mesh(broken)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_the_screen_says_true_exactly_when_there_are_pairs(dimension):
+    rng = np.random.default_rng(10 + dimension)
+    seen = set()
+    for trial in range(60):
+        n = int(rng.integers(2, 300))
+        points = rng.random((n, dimension)) * float(rng.choice([1e-3, 1.0, 1e6]))
+        if trial % 3 == 0:
+            points = np.round(points, int(rng.integers(1, 3)))
+        points = np.vstack([points, points[rng.integers(0, n, size=int(rng.integers(0, 3)))]])
+        radius = float(rng.choice([0.0, 1e-12, 0.01, 0.2])) * float(np.ptp(points, axis=0).max())
+        expected = close_pairs(points, radius).size > 0
+        assert has_close_pair(points, radius) == expected
+        seen.add(expected)
+    assert seen == {True, False}

@@ -57,8 +57,9 @@ def test_ugrid_file_layout(tmp_path):
     assert grid.n_face == mesh.n_cells and grid.n_node == mesh.n_vertices
 
 
-def test_padded_face_nodes_matches_a_loop():
-    mesh = mesh_of("voronoi", {"seed": 4, "lloyd_iterations": 0})
+@pytest.mark.parametrize("family", ["voronoi", "triangle"])  # mixed sizes; one size (no padding)
+def test_padded_face_nodes_matches_a_loop(family):
+    mesh = mesh_of(family, {"seed": 4, "lloyd_iterations": 0} if family == "voronoi" else {})
     table = padded_face_nodes(mesh)
     assert table.shape == (mesh.n_cells, mesh.cell_sizes.max())
     for k in range(mesh.n_cells):

@@ -13,7 +13,7 @@ import triangle as shewchuk
 from vemkit.config.domain import domain_from_spec
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import build_mesh, voronoi_clip, voronoi_kernels
-from vemkit.mesh.geometry import areas_centroids, areas_centroids_numpy
+from vemkit.mesh.geometry import areas_centroids, areas_centroids_numpy, indexed_polygon_areas
 
 voronoi_module = sys.modules["vemkit.mesh.families.voronoi"]  # the package exports the function
 
@@ -49,6 +49,17 @@ def test_areas_centroids_kernel_keeps_numpys_bits():
     uneven = np.array([0, 3, 3, 7])  # an empty polygon: numpy's reduceat semantics, from the twin
     for got, want in zip(areas_centroids(coords[:7], uneven), areas_centroids_numpy(coords[:7], uneven)):
         np.testing.assert_array_equal(got, want)
+
+
+def test_indexed_areas_keep_the_bits_of_the_gathered_areas():
+    rng = np.random.default_rng(5)
+    sizes = np.concatenate([rng.integers(3, 10, 3000), np.arange(3, 140)])  # up to 129 points, then numpy
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    points = rng.normal(size=(500, 2)) * 10.0 ** rng.integers(-6, 4, (500, 1)) + [250.0, -3.0]
+    refs = rng.integers(0, 500, offsets[-1])
+    np.testing.assert_array_equal(
+        indexed_polygon_areas(points, offsets, refs), areas_centroids_numpy(points[refs], offsets)[0]
+    )
 
 
 def test_fan_cells_keep_the_argsort_order_and_the_bits_of_areas():

@@ -94,3 +94,19 @@ def worst_coordinate_over_edge(vertices, offsets, cell_vertices):
             if worst < 0 or ratio > worst_ratio:
                 worst, worst_ratio, worst_length, worst_reach = h, ratio, length, reach
     return worst, worst_ratio, worst_length, worst_reach
+
+
+@numba.njit(cache=True)
+def edges_shared_properly(half_edges, half_edge_edge, edge_first_half_edges):
+    """True when every edge has at most two half-edges and a second one runs opposite to the first
+    (``checks._check_edges`` passes): one pass over the half-edges."""
+    count = np.zeros(edge_first_half_edges.shape[0], dtype=np.int64)
+    for h in range(half_edges.shape[0]):
+        e = half_edge_edge[h]
+        count[e] += 1
+        if count[e] > 2:
+            return False
+        first = edge_first_half_edges[e]
+        if first != h and half_edges[first, 0] == half_edges[h, 0]:
+            return False
+    return True

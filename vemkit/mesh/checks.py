@@ -26,9 +26,9 @@ import numba
 import numpy as np
 
 from vemkit.exceptions import MeshError
-from vemkit.mesh.check_kernels import cell_perimeters, corner_angle_sums, first_repeated_vertex
-from vemkit.mesh.close_points import close_pairs
-from vemkit.mesh.geometry import bin_boxes
+from vemkit.mesh.check_kernels import cell_perimeters, corner_angle_sums, edges_shared_properly, first_repeated_vertex
+from vemkit.mesh.close_points import close_pairs, has_close_pair
+from vemkit.mesh.geometry import bin_boxes, bounds, extents
 from vemkit.mesh.mesh import Mesh
 
 
@@ -36,7 +36,7 @@ def validate_mesh(mesh: Mesh, tol: float = 1e-12) -> None:
     """Raise ``MeshError`` for the first defect found; ``tol`` is relative to the mesh extent."""
     _check_arrays(mesh)
     v = mesh.vertices
-    extent = float(np.max(np.ptp(v, axis=0))) if v.shape[0] else 1.0
+    extent = float(np.max(extents(v))) if v.shape[0] else 1.0
     length_tol = tol * max(extent, np.finfo(float).tiny)
     _check_cells(mesh)
     _check_vertices(mesh, length_tol)
@@ -50,7 +50,7 @@ def _check_arrays(mesh: Mesh) -> None:
     v, off, cv = mesh.vertices, mesh.cell_offsets, mesh.cell_vertices
     if v.ndim != 2 or v.shape[1] != 2:
         raise MeshError(f"vertices have shape {v.shape}; give an (N, 2) array of x, y coordinates")
-    bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+    bad = np.zeros(0, dtype=np.int64) if np.isfinite(v).all() else np.flatnonzero(~np.isfinite(v).all(axis=1))
     if bad.size:
         raise MeshError(f"vertex {bad[0]} has non-finite coordinates {tuple(v[bad[0]].tolist())}; fix its coordinates")
     if off.ndim != 1 or off.size < 1 or off[0] != 0:
@@ -157,7 +157,7 @@ def _first_self_intersection(vertices, offsets, cell_vertices):
 
 # -- vertices -------------------------------------------------------------------------------
 def _check_vertices(mesh: Mesh, length_tol: float) -> None:
-    pairs = close_pairs(mesh.vertices, length_tol)
+    pairs = close_pairs(mesh.vertices, length_tol) if has_close_pair(mesh.vertices, length_tol) else np.zeros((0, 2))
     if pairs.size:
         a, b = sorted(int(x) for x in pairs[np.argmin(pairs.min(axis=1))])
         raise MeshError(
@@ -171,6 +171,13 @@ def _check_vertices(mesh: Mesh, length_tol: float) -> None:
 
 # -- edges ----------------------------------------------------------------------------------
 def _check_edges(mesh: Mesh) -> None:
+    if not edges_shared_properly(mesh.half_edges, mesh.half_edge_edge, mesh.edge_first_half_edges):
+        _name_edge_defect(mesh)
+
+
+def _name_edge_defect(mesh: Mesh) -> None:
+    """The edge checks in numpy (``edges_shared_properly`` is their screen): the first edge in more
+    than two cells, or the smallest directed pair traversed twice the same way."""
     he, cells = mesh.half_edges, mesh.half_edge_cells
     counts = np.bincount(mesh.half_edge_edge)
     crowded = np.flatnonzero(counts > 2)
@@ -205,8 +212,7 @@ def _check_cover(mesh: Mesh, length_tol: float) -> None:
     v = mesh.vertices
     edges = mesh.edges
     grid = _grid_for(v, edges.shape[0])
-    bins, items = _bin_segments(v, edges, *grid, length_tol)
-    vertex, e = _first_t_junction(v, edges, bins, items, *grid, length_tol)
+    vertex, e = _first_t_junction(v, edges, *grid, length_tol)
     if vertex >= 0:
         k = int(mesh.edge_cells[e, 0])
         raise MeshError(
@@ -258,8 +264,8 @@ def _check_angle_sums(mesh: Mesh, be: np.ndarray, out_deg: np.ndarray) -> None:
 
 
 def _grid_for(v: np.ndarray, n_segments: int):
-    lo = v.min(axis=0)
-    size = max(float(np.max(v.max(axis=0) - lo)), np.finfo(float).tiny)
+    lo, hi = bounds(v)
+    size = max(float(np.max(hi - lo)), np.finfo(float).tiny)
     g = int(min(4096, max(1, np.ceil(np.sqrt(n_segments)))))
     return lo, g / size, g
 
@@ -290,24 +296,48 @@ def _bin_segments(v, seg, lo, inv_cell, g, pad):
 
 
 @numba.njit(cache=True)
-def _first_t_junction(v, seg, bins, items, lo, inv_cell, g, tol):
-    """First vertex within tol of the interior of a segment it is not an end of: (vertex, segment)."""
+def _bin_points(v, lo, inv_cell, g):
+    """CSR (ptr, points) of the points in each of the g x g grid bins (points in increasing order)."""
+    where = np.empty(v.shape[0], dtype=np.int64)
+    ptr = np.zeros(g * g + 1, dtype=np.int64)
     for x in range(v.shape[0]):
-        i = _bin_range(v[x, 0], lo[0], inv_cell, g)
-        j = _bin_range(v[x, 1], lo[1], inv_cell, g)
-        b = j * g + i
-        for t in range(bins[b], bins[b + 1]):
-            s = items[t]
-            if seg[s, 0] == x or seg[s, 1] == x:
-                continue
-            a, c = v[seg[s, 0]], v[seg[s, 1]]
-            dx, dy = c[0] - a[0], c[1] - a[1]
-            length = np.sqrt(dx * dx + dy * dy)
-            along = ((v[x, 0] - a[0]) * dx + (v[x, 1] - a[1]) * dy) / length
-            across = abs((v[x, 0] - a[0]) * dy - (v[x, 1] - a[1]) * dx) / length
-            if across <= tol and tol < along < length - tol:
-                return x, s
-    return -1, -1
+        where[x] = _bin_range(v[x, 1], lo[1], inv_cell, g) * g + _bin_range(v[x, 0], lo[0], inv_cell, g)
+        ptr[where[x] + 1] += 1
+    for b in range(g * g):
+        ptr[b + 1] += ptr[b]
+    points = np.empty(v.shape[0], dtype=np.int64)
+    fill = ptr[:-1].copy()
+    for x in range(v.shape[0]):
+        points[fill[where[x]]] = x
+        fill[where[x]] += 1
+    return ptr, points
+
+
+@numba.njit(cache=True)
+def _first_t_junction(v, seg, lo, inv_cell, g, tol):
+    """The smallest (vertex, segment) with the vertex within tol of the interior of a segment it is
+    not an end of, among the pairs whose vertex lies in a bin of the segment's (tol-padded) bounding
+    box; (-1, -1) if none. The points are binned (one bin each), and every segment meets the points
+    of its bins."""
+    ptr, points = _bin_points(v, lo, inv_cell, g)
+    best_x, best_s = -1, -1
+    for s in range(seg.shape[0]):
+        i0, i1, j0, j1 = _segment_bin_box(v, seg, s, lo, inv_cell, g, tol)
+        a, c = v[seg[s, 0]], v[seg[s, 1]]
+        dx, dy = c[0] - a[0], c[1] - a[1]
+        length = np.sqrt(dx * dx + dy * dy)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                b = j * g + i
+                for t in range(ptr[b], ptr[b + 1]):
+                    x = points[t]
+                    if seg[s, 0] == x or seg[s, 1] == x or (best_x >= 0 and x >= best_x):
+                        continue
+                    along = ((v[x, 0] - a[0]) * dx + (v[x, 1] - a[1]) * dy) / length
+                    across = abs((v[x, 0] - a[0]) * dy - (v[x, 1] - a[1]) * dx) / length
+                    if across <= tol and tol < along < length - tol:
+                        best_x, best_s = x, s
+    return best_x, best_s
 
 
 @numba.njit(cache=True)
@@ -348,7 +378,7 @@ def _outside_winding_edge(v: np.ndarray, be: np.ndarray, length_tol: float) -> i
     the mesh's thinner direction (coordinates turned by -90 degrees when it is wider than tall) and
     meet only the boundary edges binned along them: about B^1.5 work for B boundary edges, also on
     a long thin strip (all pairs: minutes at B = 10^5)."""
-    width, height = np.ptp(v, axis=0) if v.size else (0.0, 0.0)
+    width, height = extents(v) if v.size else (0.0, 0.0)
     w = np.ascontiguousarray(np.stack([v[:, 1], -v[:, 0]], axis=1) if width > height else v)
     grid = _grid_for(w, be.shape[0])
     bins, items = _bin_segments(w, be, *grid, length_tol)

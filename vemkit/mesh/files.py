@@ -50,6 +50,8 @@ FILL_VALUE = -1
 def padded_face_nodes(mesh: Mesh, fill_value: int = FILL_VALUE) -> np.ndarray:
     """``(M, max cell size)`` vertex indices of every cell, padded with ``fill_value`` (vectorised)."""
     sizes = mesh.cell_sizes
+    if mesh.n_cells and sizes.min() == sizes.max():  # one cell size: the CSR list is the table
+        return mesh.cell_vertices.reshape(mesh.n_cells, int(sizes[0])).copy()
     out = np.full((mesh.n_cells, int(sizes.max()) if mesh.n_cells else 0), fill_value, dtype=np.int64)
     rows = np.repeat(np.arange(mesh.n_cells, dtype=np.int64), sizes)
     cols = np.arange(mesh.cell_vertices.size, dtype=np.int64) - np.repeat(mesh.cell_offsets[:-1], sizes)

@@ -6,6 +6,8 @@
   Numba kernel with the bits of its vectorized twin ``areas_centroids_numpy``; its per-polygon parts
   ``area_centroid_few`` / ``area_centroid_many`` serve other kernels), and ``counter_clockwise``
   which reverses the clockwise ones;
+- ``bounds``: the lowest and highest coordinate of a point set per axis, a column at a time
+  (numpy's ``min(axis=0)`` of an (N, 2) array runs 25x slower than a column's ``min()``);
 - ``bin_boxes``: items binned on a uniform g x g grid by their bounding boxes, for point location
   and segment-intersection searches (``vemkit.vem.norms``, ``vemkit.mesh.checks``).
 """
@@ -14,6 +16,20 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+
+
+def bounds(points: np.ndarray):
+    """(low, high): ``points.min(axis=0)`` and ``points.max(axis=0)`` of a non-empty (N, d) array,
+    one contiguous column at a time (the same values)."""
+    low = np.array([points[:, k].min() for k in range(points.shape[1])])
+    high = np.array([points[:, k].max() for k in range(points.shape[1])])
+    return low, high
+
+
+def extents(points: np.ndarray) -> np.ndarray:
+    """``np.ptp(points, axis=0)`` of a non-empty (N, d) array (by ``bounds``)."""
+    low, high = bounds(points)
+    return high - low
 
 
 @numba.njit(cache=True)
@@ -184,6 +200,42 @@ def polygon_areas(coords: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     return areas_centroids(coords, offsets)[0]
 
 
+def indexed_polygon_areas(points: np.ndarray, offsets: np.ndarray, refs: np.ndarray) -> np.ndarray:
+    """``polygon_areas(points[refs], offsets)`` (the same bits) without gathering the coordinates:
+    the kernel reads ``points[refs[i]]`` in place (1.6 M references: 0.08 s of gather saved)."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    offsets = np.ascontiguousarray(offsets, dtype=np.int64)
+    refs = np.ascontiguousarray(refs, dtype=np.int64)
+    if offsets.size < 2:
+        return np.zeros(0)
+    area, plain = _indexed_areas_kernel(points, offsets, refs)
+    return area if plain else polygon_areas(points[refs], offsets)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _indexed_areas_kernel(points, offsets, refs):
+    """The areas of ``_areas_centroids_kernel`` of the polygons points[refs[offsets[k]:offsets[k + 1]]];
+    ``plain`` False (results unused) on the same conditions, or for a reference outside points."""
+    m = offsets.shape[0] - 1
+    area = np.empty(m)
+    plain = offsets[0] == 0 and offsets[m] == refs.shape[0]
+    longest = 0
+    for k in range(m):
+        plain = plain and offsets[k + 1] > offsets[k]
+        longest = max(longest, offsets[k + 1] - offsets[k])
+    for i in range(refs.shape[0]):
+        plain = plain and 0 <= refs[i] < points.shape[0]
+    if not plain or longest > 129:
+        return area, False
+    work = np.empty((3, longest))
+    for k in range(m):
+        if offsets[k + 1] - offsets[k] <= 8:
+            area[k] = area_centroid_few(points, refs, offsets[k], offsets[k + 1])[0]
+        else:
+            area[k] = area_centroid_many(points, refs, offsets[k], offsets[k + 1], work)[0]
+    return area, True
+
+
 def ranges(sizes: np.ndarray) -> np.ndarray:
     """0..s-1 for every s in sizes, concatenated."""
     starts = np.repeat(np.cumsum(sizes) - sizes, sizes)
@@ -192,7 +244,7 @@ def ranges(sizes: np.ndarray) -> np.ndarray:
 
 def counter_clockwise(pool: np.ndarray, offsets: np.ndarray, refs: np.ndarray) -> np.ndarray:
     """Reverse the vertex order of every clockwise cell."""
-    area = polygon_areas(pool[refs], offsets)
+    area = indexed_polygon_areas(pool, offsets, refs)
     sizes = np.diff(offsets)
     local = ranges(sizes)
     flip = np.repeat(area < 0, sizes)

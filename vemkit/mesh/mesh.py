@@ -21,7 +21,7 @@ import numba
 import numpy as np
 
 from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
-from vemkit.mesh.geometry import polygon_areas
+from vemkit.mesh.geometry import indexed_polygon_areas
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,11 +65,21 @@ class Mesh:
 
     # -- derived topology --------------------------------------------------------------------
     @cached_property
+    def _plain_offsets(self) -> bool:
+        """Whether the offsets are a plain CSR of all the cell vertices (from 0, increasing, to the end):
+        the topology kernels' condition (``validate_mesh`` names what is wrong otherwise)."""
+        o = self.cell_offsets
+        return bool(o.size > 1 and o[0] == 0 and o[-1] == self.cell_vertices.size and (o[1:] > o[:-1]).all())
+
+    @cached_property
     def half_edges(self) -> np.ndarray:
         """``(H, 2)`` directed edges ``(a, b)`` of every cell, in cell order (CCW)."""
-        nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)
-        last = self.cell_offsets[1:] - 1
-        nxt[last] = self.cell_offsets[:-1]
+        offsets = self.cell_offsets
+        if self._plain_offsets:
+            return half_edge_pairs(offsets, self.cell_vertices)
+        nxt = np.arange(1, self.cell_vertices.size + 1, dtype=np.int64)  # validate_mesh names the bad offsets
+        last = offsets[1:] - 1
+        nxt[last] = offsets[:-1]
         return np.stack([self.cell_vertices, self.cell_vertices[nxt]], axis=1)
 
     @cached_property
@@ -105,9 +115,10 @@ class Mesh:
 
         Column 0 is the cell in which the edge runs as in ``edges``.
         """
-        ne = self.edges.shape[0]
-        out = np.full((ne, 2), -1, dtype=np.int64)
         first = self.edge_first_half_edges
+        if self._plain_offsets:
+            return cells_of_edges(self.cell_offsets, self.half_edge_edge, first)
+        out = np.full((first.shape[0], 2), -1, dtype=np.int64)
         out[:, 0] = self.half_edge_cells[first]
         other = np.ones(self.half_edges.shape[0], dtype=bool)
         other[first] = False
@@ -123,7 +134,7 @@ class Mesh:
     @cached_property
     def cell_areas(self) -> np.ndarray:
         """Signed (shoelace) area of every cell: positive for counter-clockwise polygons."""
-        return polygon_areas(self.vertices[self.cell_vertices], self.cell_offsets)
+        return indexed_polygon_areas(self.vertices, self.cell_offsets, self.cell_vertices)
 
     @cached_property
     def cell_diameters(self) -> np.ndarray:
@@ -203,6 +214,31 @@ def edge_table_numpy(half_edges: np.ndarray, n_vertices: int):
     half_edge_edge = np.empty_like(edge_of_sorted)
     half_edge_edge[order] = edge_of_sorted
     return half_edge_edge, order[first]
+
+
+@numba.njit(cache=True)
+def half_edge_pairs(offsets, cell_vertices):
+    """``Mesh.half_edges`` of CSR cells (offsets from 0 to len(cell_vertices), increasing): each
+    vertex paired with the next of its cell, the last with the first."""
+    out = np.empty((cell_vertices.shape[0], 2), dtype=np.int64)
+    for k in range(offsets.shape[0] - 1):
+        s, e = offsets[k], offsets[k + 1]
+        for h in range(s, e):
+            out[h, 0] = cell_vertices[h]
+            out[h, 1] = cell_vertices[h + 1 if h + 1 < e else s]
+    return out
+
+
+@numba.njit(cache=True)
+def cells_of_edges(offsets, half_edge_edge, edge_first_half_edges):
+    """``Mesh.edge_cells`` of plain CSR cells: column 0 the cell of an edge's first half-edge, column 1
+    the cell of its other one (the last, if more), -1 if none."""
+    out = np.full((edge_first_half_edges.shape[0], 2), -1, dtype=np.int64)
+    for k in range(offsets.shape[0] - 1):
+        for h in range(offsets[k], offsets[k + 1]):
+            e = half_edge_edge[h]
+            out[e, 0 if edge_first_half_edges[e] == h else 1] = k
+    return out
 
 
 #: a vertex's half-edges are ordered by insertion up to this many, by a merge sort above
