@@ -42,6 +42,7 @@ from vemkit.vem.elements.k2_kernel import (
     largest_cell,
     projection_workspace,
 )
+from vemkit.vem.elements.k2_load_kernel import p1_basis_moments, scaled_points_and_p1_sums
 from vemkit.vem.projection import strain_of
 from vemkit.vem.quadrature import body_force_averages, edge_quadrature, reference_quadrature, traction_samples
 
@@ -190,15 +191,14 @@ def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarra
     offsets, nodes = cell_nodes(mesh)
     frame = cell_frames(mesh)
     points, weights, cells = reference_quadrature(mesh, degree=5)
-    f = np.stack(np.broadcast_arrays(*body_force(points[:, 0], points[:, 1])), axis=1)
-    xi = (points[:, 0] - frame[cells, 0]) / frame[cells, 2]
-    eta = (points[:, 1] - frame[cells, 1]) / frame[cells, 2]
-    mono = np.stack([np.ones_like(xi), xi, eta], axis=1)  # (P, 3)
-    mass = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * mono[:, None, :], mesh.n_cells)
-    moments_f = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * f[:, None, :], mesh.n_cells)
+    f = np.empty_like(points)  # (P, 2): f1 at the points
+    f[:, 0], f[:, 1] = body_force(points[:, 0], points[:, 1])
+    xi, eta = np.empty(len(points)), np.empty(len(points))
+    mass, moments_f = np.zeros((mesh.n_cells, 3, 3)), np.zeros((mesh.n_cells, 3, 2))
+    scaled_points_and_p1_sums(points, weights, cells, frame, f, xi, eta, mass, moments_f)
     p1 = np.linalg.solve(mass, moments_f)  # (M, 3, 2): P_1 f1 = p1[0] + p1[1] xi + p1[2] eta
-    g = xi[:, None] * p1[cells, 1] + eta[:, None] * p1[cells, 2]  # P_1 f1 - P_0 f1 at the points
-    moments = basis_moments(xi, eta, weights[:, None] * g, cells, mesh.n_cells)
+    moments = np.zeros((mesh.n_cells, N_BASIS))
+    p1_basis_moments(xi, eta, weights, cells, p1, moments)  # P_1 f1 - P_0 f1 against the basis
     out = body_force_load_k2(mesh, p1[:, 0])
     _scatter_projected(mesh.vertices, offsets, nodes, float(lam), float(mu), moments, out)
     return out
