@@ -42,23 +42,24 @@ def interior_solve(K, size, r0, r1):
     return (e * r0 - b * r1) / det, (a * r1 - d * r0) / det
 
 
-def condense(vertices, offsets, nodes, free_index, interior_load, lam, mu, stab, out):
-    """*Template.* out[free b] -= K_bc K_cc^-1 f_c over the cells with a non-zero interior load f_c (M, 2)."""
-    work = workspace(largest_cell(offsets))  # noqa: F821 (bound by ``specialized``)
-    for c in range(offsets.shape[0] - 1):
-        if interior_load[c, 0] == 0.0 and interior_load[c, 1] == 0.0:
-            continue
-        K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
-        start = offsets[c]
-        size = offsets[c + 1] - start
-        z0, z1 = interior_solve(K, size, interior_load[c, 0], interior_load[c, 1])
-        ci = 2 * (size - 1)
-        for i in range(size - 1):
-            r = free_index[nodes[start + i]]
-            if r < 0:
+def condense(vertices, offsets, nodes, interior_load, lam, mu, stab, parts):
+    """*Template* (parallel). parts[2 offsets[c] + 2 i + a] = (K_bc K_cc^-1 f_c)[2 i + a] for the
+    non-interior nodes i of every cell with a non-zero interior load f_c (M, 2); the others stay 0."""
+    n_cells = offsets.shape[0] - 1
+    max_nodes = largest_cell(offsets)
+    for chunk in numba.prange(CELL_CHUNKS):
+        work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
+        for c in range(chunk * n_cells // CELL_CHUNKS, (chunk + 1) * n_cells // CELL_CHUNKS):
+            if interior_load[c, 0] == 0.0 and interior_load[c, 1] == 0.0:
                 continue
-            for a in range(2):
-                out[2 * r + a] -= K[2 * i + a, ci] * z0 + K[2 * i + a, ci + 1] * z1
+            K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+            start = offsets[c]
+            size = offsets[c + 1] - start
+            z0, z1 = interior_solve(K, size, interior_load[c, 0], interior_load[c, 1])
+            ci = 2 * (size - 1)
+            for i in range(size - 1):
+                for a in range(2):
+                    parts[2 * (start + i) + a] = K[2 * i + a, ci] * z0 + K[2 * i + a, ci + 1] * z1
 
 
 def recover(vertices, offsets, nodes, u, interior_load, lam, mu, stab):
@@ -92,18 +93,24 @@ def condense_load(space, lam: float, mu: float, stabilization: str, dofs, load_n
     if not dofs.condensed:
         raise ValueError("condense_load needs a condensed DofMap (VirtualElementSpace.numbering(condensed=True))")
     offsets, nodes = space.cell_nodes
-    out = dofs.restrict(load_nodes)
-    specialized(condense, space.element)(
+    out, loads = dofs.restrict(load_nodes), interior_load(space, load_nodes)
+    parts = np.zeros(2 * offsets[-1])
+    specialized(condense, space.element, parallel=True)(
         space.mesh.vertices,
         offsets,
         nodes,
-        dofs.free_index,
-        interior_load(space, load_nodes),
+        loads,
         float(lam),
         float(mu),
         stabilization_code(stabilization),
-        out,
+        parts,
     )
+    sizes = np.diff(offsets)
+    kept = np.repeat((loads[:, 0] != 0.0) | (loads[:, 1] != 0.0), sizes)  # the cells with an interior load,
+    kept[offsets[1:] - 1] = False  # their nodes but the interior one,
+    kept &= dofs.free_index[nodes] >= 0  # the free ones
+    rows = (2 * dofs.free_index[nodes[kept]][:, None] + np.arange(2)).ravel()
+    np.subtract.at(out, rows, parts.reshape(-1, 2)[kept].ravel())  # in the cells' order: a serial loop's sums
     return out
 
 
