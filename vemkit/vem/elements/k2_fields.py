@@ -144,7 +144,7 @@ def _scatter_projected(vertices, offsets, nodes, lam, mu, moments, out):
     one ordered np.add.at: the sums of a serial loop over the cells)."""
     parts = np.empty(2 * offsets[-1])
     _projected_parts(vertices, offsets, nodes, lam, mu, moments, parts)
-    np.add.at(out.reshape(-1), (2 * nodes[:, None] + np.arange(2)).ravel(), parts)
+    np.add.at(out, (np.repeat(nodes, 2), np.tile(np.arange(2), nodes.size)), parts)
 
 
 def cell_frames(mesh: Mesh) -> np.ndarray:
