@@ -54,3 +54,37 @@ def test_the_condensation_kernel_is_the_dense_schur_complement():
     work = K.copy()
     condense_interior(work, 2 * px.size + 1)
     np.testing.assert_allclose(work[b, b], expected, rtol=0, atol=1e-12 * np.abs(K).max())
+
+
+def test_a_repeated_recovery_is_a_copy_and_any_changed_input_recovers_anew():
+    """recover_interior remembers the space's last recovery: the same inputs give an equal, separate
+    array (changing it changes nothing remembered); other node values, loads or material recover anew."""
+    from vemkit.vem import condensation
+
+    mesh = family_mesh("voronoi", 4)
+    space = VirtualElementSpace(mesh, 2)
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=(space.n_nodes, 2))
+    loads = rng.normal(size=(mesh.n_cells, 2))
+    first = recover_interior(space, LAM, MU, "dofi-2mu", values, loads)
+    assert condensation._LAST_RECOVERY.get(space) is not None
+    first_copy = first.copy()
+    first[:] = 0.0  # the caller owns its array
+    again = recover_interior(space, LAM, MU, "dofi-2mu", values, loads)
+    assert np.array_equal(again, first_copy) and again is not first
+    condensation._LAST_RECOVERY.clear()
+    assert np.array_equal(recover_interior(space, LAM, MU, "dofi-2mu", values, loads), first_copy)
+    changed_values, changed_loads = values.copy(), loads.copy()
+    changed_values[0, 0] += 1.0  # a vertex value: the cell means of its cells change
+    changed_loads[0, 1] += 1.0
+    for args in [
+        (LAM, MU, "dofi-2mu", changed_values, loads),
+        (LAM, MU, "dofi-2mu", values, changed_loads),
+        (LAM, 2 * MU, "dofi-2mu", values, loads),
+        (LAM, MU, "trace", values, loads),
+    ]:
+        condensation._LAST_RECOVERY.clear()
+        fresh = recover_interior(space, *args)
+        recover_interior(space, LAM, MU, "dofi-2mu", values, loads)  # remembered: the unchanged inputs
+        assert np.array_equal(recover_interior(space, *args), fresh)
+        assert not np.array_equal(fresh, first_copy)

@@ -42,8 +42,11 @@ from vemkit.vem.elements.k2_kernel import (
     largest_cell,
     projection_workspace,
 )
+from vemkit.vem.elements.k2_load_kernel import p1_basis_moments, scaled_points_and_p1_sums
 from vemkit.vem.projection import strain_of
 from vemkit.vem.quadrature import body_force_averages, edge_quadrature, reference_quadrature, traction_samples
+
+CELL_CHUNKS = 8  # threads' shares of the cells in the per-cell projections (as vemkit.vem.condensation)
 
 _CELL_NODES: "weakref.WeakKeyDictionary[Mesh, tuple]" = weakref.WeakKeyDictionary()
 
@@ -118,18 +121,30 @@ def _frames(vertices, offsets, nodes, frame):
         frame[c, 0], frame[c, 1], frame[c, 2] = xc, yc, h
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
+def _projected_parts(vertices, offsets, nodes, lam, mu, moments, parts):
+    """parts[2 offsets[c] + j] = sum_b Pi[b, j] moments[c, b]: int_K g . Pi_2 phi_j dx given
+    int_K g . q_b dx, for the 2 (2n + 1) local dofs j of every cell (in parallel, CELL_CHUNKS shares)."""
+    n_cells = offsets.shape[0] - 1
+    nmax = largest_cell(offsets)
+    for chunk in numba.prange(CELL_CHUNKS):
+        Pi, rhs, G, sig = projection_workspace(nmax)
+        for c in range(chunk * n_cells // CELL_CHUNKS, (chunk + 1) * n_cells // CELL_CHUNKS):
+            start = offsets[c]
+            size = cell_projection(vertices, offsets, nodes, c, lam, mu, Pi, rhs, G, sig)[0]
+            for j in range(2 * size):
+                acc = 0.0
+                for b in range(N_BASIS):
+                    acc += Pi[b, j] * moments[c, b]
+                parts[2 * start + j] = acc
+
+
 def _scatter_projected(vertices, offsets, nodes, lam, mu, moments, out):
-    """out[node_j] += sum_b Pi[b, j] moments[c, b]: int_K g . Pi_2 phi_j dx given int_K g . q_b dx."""
-    Pi, rhs, G, sig = projection_workspace(largest_cell(offsets))
-    for c in range(offsets.shape[0] - 1):
-        start = offsets[c]
-        size = cell_projection(vertices, offsets, nodes, c, lam, mu, Pi, rhs, G, sig)[0]
-        for j in range(2 * size):
-            acc = 0.0
-            for b in range(N_BASIS):
-                acc += Pi[b, j] * moments[c, b]
-            out[nodes[start + j // 2], j % 2] += acc
+    """out[node_j] += sum_b Pi[b, j] moments[c, b] over the cells in order (``_projected_parts``, then
+    one ordered np.add.at: the sums of a serial loop over the cells)."""
+    parts = np.empty(2 * offsets[-1])
+    _projected_parts(vertices, offsets, nodes, lam, mu, moments, parts)
+    np.add.at(out, (np.repeat(nodes, 2), np.tile(np.arange(2), nodes.size)), parts)
 
 
 def cell_frames(mesh: Mesh) -> np.ndarray:
@@ -190,34 +205,39 @@ def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarra
     offsets, nodes = cell_nodes(mesh)
     frame = cell_frames(mesh)
     points, weights, cells = reference_quadrature(mesh, degree=5)
-    f = np.stack(np.broadcast_arrays(*body_force(points[:, 0], points[:, 1])), axis=1)
-    xi = (points[:, 0] - frame[cells, 0]) / frame[cells, 2]
-    eta = (points[:, 1] - frame[cells, 1]) / frame[cells, 2]
-    mono = np.stack([np.ones_like(xi), xi, eta], axis=1)  # (P, 3)
-    mass = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * mono[:, None, :], mesh.n_cells)
-    moments_f = cell_sums(cells, weights[:, None, None] * mono[:, :, None] * f[:, None, :], mesh.n_cells)
+    f = np.empty_like(points)  # (P, 2): f1 at the points
+    f[:, 0], f[:, 1] = body_force(points[:, 0], points[:, 1])
+    xi, eta = np.empty(len(points)), np.empty(len(points))
+    mass, moments_f = np.zeros((mesh.n_cells, 3, 3)), np.zeros((mesh.n_cells, 3, 2))
+    scaled_points_and_p1_sums(points, weights, cells, frame, f, xi, eta, mass, moments_f)
     p1 = np.linalg.solve(mass, moments_f)  # (M, 3, 2): P_1 f1 = p1[0] + p1[1] xi + p1[2] eta
-    g = xi[:, None] * p1[cells, 1] + eta[:, None] * p1[cells, 2]  # P_1 f1 - P_0 f1 at the points
-    moments = basis_moments(xi, eta, weights[:, None] * g, cells, mesh.n_cells)
+    moments = np.zeros((mesh.n_cells, N_BASIS))
+    p1_basis_moments(xi, eta, weights, cells, p1, moments)  # P_1 f1 - P_0 f1 against the basis
     out = body_force_load_k2(mesh, p1[:, 0])
     _scatter_projected(mesh.vertices, offsets, nodes, float(lam), float(mu), moments, out)
     return out
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def _cell_projections(vertices, offsets, nodes, u, lam, mu, coef, frame):
-    Pi, rhs, G, sig = projection_workspace(largest_cell(offsets))
-    for c in range(offsets.shape[0] - 1):
-        start = offsets[c]
-        size, area, xc, yc, h, m20, m11, m02 = cell_projection(vertices, offsets, nodes, c, lam, mu, Pi, rhs, G, sig)
-        frame[c, 0] = xc
-        frame[c, 1] = yc
-        frame[c, 2] = h
-        for b in range(N_BASIS):
-            acc = 0.0
-            for i in range(size):
-                acc += Pi[b, 2 * i] * u[nodes[start + i], 0] + Pi[b, 2 * i + 1] * u[nodes[start + i], 1]
-            coef[c, b] = acc
+    """coef[c] = Pi_2 of u on cell c, frame[c] = (x_K, y_K, h_K) (in parallel, CELL_CHUNKS shares)."""
+    n_cells = offsets.shape[0] - 1
+    nmax = largest_cell(offsets)
+    for chunk in numba.prange(CELL_CHUNKS):
+        Pi, rhs, G, sig = projection_workspace(nmax)
+        for c in range(chunk * n_cells // CELL_CHUNKS, (chunk + 1) * n_cells // CELL_CHUNKS):
+            start = offsets[c]
+            size, area, xc, yc, h, m20, m11, m02 = cell_projection(
+                vertices, offsets, nodes, c, lam, mu, Pi, rhs, G, sig
+            )
+            frame[c, 0] = xc
+            frame[c, 1] = yc
+            frame[c, 2] = h
+            for b in range(N_BASIS):
+                acc = 0.0
+                for i in range(size):
+                    acc += Pi[b, 2 * i] * u[nodes[start + i], 0] + Pi[b, 2 * i + 1] * u[nodes[start + i], 1]
+                coef[c, b] = acc
 
 
 @dataclass(frozen=True)
