@@ -79,6 +79,7 @@ bench: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python benchmarks/sweep.py
 	$(BIN)/python benchmarks/meshing.py
 	$(BIN)/python benchmarks/assembly_k2.py
+	$(BIN)/python benchmarks/threads.py
 
 # vemkit k = 1 against scikit-fem and GetFEM P1 on the same triangle meshes (benchmarks/peers.py),
 # and k = 2 against their P2 at equal error (benchmarks/peers_order2.py; docs/benchmarks/peers.md).

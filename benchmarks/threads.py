@@ -1,0 +1,125 @@
+"""Would a second thread speed up CG and its V-cycle? The finest level's memory-bound kernels on one
+stiffness matrix, serial against a Numba ``prange`` twin on 1 and 2 threads (issue 22).
+
+    .venv/bin/python benchmarks/threads.py [--n 708] [--family triangle|square] [--repeat 20]
+
+Measures, on the paper scene's stiffness matrix K (structured triangles by default: n = 708 is the
+1 005 362-DOF elasticity case of benchmarks/peers.py): the CSR product K x by scipy (serial) and by
+the row-parallel kernel below (the same sums in the same order: the results are compared bit for
+bit), each in float64 and in the V-cycle's float32; one forward Gauss-Seidel sweep by pyamg; and a
+plain copy of as many bytes as K's values and column indices (numpy), the memory traffic a product
+cannot go below. Every time is the best of ``--repeat`` (wall). Writes benchmarks/out/threads.{json,md}.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+import scipy.sparse as sp
+
+from _common import MACHINE, write_report
+
+PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+
+
+@numba.njit(cache=True, parallel=True)
+def row_parallel_product(indptr, indices, data, x, out):
+    """out += A x, the rows split over the threads (scipy's csr_matvec sums, row by row)."""
+    for i in numba.prange(out.shape[0]):
+        s = out[i]
+        for p in range(indptr[i], indptr[i + 1]):
+            s += data[p] * x[indices[p]]
+        out[i] = s
+
+
+def best(repeat, fn):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def measure(K, repeat: int) -> dict:
+    record = {}
+    for precision in (np.float64, np.float32):
+        record.update(measure_precision(K, precision, repeat))
+    return record
+
+
+def measure_precision(K, precision, repeat: int) -> dict:
+    """The kernels on K's values in ``precision`` (keys suffixed with its name)."""
+    from pyamg.relaxation.relaxation import gauss_seidel
+
+    name = np.dtype(precision).name
+    A = sp.csr_matrix((K.data.astype(precision), K.indices, K.indptr), shape=K.shape)
+    x = np.random.default_rng(0).standard_normal(A.shape[0]).astype(precision)
+    reference = A @ x
+    record = {f"scipy_product_{name}_ms": 1e3 * best(repeat, lambda: A @ x)}
+    for threads in (1, 2):
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        out = np.zeros_like(x)
+        row_parallel_product(A.indptr, A.indices, A.data, x, out)
+        record[f"same_bits_{name}"] = record.get(f"same_bits_{name}", True) and bool(np.array_equal(out, reference))
+        record[f"numba_product_{name}_{threads}_threads_ms"] = 1e3 * best(
+            repeat, lambda: row_parallel_product(A.indptr, A.indices, A.data, x, np.zeros_like(x))
+        )
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    record[f"pyamg_gauss_seidel_{name}_ms"] = 1e3 * best(
+        repeat, lambda: gauss_seidel(A, np.zeros_like(x), x, sweep="forward")
+    )
+    traffic = np.empty(A.data.nbytes + A.indices.nbytes, dtype=np.uint8)
+    target = np.empty_like(traffic)
+    record[f"copy_{name}_ms"] = 1e3 * best(repeat, lambda: np.copyto(target, traffic))
+    record[f"bytes_{name}"] = int(traffic.nbytes)
+    return record
+
+
+def report_lines(record: dict) -> list:
+    lines = [
+        "# One thread or two: the finest level's kernels (benchmarks/threads.py)",
+        "",
+        f"Machine: {MACHINE}, {numba.config.NUMBA_NUM_THREADS} Numba threads. "
+        f"K: {record['dofs']:,} DOFs, {record['nnz']:,} entries ({record['family']}, n = {record['n']}). "
+        "Best of the repeats, milliseconds.",
+        "",
+        "| values | scipy K x | Numba K x, 1 thread | Numba K x, 2 threads | same bits | pyamg Gauss-Seidel "
+        "| copy of values + indices (GB/s) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name in ("float64", "float32"):
+        rate = record[f"bytes_{name}"] / (record[f"copy_{name}_ms"] * 1e-3) / 1e9
+        lines.append(
+            f"| {name} | {record[f'scipy_product_{name}_ms']:.1f} | {record[f'numba_product_{name}_1_threads_ms']:.1f} "
+            f"| {record[f'numba_product_{name}_2_threads_ms']:.1f} | {record[f'same_bits_{name}']} "
+            f"| {record[f'pyamg_gauss_seidel_{name}_ms']:.1f} | {record[f'copy_{name}_ms']:.1f} ({rate:.1f}) |"
+        )
+    return lines
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--n", type=int, default=708)
+    parser.add_argument("--family", default="triangle", choices=["triangle", "square"])
+    parser.add_argument("--repeat", type=int, default=20)
+    args = parser.parse_args()
+    from vemkit.config.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+
+    overrides = [f"discretization.mesh.n={args.n}", f"discretization.mesh.family={args.family}"]
+    if args.family == "triangle":
+        overrides.append("discretization.mesh.kind=structured")
+    problem = scene_problem(load_scene(PAPER_SCENE, overrides))
+    K = problem.stiffness.tocsr()
+    record = {"n": args.n, "family": args.family, "dofs": int(problem.n_dofs), "nnz": int(K.nnz)}
+    record.update(measure(K, args.repeat))
+    write_report("threads", record, report_lines(record))
+
+
+if __name__ == "__main__":
+    main()
