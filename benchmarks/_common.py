@@ -8,6 +8,7 @@ import platform
 from pathlib import Path
 
 OUT = Path(__file__).resolve().parent / "out"  # ignored by git
+PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
 MACHINE = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
 
 
@@ -30,3 +31,17 @@ def write_report(name: str, record: dict, lines: list) -> None:
 
 def targets_line(targets: dict, prefix: str = "Targets") -> str:
     return f"{prefix}: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in targets.items())
+
+
+def paper_problem(n: int, family: str = "square"):
+    """The paper scene's assembled problem on the n x n mesh of ``family`` (square, or the structured
+    triangles), and its record: n, family, DOFs and K's entries."""
+    from vemkit.config.scene import load_scene
+    from vemkit.contact.problem import scene_problem
+
+    overrides = [f"discretization.mesh.n={n}", f"discretization.mesh.family={family}"]
+    if family == "triangle":
+        overrides.append("discretization.mesh.kind=structured")
+    problem = scene_problem(load_scene(PAPER_SCENE, overrides))
+    record = {"n": n, "family": family, "dofs": int(problem.n_dofs), "nnz": int(problem.stiffness.nnz)}
+    return problem, record

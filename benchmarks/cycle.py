@@ -12,11 +12,10 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 
 import numpy as np
 
-PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+from _common import paper_problem
 
 
 def best(repeat, fn):
@@ -36,16 +35,10 @@ def main():
     parser.add_argument("--tol", type=float, default=1e-10)
     parser.add_argument("--setup-repeat", type=int, default=1)
     args = parser.parse_args()
-    from vemkit.config.scene import load_scene
-    from vemkit.contact.problem import scene_problem
     from vemkit.solvers import linear
 
-    overrides = [f"discretization.mesh.n={args.n}", f"discretization.mesh.family={args.family}"]
-    if args.family == "triangle":
-        overrides.append("discretization.mesh.kind=structured")
-    problem = scene_problem(load_scene(PAPER_SCENE, overrides))
+    problem, record = paper_problem(args.n, args.family)
     K, f = problem.stiffness.tocsr(), problem.load
-    record = {"n": args.n, "family": args.family, "dofs": problem.n_dofs, "nnz": K.nnz}
     record["setup_s"], amg = best(args.setup_repeat, lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol))
     x = np.random.default_rng(0).standard_normal(K.shape[0])
     for precision in (np.float64, np.float32):

@@ -15,15 +15,12 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 
 import numba
 import numpy as np
 import scipy.sparse as sp
 
-from _common import MACHINE, write_report
-
-PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+from _common import MACHINE, paper_problem, write_report
 
 
 @numba.njit(cache=True, parallel=True)
@@ -108,15 +105,8 @@ def main():
     parser.add_argument("--family", default="triangle", choices=["triangle", "square"])
     parser.add_argument("--repeat", type=int, default=20)
     args = parser.parse_args()
-    from vemkit.config.scene import load_scene
-    from vemkit.contact.problem import scene_problem
-
-    overrides = [f"discretization.mesh.n={args.n}", f"discretization.mesh.family={args.family}"]
-    if args.family == "triangle":
-        overrides.append("discretization.mesh.kind=structured")
-    problem = scene_problem(load_scene(PAPER_SCENE, overrides))
+    problem, record = paper_problem(args.n, args.family)
     K = problem.stiffness.tocsr()
-    record = {"n": args.n, "family": args.family, "dofs": int(problem.n_dofs), "nnz": int(K.nnz)}
     record.update(measure(K, args.repeat))
     write_report("threads", record, report_lines(record))
 
