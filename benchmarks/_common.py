@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import platform
+import time
 from pathlib import Path
 
 OUT = Path(__file__).resolve().parent / "out"  # ignored by git
@@ -31,6 +32,16 @@ def write_report(name: str, record: dict, lines: list) -> None:
 
 def targets_line(targets: dict, prefix: str = "Targets") -> str:
     return f"{prefix}: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in targets.items())
+
+
+def best_of(fn, repeat: int):
+    """(the least wall time of ``repeat`` calls of fn, in seconds; the last call's result)."""
+    times, result = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - start)
+    return min(times), result
 
 
 def paper_problem(n: int, family: str = "square"):

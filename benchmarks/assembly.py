@@ -20,16 +20,7 @@ import time
 
 import numpy as np
 
-from _common import MACHINE, OUT
-
-
-def best_of(fn, repeat):
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), result
+from _common import MACHINE, OUT, best_of
 
 
 def assembly_case(kind: str, n: int, repeat: int) -> dict:

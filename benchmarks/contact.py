@@ -16,11 +16,8 @@ import resource
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-from _common import MACHINE, OUT
-
-PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
+from _common import MACHINE, OUT, PAPER_SCENE
 
 
 def run_case(method: str, level: int) -> dict:

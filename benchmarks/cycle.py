@@ -11,20 +11,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 
 import numpy as np
 
-from _common import paper_problem
-
-
-def best(repeat, fn):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from _common import best_of, paper_problem
 
 
 def main():
@@ -39,13 +29,15 @@ def main():
 
     problem, record = paper_problem(args.n, args.family)
     K, f = problem.stiffness.tocsr(), problem.load
-    record["setup_s"], amg = best(args.setup_repeat, lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol))
+    record["setup_s"], amg = best_of(
+        lambda: linear.AMGSolver(K, problem.near_nullspace, tol=args.tol), args.setup_repeat
+    )
     x = np.random.default_rng(0).standard_normal(K.shape[0])
     for precision in (np.float64, np.float32):
         name = np.dtype(precision).name
         amg.preconditioner = linear.v_cycle_preconditioner(amg.hierarchy, precision)
-        record[f"cycle_{name}_s"], _ = best(args.repeat, lambda: amg.preconditioner @ x)
-        record[f"cg_{name}_s"], u = best(args.repeat, lambda: amg.solve(f))
+        record[f"cycle_{name}_s"], _ = best_of(lambda: amg.preconditioner @ x, args.repeat)
+        record[f"cg_{name}_s"], u = best_of(lambda: amg.solve(f), args.repeat)
         record[f"cg_{name}_iterations"], record[f"cg_{name}_residual"] = amg.iterations, amg.residual
     print(json.dumps(record))
 

@@ -20,11 +20,9 @@ import resource
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-from _common import MACHINE, quick_parser, targets_line, write_report
+from _common import MACHINE, PAPER_SCENE, quick_parser, targets_line, write_report
 
-PAPER_SCENE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "paper.yaml"
 CASES = [(2, 256), (2, 288), (1, 512)]
 QUICK_CASES = [(2, 32), (1, 64)]
 TARGET_SECONDS = 15.0

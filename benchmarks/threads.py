@@ -15,13 +15,12 @@ indices (numpy), the memory traffic a product cannot go below. Every time is the
 from __future__ import annotations
 
 import argparse
-import time
 
 import numba
 import numpy as np
 import scipy.sparse as sp
 
-from _common import MACHINE, paper_problem, write_report
+from _common import MACHINE, best_of, paper_problem, write_report
 
 
 @numba.njit(cache=True, parallel=True)
@@ -51,15 +50,6 @@ def row_parallel_product_unsigned(indptr, indices, data, x, out):
 KERNELS = {"numba": row_parallel_product, "numba_unsigned": row_parallel_product_unsigned}
 
 
-def best(repeat, fn):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
-
-
 def measure(K, repeat: int) -> dict:
     record = {}
     for precision in (np.float64, np.float32):
@@ -75,24 +65,25 @@ def measure_precision(K, precision, repeat: int) -> dict:
     A = sp.csr_matrix((K.data.astype(precision), K.indices, K.indptr), shape=K.shape)
     x = np.random.default_rng(0).standard_normal(A.shape[0]).astype(precision)
     reference = A @ x
-    record = {f"scipy_product_{name}_ms": 1e3 * best(repeat, lambda: A @ x)}
+    record = {f"scipy_product_{name}_ms": 1e3 * best_of(lambda: A @ x, repeat)[0]}
+    same_bits = []
     for kernel_name, kernel in KERNELS.items():
         for threads in (1, 2):
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
             out = np.zeros_like(x)
             kernel(A.indptr, A.indices, A.data, x, out)
-            same = record.get(f"same_bits_{name}", True) and bool(np.array_equal(out, reference))
-            record[f"same_bits_{name}"] = same
-            record[f"{kernel_name}_product_{name}_{threads}_threads_ms"] = 1e3 * best(
-                repeat, lambda kernel=kernel: kernel(A.indptr, A.indices, A.data, x, np.zeros_like(x))
+            same_bits.append(bool(np.array_equal(out, reference)))
+            record[f"{kernel_name}_product_{name}_{threads}_threads_ms"] = (
+                1e3 * best_of(lambda kernel=kernel: kernel(A.indptr, A.indices, A.data, x, np.zeros_like(x)), repeat)[0]
             )
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-    record[f"pyamg_gauss_seidel_{name}_ms"] = 1e3 * best(
-        repeat, lambda: gauss_seidel(A, np.zeros_like(x), x, sweep="forward")
+    record[f"same_bits_{name}"] = all(same_bits)
+    record[f"pyamg_gauss_seidel_{name}_ms"] = (
+        1e3 * best_of(lambda: gauss_seidel(A, np.zeros_like(x), x, sweep="forward"), repeat)[0]
     )
     traffic = np.empty(A.data.nbytes + A.indices.nbytes, dtype=np.uint8)
     target = np.empty_like(traffic)
-    record[f"copy_{name}_ms"] = 1e3 * best(repeat, lambda: np.copyto(target, traffic))
+    record[f"copy_{name}_ms"] = 1e3 * best_of(lambda: np.copyto(target, traffic), repeat)[0]
     record[f"bytes_{name}"] = int(traffic.nbytes)
     return record
 
