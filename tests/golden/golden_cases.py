@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = ROOT / "results" / "archive" / "golden.nc"
 
 _PAPER, _SCENES, _ORDER2 = "config/scenes/paper.yaml", "config/scenes", "config/order2"
+_BOX, _SHEARED = "config/scenes/3d/box_manufactured.yaml", "config/scenes/3d/sheared_box.yaml"
 
 #: name -> (command, scene, overrides)
 CASES = {
@@ -77,6 +78,24 @@ CASES = {
         ["discretization.mesh.h=2.0", "discretization.order=2"],
     ),
     "k2_kirsch_triangle": ("solve", f"{_SCENES}/kirsch.yaml", ["discretization.mesh.h=0.4", "discretization.order=2"]),
+    # 3D (recorded before the contact boundary, the files and the solvers become one for both dimensions)
+    "k1_3d_elasticity_hex": ("solve", _BOX, ["discretization.mesh.n=4"]),
+    "k1_3d_elasticity_tet": ("solve", _BOX, ["discretization.mesh.n=3", "discretization.mesh.family=tet"]),
+    "k1_3d_elasticity_octree": ("solve", _BOX, ["discretization.mesh.n=4", "discretization.mesh.family=octree"]),
+    "k1_3d_elasticity_voronoi": ("solve", _BOX, ["discretization.mesh.n=3", "discretization.mesh.family=voronoi"]),
+    "k1_3d_lame_voronoi_prisms": ("solve", f"{_SCENES}/3d/lame.yaml", ["discretization.mesh.h=0.25"]),
+    "k1_3d_friction_hex_ssn": ("solve", _SHEARED, ["discretization.mesh.n=6"]),
+    "k1_3d_friction_hex_uzawa": ("solve", _SHEARED, ["discretization.mesh.n=6", "solver.method=uzawa"]),
+    "k1_3d_friction_voronoi_ssn": (
+        "solve",
+        _SHEARED,
+        ["discretization.mesh.n=5", "discretization.mesh.family=voronoi", "contact.friction.m=1.0"],
+    ),
+    "k1_3d_friction_sliding_direct": (
+        "solve",
+        f"{_SCENES}/3d/contact_sliding.yaml",
+        ["discretization.mesh.n=3", "solver.linear=direct"],
+    ),
 }
 
 #: the numbers of a solution file that the code computes (not timings, versions or paths)
@@ -105,6 +124,28 @@ VARIABLES = (
     "mesh2d_node_x",
     "mesh2d_node_y",
     "mesh2d_face_nodes",
+    # 3D
+    "u3",
+    "strain_33",
+    "strain_13",
+    "strain_23",
+    "stress_33",
+    "stress_13",
+    "stress_23",
+    "von_mises",
+    "friction_bound",
+    "contact_vertex",
+    "contact_normal_x",
+    "contact_normal_y",
+    "contact_normal_z",
+    "contact_tangent1_x",
+    "contact_tangent1_y",
+    "contact_tangent1_z",
+    "mesh3d_node_x",
+    "mesh3d_node_y",
+    "mesh3d_node_z",
+    "mesh3d_face_nodes",
+    "mesh3d_volume_faces",
 )
 ATTRIBUTES = ("iterations", "linear_iterations", "n_dofs", "n_space_dofs")
 
