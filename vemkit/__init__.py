@@ -31,7 +31,7 @@ _API = {
     "discrete_problem": "vemkit.contact.problem",
     "scene_problem": "vemkit.contact.problem",
     "solve": "vemkit.solvers.dispatch",
-    "solution_dataset": "vemkit.io.solution_file",
+    "solution_dataset": "vemkit.studies.scene_solve",
     "read_solution": "vemkit.io.solution_file",
 }
 __all__ = sorted(_API) + ["__version__"]

@@ -123,10 +123,21 @@ def cmd_solve(args) -> int:
             _write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:
         print(
-            f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
+            f"{_name(args.output)}: {solved_how(problem, solution)}, "
             f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})"
         )
     return 0
+
+
+def solved_how(problem, solution) -> str:
+    """How the solve went, for the summary line: a problem without contact (or without a contact
+    force at the linear solution) is one linear solve, not "converged in 0 iterations"."""
+    if problem.contact.size == 0:
+        return f"{solution.method}: no contact side, one linear solve"
+    if solution.iterations == 0:
+        return f"{solution.method}: no contact force at the linear solution, one linear solve"
+    plural = "" if solution.iterations == 1 else "s"
+    return f"{solution.method} converged in {solution.iterations} iteration{plural}"
 
 
 def _check_resources(scene, max_dofs):

@@ -220,4 +220,5 @@ def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
     problem = discrete_problem(mesh, scene.E, scene.nu, **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
     problem.info["order"] = scene.order
+    problem.info["scene"] = scene  # the solution Dataset records it as the file of vemkit solve does
     return problem
