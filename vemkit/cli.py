@@ -31,6 +31,16 @@ from vemkit.exceptions import InputError, OutputError, SolveError, VemkitError
 
 EXIT_FAILURE = 2
 EXIT_INTERNAL = 70
+#: what ``vemkit --help`` says above and below the subcommands (plain text: a terminal shows it)
+DESCRIPTION = (
+    "vemkit: virtual elements for elastic bodies in frictional contact. Solve a scene, mesh a body, "
+    "or solve adaptively; 'vemkit COMMAND --help' lists a command's options."
+)
+EPILOG = (
+    "Exit status 0 on success (a converged, independently checked solution), 2 on a refused input "
+    "(one line 'vemkit: error: ...' naming it; nothing written), 70 on an internal error, 128 + N when ended by the signal N. The scene "
+    "keys, the file formats and these rules are in the documentation (docs/reference/)."
+)
 
 
 class _Progress:
@@ -184,7 +194,7 @@ def _adapt_inputs(args):
     if scene.dimension == 3:
         raise InputError(
             f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
-            "(SPEC §9); solve it with vemkit solve",
+            "(see docs/reference/files.md); solve it with vemkit solve",
             key="model",
         )
     mesh_file = scene.mesh_options.get("file")
@@ -323,7 +333,7 @@ def _positive_int(text: str) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from vemkit.config.limits import DEFAULT_MAX_DOFS
 
-    parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
+    parser = _ArgumentParser(prog="vemkit", description=DESCRIPTION, epilog=EPILOG)
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     limit: dict[str, Any] = dict(
@@ -347,7 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mesh.add_argument("family", nargs="?", help="square, triangle, voronoi or hanging")
     mesh.add_argument("n", nargs="?", type=int, help="cells per side (h = 1/n)")
-    mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead (SPEC §8)")
+    mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead")
     mesh.add_argument("--set", action="append", metavar="KEY=VALUE", help="with --scene: override a scene value")
     mesh.add_argument("-o", "--output", required=True, help="mesh file (netCDF4, UGRID)")
     mesh.add_argument(
@@ -359,8 +369,8 @@ def build_parser() -> argparse.ArgumentParser:
     mesh.set_defaults(func=cmd_mesh)
     adapt = sub.add_parser(
         "adapt",
-        help="solve, estimate, mark and refine until the scene's adaptivity target "
-        "(SPEC §9); write the final solution with the indicator and the history",
+        help="solve, estimate, mark and refine until the scene's adaptivity target; write the final "
+        "solution with the indicator and the history",
     )
     adapt.add_argument("scene", help="scene YAML file; its adaptivity: block sets the loop (defaults filled in)")
     adapt.add_argument(

@@ -135,7 +135,7 @@ class Scene:
 
     name = _field("name")
     domain = _field("domain")
-    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d (SPEC §10)")
+    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d")
     E = _field("material", "E", doc="Young's modulus")
     nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
     dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
@@ -167,7 +167,7 @@ class Scene:
     adaptivity_options = _field(
         "adaptivity",
         convert=copy.deepcopy,
-        doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)",
+        doc="adaptivity (docs/reference/files.md), defaults filled; max_hanging/reference may be None (a copy)",
     )
     body_force = property(
         lambda self: self._expressions["body_force"], doc="(Expression, Expression) (3D: three): the volume force f1"

@@ -102,7 +102,8 @@ def solution_contents(problem, solution, scene=None, *, verify: bool = False, ch
     solver_options = scene.solver_options if scene is not None else {"tol": DEFAULT_SOLVER_TOL}
     if verify or check:
         attrs.update((verified if verify else checked)(problem, solution, solver_options))
-    if scene is not None and scene.exact_displacement is not None:  # SPEC §7: relative errors of Pi u_h against the exact field
+    # with exact: the relative errors of Pi u_h against the exact field (docs/reference/files.md)
+    if scene is not None and scene.exact_displacement is not None:
         from vemkit.vem.norms import relative_exact_errors  # here: a solve without exact: never imports it
 
         attrs.update(

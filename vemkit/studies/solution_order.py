@@ -19,8 +19,8 @@ def refuse_order2(ds, what: str) -> None:
     if solution_order(ds) != 1:
         raise InputError(
             f"{what} has discretization.order = {solution_order(ds)}: this error measure (Pi_1 of vertex "
-            "values, SPEC 5) is for k = 1 only; use discretization.order=1 or the order2 study "
-            "(snakemake -j2 order2)",
+            "values) is for k = 1 only; use discretization.order=1 or the order2 study "
+            "(.venv/bin/snakemake -j2 order2)",
             key="discretization.order",
         )
 

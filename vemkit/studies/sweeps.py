@@ -339,7 +339,9 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             extra = ("contact_tangent",) if tangent_shape.get(k) else ()
             meta = {"long_name": long_name, "units": units}
             if extra:
-                meta["comment"] = "components along the vertex's tangent basis (t1, t2) of the solution file (SPEC §10)"
+                meta["comment"] = (
+                    "components along the vertex's tangent basis (t1, t2) of the solution file (docs/reference/files.md)"
+                )
             ds[f"profile_{k}"] = (pdims + extra, profile_data[k], meta)
         ds["profile_state"] = (
             pdims,
