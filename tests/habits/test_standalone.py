@@ -39,8 +39,9 @@ def text_of(name: str) -> str | None:
 
 def test_no_tracked_file_names_a_path_or_contract_outside_the_repository():
     found = []
+    itself = str(Path(__file__).resolve().relative_to(ROOT))  # spells the patterns out
     for name in tracked_files():
-        text = text_of(name)
+        text = text_of(name) if name != itself else None
         if text is None:
             continue
         for number, line in enumerate(text.splitlines(), 1):
