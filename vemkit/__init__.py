@@ -9,7 +9,7 @@ effects)::
     problem = vemkit.discrete_problem(mesh, E=2000.0, nu=0.4, dirichlet=["right"], contact=["bottom"], order=2)
     problem = vemkit.scene_problem(scene)                       # the same from a scene
     solution = vemkit.solve(problem, scene.solver_options)      # ssn or uzawa
-    ds = vemkit.solution_dataset(problem, solution)             # xarray.Dataset (SPEC §6)
+    ds = vemkit.solution_dataset(problem, solution)             # xarray.Dataset (docs/reference/files.md)
     mesh, ds = vemkit.read_solution("paper.nc")
 
 Layers (each subpackage imports only the ones before it): ``exceptions`` → ``config`` → ``mesh``

@@ -1,4 +1,4 @@
-"""The ``vemkit`` command line (SPEC §6).
+"""The ``vemkit`` command line (docs/reference/files.md).
 
     vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
     vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu] [--max-dofs N] [-q]
@@ -6,7 +6,7 @@
     vemkit adapt SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
 
 Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy;
-for ``adapt`` (SPEC §9): every step's solution met it, also when the loop stopped at its limits
+for ``adapt`` (docs/reference/files.md): every step's solution met it, also when the loop stopped at its limits
 before the target, which a note on stderr says).
 Any failure is one line ``vemkit: error: ...`` naming the input and the fix, exit status 2: a bad
 scene, ``--set``, option, argument, output path, a request beyond the limits, a solve that did
@@ -112,7 +112,7 @@ def cmd_solve(args) -> int:
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
-    mesh_file = scene.mesh_options.get("file")  # SPEC §8: relative to the scene file
+    mesh_file = scene.mesh_options.get("file")  # docs/reference/files.md: relative to the scene file
     output, vtu = _outputs(args, [args.scene] + ([Path(args.scene).parent / mesh_file] if mesh_file else []))
 
     _check_resources(scene, args.max_dofs)  # before anything is built
@@ -273,7 +273,7 @@ def _family_mesh(args):
 
 
 def _scene_mesh(args):
-    """The mesh a scene's discretization.mesh and domain ask for (SPEC §8: vemkit mesh --scene)."""
+    """The mesh a scene's discretization.mesh and domain ask for (docs/reference/files.md: vemkit mesh --scene)."""
     from vemkit.config.scene import load_scene
 
     if args.family is not None or args.n is not None or args.option:

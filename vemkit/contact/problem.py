@@ -178,7 +178,7 @@ def discrete_problem(
 
 
 def scene_gap(scene):
-    """The gap of the scene: its foundation line or plane (SPEC §7, §10) or its gap expression of the
+    """The gap of the scene: its foundation line or plane (docs/reference/files.md) or its gap expression of the
     coordinates (zero if none), as ``ContactBoundary.with_gap`` takes it."""
     if scene.foundation is not None:
         return FoundationLine(*scene.foundation)

@@ -1,6 +1,6 @@
 """Table 1 of the paper next to ours (Markdown, CSV, LaTeX), and the convergence tables.
 
-``PAPER_TABLE1`` holds the paper's numbers (SPEC §5): the relative "H1 error" on square meshes,
+``PAPER_TABLE1`` holds the paper's numbers (docs/reference/mathematics.md): the relative "H1 error" on square meshes,
 h = 2^-2 ... 2^-6, against the 2^-8 reference, and the observed orders. Our Table 1 gives, for
 every stabilization and for three measures, the error, its ratio to the paper's error, the order
 and its difference from the paper's order (5 significant digits):

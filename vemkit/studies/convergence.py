@@ -1,6 +1,6 @@
 """Convergence studies: per-run error records -> one self-describing ``xarray.Dataset``.
 
-The records (one coarse solve against the reference of the same stabilization, SPEC §5) are
+The records (one coarse solve against the reference of the same stabilization, docs/reference/mathematics.md) are
 ``vemkit.studies.error_records``; :func:`convergence_dataset` gathers them on the grid ``family x
 stabilization x h`` and :func:`write_convergence` stores the result as netCDF4.
 

@@ -1,4 +1,4 @@
-"""Error records of convergence studies: one coarse solve against the reference solution (SPEC §5).
+"""Error records of convergence studies: one coarse solve against the reference solution (docs/reference/mathematics.md).
 
 A *record* is a dict with the keys of :data:`RECORD_KEYS`: :func:`error_records` and
 :func:`family_error_records` compute them from solution files, :func:`solved_error_records` solves
@@ -117,7 +117,7 @@ class ReferenceSolution:
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
 
     def errors(self, mesh, dataset) -> dict:
-        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), SPEC 5.
+        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), docs/reference/mathematics.md.
         Both are k = 1 measures of vertex values: a k = 2 solution or reference is refused."""
         from vemkit.vem.norms import paper_error, projection_error
 

@@ -1,4 +1,4 @@
-"""The paper's published numbers (SPEC §5), which the studies and the reports compare with."""
+"""The paper's published numbers (docs/reference/mathematics.md), which the studies and the reports compare with."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ PAPER_TABLE1 = {
     # h = 2^-5 is printed 2.80070e-2, one digit more than the others, and its sixth digit is not
     # what the paper computed: the paper's order 0.95656 with its 5.4352e-2 at h = 2^-4 (both
     # rounded) puts the error in [2.80064e-2, 2.80071e-2], and the paper's measure with Gauss
-    # quadrature on Gamma_C gives 5.43516e-2 and 2.80065e-2 (order 0.95656; SPEC 5). The
+    # quadrature on Gamma_C gives 5.43516e-2 and 2.80065e-2 (order 0.95656; docs/reference/mathematics.md). The
     # comparison uses 2.8007e-2, five digits like the other levels.
 }
 

@@ -62,7 +62,7 @@ def verified(problem, solution, solver_options, where: str = "", source: str = "
 
 
 def mesh_family(mesh) -> str:
-    """The family that made ``mesh``; prisms over a 2D mesh (SPEC §10): ``extrude:`` and the base's family."""
+    """The family that made ``mesh``; prisms over a 2D mesh (docs/reference/files.md): ``extrude:`` and the base's family."""
     family = str(mesh.meta.get("family", ""))
     if family == "extrude":
         family += ":" + str(mesh.meta.get("base", {}).get("family", ""))
