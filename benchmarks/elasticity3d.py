@@ -1,4 +1,4 @@
-"""3D elasticity at about 10^6 DOFs (SPEC §10, issue 20). Writes benchmarks/out/elasticity3d.{json,md}.
+"""3D elasticity at about 10^6 DOFs (docs/reference/files.md, issue 20). Writes benchmarks/out/elasticity3d.{json,md}.
 
     .venv/bin/python benchmarks/elasticity3d.py [--quick] [--n N]
 

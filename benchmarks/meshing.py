@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/meshing.py [--quick]
 
-A 4 x 2 plate with three circular holes (SPEC §7 domain) meshed with about 100 000 cells
+A 4 x 2 plate with three circular holes (a domain as in docs/reference/files.md) meshed with about 100 000 cells
 (``cells=100000``) in each family, timed after a warm-up on a coarse mesh (Numba compiled,
 imports done); best of ``--repeat`` runs, wall and CPU time (the machine may be shared). Also reported, outside the timing: the time of
 ``validate_mesh``, the cell count, and for the cut-cell families the worst ratio of a cell's area to

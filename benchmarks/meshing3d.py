@@ -1,4 +1,4 @@
-"""3D meshing benchmark (SPEC §10). Writes benchmarks/out/meshing3d.{json,md}.
+"""3D meshing benchmark (docs/reference/files.md). Writes benchmarks/out/meshing3d.{json,md}.
 
     .venv/bin/python benchmarks/meshing3d.py [--quick] [--repeat R]
 

@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/peers.py [--quick] [--sizes 32 128 512 708] [--delaunay-sizes 32 128]
 
-On triangles the k = 1 VEM is exactly P1 (SPEC §3): every peer solves the same discrete problem
+On triangles the k = 1 VEM is exactly P1 (docs/reference/mathematics.md): every peer solves the same discrete problem
 on the mesh that `vemkit mesh` wrote (the paper scene's unit square, structured or Delaunay):
   elasticity  the paper scene without contact (right side clamped, the left traction): vemkit,
               scikit-fem (ElementVector(ElementTriP1()), linear_elasticity), GetFEM (FEM_PK(2,1),
@@ -40,7 +40,7 @@ PEERS = Path(__file__).resolve().parent / "peers"
 VEMKIT = Path(sys.executable).with_name("vemkit")
 SYSTEM_PYTHON = "/usr/bin/python3"
 E, NU = 2000.0, 0.4
-LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C (SPEC §1)
+LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C (docs/reference/mathematics.md)
 TRACTION_LEFT = [[1000.0, 0.0, -200.0], [-200.0, 0.0, 0.0]]  # (200 (5 - y), -200) as a + b x + c y
 PROBLEMS = ("elasticity", "compliance", "friction")
 FRICTION_K = 450.0  # the paper's k_tau (m_tau = 0): every Gamma_C vertex slides
@@ -89,7 +89,7 @@ def write_mesh(kind: str, n: int, path: Path) -> None:
 
 
 def mesh_case(mesh_path: Path) -> dict:
-    """Vertices, triangles and the four sides' edges of a vemkit mesh file (UGRID, SPEC §8)."""
+    """Vertices, triangles and the four sides' edges of a vemkit mesh file (UGRID, docs/reference/files.md)."""
     with xr.open_dataset(mesh_path) as ds:
         case = {
             "vertices": np.stack([ds.mesh2d_node_x.values, ds.mesh2d_node_y.values], axis=1),

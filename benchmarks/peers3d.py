@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/peers3d.py [--quick] [--sizes 8 16 32 48] [--problems elasticity compliance]
 
-On tetrahedra the 3D k = 1 VEM is exactly P1 (SPEC §10): every code solves the same discrete problem
+On tetrahedra the 3D k = 1 VEM is exactly P1 (docs/reference/files.md): every code solves the same discrete problem
 on the Kuhn tetrahedra of an n^3 grid of the unit cube (`family: tet, kind: structured`, 6 n^3 cells)
 that `vemkit mesh --scene` wrote (E = 1000, nu = 0.3):
   elasticity  the bottom face clamped, the traction (0, 0, -1) on the top face: vemkit, scikit-fem

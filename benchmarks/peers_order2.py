@@ -51,7 +51,7 @@ VEMKIT_CODES = ("vemkit", "vemkit_square")  # vemkit on triangles, on squares
 
 
 def vemkit_scene(problem: dict, mesh_path: Path, order: int) -> dict:
-    """The manufactured problem as a vemkit scene (SPEC §7 expressions), on the mesh file."""
+    """The manufactured problem as a vemkit scene (expressions as in docs/reference/files.md), on the mesh file."""
     dirichlet = {side: list(problem["displacement"]) for side in problem["dirichlet"]}
     neumann = {side: {"traction": list(t)} for side, t in problem["traction"].items()}
     return {

@@ -43,6 +43,7 @@ exclude_patterns = [
     "_generated/*.md",
     "_generated/paper",
     "_generated/verification",
+    "_generated/three-d",
     "reference/examples",
     "gallery/*.md5",
     "gallery/*.json",

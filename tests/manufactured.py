@@ -9,7 +9,7 @@ X, Y = sympy.symbols("x y")
 
 
 def elasticity_solution(u1: str, u2: str, E: float, nu: float) -> dict:
-    """The paper's plane-stress C (SPEC §1) applied to u = (u1, u2) (sympy text in x, y).
+    """The paper's plane-stress C (docs/reference/mathematics.md) applied to u = (u1, u2) (sympy text in x, y).
 
     Returns the body force f = −div σ(u) as scene expressions, and numpy callables of u, ∇u and of
     the traction σ n for a constant normal n.

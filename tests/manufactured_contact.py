@@ -37,7 +37,7 @@ from sympy.printing.str import StrPrinter
 X, Y = sympy.symbols("x y")
 E, NU = 1000.0, 0.3
 K_NORMAL = 1000.0
-LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C (SPEC §1)
+LAM, MU = E * NU / (1 - NU**2), E / (2 * (1 + NU))  # the paper's plane-stress C (docs/reference/mathematics.md)
 BUMP = sympy.exp(-20 * ((X - 0.7) ** 2 + (Y - 0.6) ** 2))
 SEPARATION_POINT = sympy.Rational(3, 5)
 #: (x0 − x)₊, a placeholder function: its derivative is −1 wherever it is positive, and every term

@@ -1,7 +1,7 @@
 """Manufactured frictional-contact solutions of a 3D body that need no traction on Γ_C but the contact law.
 
 u = (u1, u2, u3) on the unit cube (E = 1000, ν = 0.3, the 3D isotropic C: λ = Eν/((1+ν)(1−2ν)),
-μ = E/(2(1+ν)), SPEC §10), Γ_C the face y = 0 (ν = (0, −1, 0): u_ν = −u2, u_τ = (u1, u3) in the
+μ = E/(2(1+ν)), docs/reference/files.md), Γ_C the face y = 0 (ν = (0, −1, 0): u_ν = −u2, u_τ = (u1, u3) in the
 x-z plane), u held on y = 1, σ(u)n on the four other faces, the body force −div σ(u). With the signed
 penetration t(x, z) chosen the gap is g = u_ν − t = −u2(x, 0, z) − t, and u is built so that on y = 0
 
@@ -9,7 +9,7 @@ penetration t(x, z) chosen the gap is g = u_ν − t = −u2(x, 0, z) − t, and
     (σ12, σ23) = p_τ(t) λ = k_τ t₊^{m_τ} λ          (friction, (2.7)-(2.9), (5.1))
 
 i.e. σν = −p_ν ν − p_τ λ: the tangential traction σ_τ = (−σ12, −σ23) = −p_τ λ opposes the slip
-where λ = u_τ/|u_τ| (SPEC §10, vemkit.solvers.solution). Writing u1 = f1 + y a1 + y² B1,
+where λ = u_τ/|u_τ| (docs/reference/files.md, vemkit.solvers.solution). Writing u1 = f1 + y a1 + y² B1,
 u2 = h + y b + y² B2, u3 = f3 + y a3 + y² B3 (f1, f3, h, a1, a3, b of x and z), the three conditions
 fix a1, a3 and b; the y² terms (``INTERIOR``) leave them alone. The kinds (issue 21 item 3;
 k_ν = 1000, t ≤ 0.06, g ≥ 0.01):
@@ -50,7 +50,7 @@ from sympy.printing.str import StrPrinter
 X, Y, Z = sympy.symbols("x y z")
 E, NU = 1000.0, 0.3
 K_NORMAL = 1000.0
-LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))  # the 3D isotropic C (SPEC §10)
+LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))  # the 3D isotropic C (docs/reference/files.md)
 #: the y² terms of u (module docstring): a smooth interior field that Γ_C's conditions do not see
 INTERIOR = (0.05 * sympy.cos(X - Y + 2 * Z), -0.03 * sympy.sin(2 * X + Y - Z), 0.04 * sympy.cos(X + Y + Z))
 #: the separation curve q = 1 on Γ_C (y = 0): the ellipse w_x (x − x_c)² + w_z (z − z_c)² = 1 of

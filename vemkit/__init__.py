@@ -9,7 +9,7 @@ effects)::
     problem = vemkit.discrete_problem(mesh, E=2000.0, nu=0.4, dirichlet=["right"], contact=["bottom"], order=2)
     problem = vemkit.scene_problem(scene)                       # the same from a scene
     solution = vemkit.solve(problem, scene.solver_options)      # ssn or uzawa
-    ds = vemkit.solution_dataset(problem, solution)             # xarray.Dataset (SPEC §6)
+    ds = vemkit.solution_dataset(problem, solution)             # xarray.Dataset (docs/reference/files.md)
     mesh, ds = vemkit.read_solution("paper.nc")
 
 Layers (each subpackage imports only the ones before it): ``exceptions`` → ``config`` → ``mesh``
@@ -31,7 +31,7 @@ _API = {
     "discrete_problem": "vemkit.contact.problem",
     "scene_problem": "vemkit.contact.problem",
     "solve": "vemkit.solvers.dispatch",
-    "solution_dataset": "vemkit.io.solution_file",
+    "solution_dataset": "vemkit.studies.scene_solve",
     "read_solution": "vemkit.io.solution_file",
 }
 __all__ = sorted(_API) + ["__version__"]

@@ -1,4 +1,4 @@
-"""The ``vemkit`` command line (SPEC §6).
+"""The ``vemkit`` command line (docs/reference/files.md).
 
     vemkit solve SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
     vemkit mesh FAMILY N -o MESH.nc [--option key=value ...] [--vtu MESH.vtu] [--max-dofs N] [-q]
@@ -6,7 +6,7 @@
     vemkit adapt SCENE.yaml -o OUT.nc [--set key.path=value ...] [--vtu OUT.vtu] [--max-dofs N] [-q]
 
 Exit status 0 on success (for ``solve``: the independent residual check met the scene's accuracy;
-for ``adapt`` (SPEC §9): every step's solution met it, also when the loop stopped at its limits
+for ``adapt`` (docs/reference/files.md): every step's solution met it, also when the loop stopped at its limits
 before the target, which a note on stderr says).
 Any failure is one line ``vemkit: error: ...`` naming the input and the fix, exit status 2: a bad
 scene, ``--set``, option, argument, output path, a request beyond the limits, a solve that did
@@ -31,6 +31,16 @@ from vemkit.exceptions import InputError, OutputError, SolveError, VemkitError
 
 EXIT_FAILURE = 2
 EXIT_INTERNAL = 70
+#: what ``vemkit --help`` says above and below the subcommands (plain text: a terminal shows it)
+DESCRIPTION = (
+    "vemkit: virtual elements for elastic bodies in frictional contact. Solve a scene, mesh a body, "
+    "or solve adaptively; 'vemkit COMMAND --help' lists a command's options."
+)
+EPILOG = (
+    "Exit status 0 on success (a converged, independently checked solution), 2 on a refused input "
+    "(one line 'vemkit: error: ...' naming it; nothing written), 70 on an internal error, 128 + N when ended by the signal N. The scene "
+    "keys, the file formats and these rules are in the documentation (docs/reference/)."
+)
 
 
 class _Progress:
@@ -102,7 +112,7 @@ def cmd_solve(args) -> int:
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
-    mesh_file = scene.mesh_options.get("file")  # SPEC §8: relative to the scene file
+    mesh_file = scene.mesh_options.get("file")  # docs/reference/files.md: relative to the scene file
     output, vtu = _outputs(args, [args.scene] + ([Path(args.scene).parent / mesh_file] if mesh_file else []))
 
     _check_resources(scene, args.max_dofs)  # before anything is built
@@ -123,10 +133,21 @@ def cmd_solve(args) -> int:
             _write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:
         print(
-            f"{_name(args.output)}: {solution.method} converged in {solution.iterations} iterations, "
+            f"{_name(args.output)}: {solved_how(problem, solution)}, "
             f"{problem.n_dofs} dofs, {solution.wall_time:.2f} s (check {ds.attrs['check_worst']:.1e})"
         )
     return 0
+
+
+def solved_how(problem, solution) -> str:
+    """How the solve went, for the summary line: a problem without contact (or without a contact
+    force at the linear solution) is one linear solve, not "converged in 0 iterations"."""
+    if problem.contact.size == 0:
+        return f"{solution.method}: no contact side, one linear solve"
+    if solution.iterations == 0:
+        return f"{solution.method}: no contact force at the linear solution, one linear solve"
+    plural = "" if solution.iterations == 1 else "s"
+    return f"{solution.method} converged in {solution.iterations} iteration{plural}"
 
 
 def _check_resources(scene, max_dofs):
@@ -173,7 +194,7 @@ def _adapt_inputs(args):
     if scene.dimension == 3:
         raise InputError(
             f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
-            "(SPEC §9); solve it with vemkit solve",
+            "(see docs/reference/files.md); solve it with vemkit solve",
             key="model",
         )
     mesh_file = scene.mesh_options.get("file")
@@ -252,7 +273,7 @@ def _family_mesh(args):
 
 
 def _scene_mesh(args):
-    """The mesh a scene's discretization.mesh and domain ask for (SPEC §8: vemkit mesh --scene)."""
+    """The mesh a scene's discretization.mesh and domain ask for (docs/reference/files.md: vemkit mesh --scene)."""
     from vemkit.config.scene import load_scene
 
     if args.family is not None or args.n is not None or args.option:
@@ -312,7 +333,7 @@ def _positive_int(text: str) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from vemkit.config.limits import DEFAULT_MAX_DOFS
 
-    parser = _ArgumentParser(prog="vemkit", description=__doc__.split("\n\n")[0])
+    parser = _ArgumentParser(prog="vemkit", description=DESCRIPTION, epilog=EPILOG)
     parser.add_argument("--version", action="version", version=f"vemkit {vemkit.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     limit: dict[str, Any] = dict(
@@ -336,7 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mesh.add_argument("family", nargs="?", help="square, triangle, voronoi or hanging")
     mesh.add_argument("n", nargs="?", type=int, help="cells per side (h = 1/n)")
-    mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead (SPEC §8)")
+    mesh.add_argument("--scene", help="mesh the body and discretization.mesh of this scene instead")
     mesh.add_argument("--set", action="append", metavar="KEY=VALUE", help="with --scene: override a scene value")
     mesh.add_argument("-o", "--output", required=True, help="mesh file (netCDF4, UGRID)")
     mesh.add_argument(
@@ -348,8 +369,8 @@ def build_parser() -> argparse.ArgumentParser:
     mesh.set_defaults(func=cmd_mesh)
     adapt = sub.add_parser(
         "adapt",
-        help="solve, estimate, mark and refine until the scene's adaptivity target "
-        "(SPEC §9); write the final solution with the indicator and the history",
+        help="solve, estimate, mark and refine until the scene's adaptivity target; write the final "
+        "solution with the indicator and the history",
     )
     adapt.add_argument("scene", help="scene YAML file; its adaptivity: block sets the loop (defaults filled in)")
     adapt.add_argument(

@@ -1,6 +1,6 @@
 """The manufactured elasticity problem of the k = 2 / P2 comparison (benchmarks/peers_order2.py).
 
-The unit square in plane stress with the paper's E = 2000, nu = 0.4 (SPEC §1), the smooth exact
+The unit square in plane stress with the paper's E = 2000, nu = 0.4 (docs/reference/mathematics.md), the smooth exact
 displacement u = (sin(3x + 2y), cos(2x - 3y)) / 100, u = u_exact on the sides `left` and `bottom`,
 the traction sigma(u_exact) n on `right` (n = (1, 0)) and `top` (n = (0, 1)), and the body force
 f = -div sigma(u_exact). Everything is text in x and y that three languages read alike: vemkit's

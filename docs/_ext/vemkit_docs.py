@@ -11,6 +11,8 @@ At ``builder-inited`` this extension writes ``docs/_generated/`` (not committed)
   (``results/*.nc`` when the pipeline ran, else the committed ``results/archive/``), Figures 3-6, the
   contact profile and the convergence plot (drawn from the pipeline's figure meshes, small enough to
   solve during the build);
+- ``three-d/``: the picture of a 3D solve for the 3D tutorial and Getting started
+  (:func:`three_d_figure`);
 - ``verification/``: the verification tables from ``results/verification/verification.nc`` when the
   pipeline made it, else a statement that it is absent plus a build-time run on coarse meshes.
 
@@ -394,7 +396,7 @@ COARSE_VERIFICATION = {
 
 
 def verification_tables(out: Path) -> str:
-    """The verification tables and figures of ``results/verification/`` (``snakemake verification``);
+    """The verification tables and figures of ``results/verification/`` (``.venv/bin/snakemake verification``);
     when absent, says so and runs the same cases (``vemkit.studies.verification.run_case``) on the
     coarse meshes of :data:`COARSE_VERIFICATION`, tabled by the pipeline's own report function."""
     from vemkit.report.verification import verification_markdown
@@ -415,7 +417,7 @@ def verification_tables(out: Path) -> str:
             records += run_case(name, ROOT / "config" / "scenes" / f"{name}.yaml", family, sizes=sizes)
     ds = verification_dataset(records)
     head = (
-        f"```{{note}}\n`{path.relative_to(ROOT)}` is absent from this build: `snakemake -j2 verification` "
+        f"```{{note}}\n`{path.relative_to(ROOT)}` is absent from this build: `.venv/bin/snakemake -j2 verification` "
         "(about 3 minutes on 2 cores) makes it on every family at the published sizes, and the next "
         "`make docs` shows its tables and figures here. The tables below are this build's own run of the "
         "same cases (`vemkit.studies.verification.run_case`) on coarse meshes only, so their errors are "
@@ -426,7 +428,7 @@ def verification_tables(out: Path) -> str:
 
 def manufactured_tables() -> str:
     """The manufactured contact solutions (``config/order2/*.yaml``): the pipeline's
-    ``results/order2/manufactured.md`` when ``snakemake order2`` made it; else says so and solves
+    ``results/order2/manufactured.md`` when ``.venv/bin/snakemake order2`` made it; else says so and solves
     them during the build, k = 1 and k = 2 on squares n = 8 and 16, errors against the exact field."""
     import math
 
@@ -438,7 +440,7 @@ def manufactured_tables() -> str:
         return f"Generated from the pipeline's `{made.relative_to(ROOT)}`.\n\n" + _demote(made.read_text()) + "\n"
     lines = [
         "```{note}",
-        f"`{made.relative_to(ROOT)}` is absent from this build: `snakemake -j2 order2` makes it "
+        f"`{made.relative_to(ROOT)}` is absent from this build: `.venv/bin/snakemake -j2 order2` makes it "
         "(uniform and Γ_C-refined squares up to n = 128). Below, this build's own solves on 8 × 8 and "
         "16 × 16 squares; the observed order is log₂ of the ratio of the two errors.",
         "```",
@@ -470,10 +472,42 @@ def adaptivity_summary() -> str:
     if made.exists():
         return f"Generated from the pipeline's `{made.relative_to(ROOT)}`.\n\n" + _demote(made.read_text()) + "\n"
     return (
-        f"`{made.relative_to(ROOT)}` is absent from this build: `snakemake -j2 adaptivity` (about 11 minutes "
+        f"`{made.relative_to(ROOT)}` is absent from this build: `.venv/bin/snakemake -j2 adaptivity` (about 11 minutes "
         "on 2 cores, most of it the fine references) makes it, and the next `make docs` shows it here. The "
         "numbers measured when the study was last run are in the [Adaptivity](tutorials/adaptivity.md) "
         "tutorial.\n"
+    )
+
+
+#: the 3D picture of the tutorial and Getting started: a real solve during the build
+THREE_D_SCENE = ROOT / "config" / "scenes" / "3d" / "sheared_box.yaml"
+THREE_D_SETTINGS = ("discretization.mesh.n=8",)
+
+
+def three_d_figure(out: Path) -> str:
+    """``config/scenes/3d/sheared_box.yaml`` on 8 x 8 x 4 hexahedra, solved and checked as
+    ``vemkit solve`` does (:func:`vemkit.studies.scene_solve.solve_scene`), drawn by
+    :func:`vemkit.report.body3d_figures.body3d_figure`: the Markdown that shows it."""
+    import vemkit
+    from vemkit.report import figures as plots
+    from vemkit.report.body3d_figures import body3d_figure
+    from vemkit.studies.scene_solve import solve_scene
+
+    scene = vemkit.load_scene(str(THREE_D_SCENE), list(THREE_D_SETTINGS))
+    problem, solution, ds = solve_scene(scene, verify=True)
+    out.mkdir(parents=True, exist_ok=True)
+    title = f"sheared_box: {problem.mesh.n_cells} hexahedra, displacements ×20"
+    plots.save(body3d_figure(problem.mesh, ds, magnification=20, title=title), out / "sheared-box.png", dpi=80)
+    settings = " ".join(f"--set {s}" for s in THREE_D_SETTINGS)
+    return (
+        "![The sheared box on its foundation: the deformed body coloured by von Mises, and the stick and "
+        "slip zones of its contact face](/_generated/three-d/sheared-box.png)\n\n"
+        f"*`.venv/bin/vemkit solve config/scenes/3d/sheared_box.yaml -o box.nc {settings}`, drawn "
+        "from the Dataset by `vemkit.report.body3d_figures.body3d_figure` during this build: a box "
+        "pressed onto a foundation across a gap that opens along x, its top moved by "
+        "(0.004, 0.002, -0.01); left the deformed body, right its contact face projected on the x-y plane "
+        f"({solution.method}: {solution.iterations} Newton steps, {problem.n_dofs} unknowns, "
+        f"check {ds.attrs['check_worst']:.1e}).*\n"
     )
 
 
@@ -493,6 +527,7 @@ def generate(app=None) -> None:
     _write(OUT / "verification" / "tables.md", verification_tables(OUT / "verification"))
     _write(OUT / "verification" / "manufactured.md", manufactured_tables())
     _write(OUT / "verification" / "adaptivity.md", adaptivity_summary())
+    _write(OUT / "three-d" / "figure.md", three_d_figure(OUT / "three-d"))
 
 
 def _data_docstring(app, what, name, obj, options, lines):

@@ -1,7 +1,7 @@
 """vemkit k = 2 against P2 at equal error (benchmarks/peers_order2.py, issue 22 (a)): the mathematics
 of the comparison pinned on small meshes: each code's errors against the exact solution fall at its
 order's rates, vemkit's errors are those of the scikit-fem element of the same order up to a modest
-factor, GetFEM's P2 is scikit-fem's P2, and vemkit's own `exact:` measure (SPEC §7) agrees with the
+factor, GetFEM's P2 is scikit-fem's P2, and vemkit's own `exact:` measure (docs/reference/files.md) agrees with the
 benchmark's measure of the solution file. GetFEM cases are skipped with the reason when it is missing.
 """
 
@@ -99,7 +99,7 @@ def test_the_error_rule_integrates_degree_eight_exactly_on_squares():
 
 def test_the_benchmark_measure_is_vemkits_exact_measure(tmp_path):
     """The solution file's projection against u_exact after the process equals, relative to |u|_1,
-    the `exact:` errors vemkit reports itself (SPEC §7, a degree-5 rule): the H1 error of Pi u_h."""
+    the `exact:` errors vemkit reports itself (docs/reference/files.md, a degree-5 rule): the H1 error of Pi u_h."""
     problem = peers_order2.manufactured_problem()
     mesh_path = tmp_path / "mesh.nc"
     peers_order2.write_mesh("structured", 8, mesh_path)

@@ -1,4 +1,4 @@
-"""`vemkit solve` and `vemkit mesh`: the SPEC §6 contract, end to end through the console script."""
+"""`vemkit solve` and `vemkit mesh`: the docs/reference/files.md contract, end to end through the console script."""
 
 import subprocess
 import sys

@@ -1,4 +1,4 @@
-"""3D bodies through the real CLI (SPEC §10): a linear displacement reproduced on polyhedral meshes
+"""3D bodies through the real CLI (docs/reference/files.md): a linear displacement reproduced on polyhedral meshes
 (the patch test of the whole path: scene -> mesh -> problem -> solve -> mesh3d file -> VTU), the
 solution file's contract read back independently, and bad 3D input refused in one line."""
 

@@ -1,4 +1,4 @@
-"""`vemkit adapt` (SPEC §9) through the real command: the final solution file with the indicator and
+"""`vemkit adapt` (docs/reference/files.md) through the real command: the final solution file with the indicator and
 the history, a progress line per step, a note when the limits stop the loop, and bad input refused
 in one line with exit status 2 and nothing written."""
 

@@ -1,4 +1,4 @@
-"""3D contact through the real CLI (SPEC §10, issue 21 items 1-2): a box pressed on a foundation plane
+"""3D contact through the real CLI (docs/reference/files.md, issue 21 items 1-2): a box pressed on a foundation plane
 gives the solution file's contact node variables (the per-vertex basis, tangential quantities with a
 ``contact_tangent`` dimension of size 2), and bad 3D contact keys are refused in one line (exit 2,
 nothing written)."""

@@ -1,4 +1,4 @@
-"""Any body through the real CLI (SPEC §7): the shipped Cook's membrane scene against its reference."""
+"""Any body through the real CLI (docs/reference/files.md): the shipped Cook's membrane scene against its reference."""
 
 import subprocess
 import sys
@@ -78,7 +78,7 @@ def test_vemkit_mesh_wants_a_family_or_a_scene_not_both(tmp_path, args):
 
 
 def test_a_scene_solves_on_a_mesh_file_named_relative_to_it(tmp_path):
-    """SPEC §8: `vemkit mesh --scene` writes Cook's mesh, a scene in another folder names it by a
+    """docs/reference/files.md: `vemkit mesh --scene` writes Cook's mesh, a scene in another folder names it by a
     relative path and solves to the same displacement as meshing the scene itself."""
     folder = tmp_path / "study"
     folder.mkdir()

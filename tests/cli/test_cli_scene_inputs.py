@@ -1,4 +1,4 @@
-"""The scene inputs of SPEC §7-8 (any body, boundary conditions, mesh sizes, mesh files) through the real
+"""The scene inputs of docs/reference/files.md (any body, boundary conditions, mesh sizes, mesh files) through the real
 command, as an adversarial but realistic user types them (issue 9).
 
 Every bad input ends with exit status 2, one stderr line ``vemkit: error: ...`` naming it, every file
@@ -216,7 +216,7 @@ CASES = {
     ),
     "domain: unit_circle": (scene(domain="unit_circle"), [], "must be unit_square or a mapping"),
     "mesh file as a list": (scene(("discretization.mesh", {"file": ["m.msh"]})), [], "must be a string"),
-    # mesh files (SPEC §8)
+    # mesh files (docs/reference/files.md)
     "mesh file is a FIFO": (on_file("fifo.msh"), [], "is a FIFO (named pipe), not a regular file"),
     "mesh file is /dev/zero": (on_file("zero.msh"), [], "is a character device"),
     "mesh file is a directory": (on_file("folder.msh"), [], "is a directory"),

@@ -1,4 +1,4 @@
-"""Curved outer sides (``domain.arcs``, an extension of SPEC §7): the geometry of the arcs (exact area,
+"""Curved outer sides (``domain.arcs``, an extension of docs/reference/files.md): the geometry of the arcs (exact area,
 vertices on the circle, chords of about h, bounds), validation with one-line errors naming the
 entry, and the arcs through the scene loader and the real CLI."""
 

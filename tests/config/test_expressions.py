@@ -1,4 +1,4 @@
-"""The whitelist expression compiler of scene values (SPEC §6)."""
+"""The whitelist expression compiler of scene values (docs/reference/files.md)."""
 
 import builtins
 import math

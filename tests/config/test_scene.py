@@ -1,4 +1,4 @@
-"""Scene files (SPEC §6): the paper scene, defaults, overrides and one-line rejections."""
+"""Scene files (docs/reference/files.md): the paper scene, defaults, overrides and one-line rejections."""
 
 import copy
 import json
@@ -16,7 +16,7 @@ from vemkit.exceptions import InputError, SceneError
 
 PAPER = Path(__file__).resolve().parents[2] / "config" / "scenes" / "paper.yaml"
 
-# SPEC §6, "minimal form of the paper scene", verbatim.
+# docs/reference/files.md, "minimal form of the paper scene", verbatim.
 SPEC_PAPER_SCENE = {
     "name": "paper",
     "domain": "unit_square",
@@ -346,13 +346,13 @@ def test_first_problem_in_file_order_is_reported():
 
 
 def test_an_unknown_side_in_an_override_names_the_sides_of_the_domain():
-    """Side names belong to the domain (SPEC §7), so an override cannot know them: the scene check
+    """Side names belong to the domain (docs/reference/files.md), so an override cannot know them: the scene check
     refuses the unknown side and lists the valid ones."""
     message = rejection(overrides=["boundary.neumann.front={traction: [0, 0]}"])
     assert "'front'" in message and "left, right, bottom, top" in message
 
 
-# -- any domain (SPEC §7) -------------------------------------------------------------------------
+# -- any domain (docs/reference/files.md) -------------------------------------------------------------------------
 def _plate(**extra):
     data = yaml.safe_load(PAPER.read_text())
     data["domain"] = {

@@ -1,4 +1,4 @@
-"""The scene's adaptivity block (SPEC §9): defaults from the schema, overrides, one-line refusals."""
+"""The scene's adaptivity block (docs/reference/files.md): defaults from the schema, overrides, one-line refusals."""
 
 from pathlib import Path
 

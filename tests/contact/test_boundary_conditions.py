@@ -1,4 +1,4 @@
-"""SPEC §7 boundary conditions pinned by exact solutions: rollers, prescribed displacements,
+"""docs/reference/files.md boundary conditions pinned by exact solutions: rollers, prescribed displacements,
 normal pressure, the exact-error attributes, the foundation line, rigid motions refused."""
 
 import subprocess
@@ -79,7 +79,7 @@ def test_prescribed_linear_displacement_on_the_boundary_is_reproduced_inside(fam
 
 def test_exact_errors_of_a_nonpolynomial_field_fall_at_the_expected_rates():
     """u = (sin x sin y, x y^2 / 4) imposed on the whole boundary with its body force: relative
-    H1 error O(h), L2 O(h^2) (Pi_1 of u_h, SPEC §7)."""
+    H1 error O(h), L2 O(h^2) (Pi_1 of u_h, docs/reference/files.md)."""
     field = ["sin(x)*sin(y)", "x*y**2/4"]
     force = elasticity_solution(*field, E, NU)["body_force"]
     sides = ("bottom", "right", "top", "left")

@@ -1,4 +1,4 @@
-"""The contact boundary of a 3D body (SPEC §10, issue 21 item 1) and the partial-Dirichlet rule in 2D.
+"""The contact boundary of a 3D body (docs/reference/files.md, issue 21 item 1) and the partial-Dirichlet rule in 2D.
 
 The nodal weights are int_F Pi^F phi_i over the Gamma_C faces: they sum to the area, and on the
 bottom of a prism over a 2D mesh they are the 2D trapezoid weight times the trapezoid across the

@@ -246,7 +246,7 @@ def test_gauss_contact_quadrature_is_refused_at_order_2():
 
 
 def test_contact_on_a_slanted_side_at_order_2_has_the_edge_normals_at_the_midpoints():
-    """Any side (SPEC §7): vertices and midpoints of a slanted Gamma_C get the side's normal, and the
+    """Any side (docs/reference/files.md): vertices and midpoints of a slanted Gamma_C get the side's normal, and the
     ssn solution passes the independent check (uzawa stagnates on this deep indentation for k = 1
     and k = 2 alike: the lagged normal compliance oscillates)."""
     import yaml

@@ -1,4 +1,4 @@
-"""Contact on any side of any body (SPEC §7): a slanted side gets its own normal and tangent."""
+"""Contact on any side of any body (docs/reference/files.md): a slanted side gets its own normal and tangent."""
 
 from pathlib import Path
 

@@ -1,5 +1,5 @@
 """The extruded paper body with u3 = 0 on both end faces against the 2D plane-strain contact solve
-(SPEC §10, issue 21 item 5): equal u1, u2 at every vertex to 1e-10, both solvers, friction on.
+(docs/reference/files.md, issue 21 item 5): equal u1, u2 at every vertex to 1e-10, both solvers, friction on.
 
 The end faces' contact vertices have u3 prescribed (a symmetry roller meeting Gamma_C): they stay
 contact points with u1, u2 in the law (vemkit.contact.boundary). On prisms over triangles, squares

@@ -95,7 +95,7 @@ def _face_points(normal, point):
 def _read_back(kind, body):
     data = yaml.safe_load(_committed(kind, body))
     E, nu = data["material"]["E"], data["material"]["nu"]
-    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))  # the 3D isotropic C (SPEC §10)
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))  # the 3D isotropic C (docs/reference/files.md)
     u = sympy.Matrix([_sym(c) for c in data["exact"]["displacement"]])
     grad = u.jacobian(XYZ)
     eps = (grad + grad.T) / 2

@@ -52,7 +52,7 @@ def test_the_committed_scene_is_the_generated_one(kind):
 def test_the_exact_solution_solves_the_scene_and_meets_the_contact_law_on_gamma_c(kind):
     data = yaml.safe_load(_committed(kind))
     E, nu = data["material"]["E"], data["material"]["nu"]
-    lam, mu = E * nu / (1 - nu**2), E / (2 * (1 + nu))  # the paper's plane-stress C (SPEC §1)
+    lam, mu = E * nu / (1 - nu**2), E / (2 * (1 + nu))  # the paper's plane-stress C (docs/reference/mathematics.md)
     u = sympy.Matrix([_sym(c) for c in data["exact"]["displacement"]])
     grad = u.jacobian([X, Y])
     eps = (grad + grad.T) / 2

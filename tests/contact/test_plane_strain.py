@@ -1,4 +1,4 @@
-"""The scene's model (SPEC §10): plane strain beside the paper's plane stress, checked against closed forms
+"""The scene's model (docs/reference/files.md): plane strain beside the paper's plane stress, checked against closed forms
 nobody here wrote.
 
 Lamé's thick-walled cylinder (a quarter annulus a < r < b with rollers on its straight sides and an

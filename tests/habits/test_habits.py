@@ -29,7 +29,10 @@ def test_citation_file_has_the_keys_cff_requires():
     assert cff["version"] == vemkit.__version__
     date.fromisoformat(str(cff["date-released"]))
     paper = cff["preferred-citation"]
-    assert paper["type"] == "article" and paper["title"] and paper["year"] == 2021
+    assert paper["type"] == "article" and paper["year"] == 2022 and paper["volume"] == 107
+    assert paper["title"] == "Virtual element method for a frictional contact problem with normal compliance"
+    assert paper["journal"] == "Communications in Nonlinear Science and Numerical Simulation"
+    assert [a["family-names"] for a in paper["authors"]] == ["Wu", "Wang", "Han"] and str(paper["start"]) == "106125"
     assert paper["authors"] and all(_person_or_entity(a) for a in paper["authors"])
 
 

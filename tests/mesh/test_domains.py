@@ -1,4 +1,4 @@
-"""Domains (SPEC §7): validation of the domain mapping, every family on a body with holes (valid,
+"""Domains (docs/reference/files.md): validation of the domain mapping, every family on a body with holes (valid,
 sides named, area kept, VEM patch test), mesh size by n, h or cells."""
 
 import re

@@ -1,4 +1,4 @@
-"""Mesh files (SPEC §8): gmsh .msh versions 2 and 4 written here as text, read through meshio with
+"""Mesh files (docs/reference/files.md): gmsh .msh versions 2 and 4 written here as text, read through meshio with
 physical line groups as sides; broken files refused with one line; read_mesh dispatch."""
 
 import re

@@ -1,4 +1,4 @@
-"""3D domain specs (SPEC §10): parsed, refused with one-line SceneErrors naming the key, and meshed."""
+"""3D domain specs (docs/reference/files.md): parsed, refused with one-line SceneErrors naming the key, and meshed."""
 
 import numpy as np
 import pytest

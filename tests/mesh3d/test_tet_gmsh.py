@@ -1,4 +1,4 @@
-"""The tet family's Delaunay tetrahedra (gmsh) on boxes and extruded §7 domains: valid, filling the
+"""The tet family's Delaunay tetrahedra (gmsh) on boxes and extruded 2D domains: valid, filling the
 body, every boundary face named by its side, sized by n / h / cells, predicted before they are built,
 of measured quality, silent, and the 3D element on them equal to P1 finite elements.
 

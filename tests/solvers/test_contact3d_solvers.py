@@ -1,4 +1,4 @@
-"""Coulomb friction on a 3D body (SPEC §10, issue 21 items 3-4): uzawa (Steps 1-3 with the multiplier
+"""Coulomb friction on a 3D body (docs/reference/files.md, issue 21 items 3-4): uzawa (Steps 1-3 with the multiplier
 projected on the unit disk) and ssn (the semismooth Newton step of vemkit.solvers.ssn_disk) agree to
 1e-10 at tol 1e-12 with stick and slip vertices, the slip direction is not an axis (turning along Gamma_C: a box
 instead of the disk would fail), for the reduced law m_tau = 0 and for m_tau = 1, and the independent

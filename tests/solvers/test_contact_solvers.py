@@ -38,7 +38,7 @@ def _paper_tractions(scale):
 
 @functools.cache
 def scene(n, law=PAPER_LAW, gap=0.1, E=2000.0, traction_scale=1.0):
-    """The paper's scene (SPEC §2) on square(n), with optional changes of law, gap and E."""
+    """The paper's scene (docs/reference/mathematics.md) on square(n), with optional changes of law, gap and E."""
     return discrete_problem(
         square(n),
         E,

@@ -159,7 +159,7 @@ def test_a_circular_hole_is_refined_on_the_circle_and_every_mesh_is_valid():
 def test_the_reference_error_is_exact_on_meshes_finer_than_the_reference_in_places():
     """Two adapted meshes, each finer than the other somewhere: ‖Π(u_A − u_B)‖ is the same whichever
     is the reference (the common-refinement quadrature is exact on nested meshes), and on a uniform
-    mesh coarser than the reference it is projection_error (SPEC §5)."""
+    mesh coarser than the reference it is projection_error (docs/reference/mathematics.md)."""
     from vemkit.io.solution_file import solution_dataset
     from vemkit.mesh.families import build_mesh
     from vemkit.studies.adaptivity_errors import reference_errors

@@ -1,4 +1,4 @@
-"""The solve's errors against ``exact:`` (SPEC §7) are the exact integrals (issue 18, item 6).
+"""The solve's errors against ``exact:`` (docs/reference/files.md) are the exact integrals (issue 18, item 6).
 
 For a field that varies on the scale of a finite-difference step (waves of length 0.1 to 0.16)
 ``error_h1_semi``, ``error_h1`` and ``error_l2`` must equal ||Π u_h − u|| / ||u|| computed with the

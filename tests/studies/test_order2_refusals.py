@@ -1,4 +1,4 @@
-"""discretization.order = 2 where a study would mis-measure it (Pi_1 of vertex values, SPEC 5) is refused
+"""discretization.order = 2 where a study would mis-measure it (Pi_1 of vertex values, docs/reference/mathematics.md) is refused
 with a typed one-line error; the studies that measure k = 2 correctly (sweeps, robustness matrix: contact
 quantities on the k = 2 contact boundary) accept it and agree with k = 1."""
 

@@ -1,4 +1,4 @@
-"""The sweeps and the stability matrix on a 3D studies scene (SPEC §10, issue 21 item 5): areas and
+"""The sweeps and the stability matrix on a 3D studies scene (docs/reference/files.md, issue 21 item 5): areas and
 forces instead of lengths and forces per depth, the resultant tangential force as a vector's magnitude,
 tangential profiles in the per-vertex basis (dimension contact_tangent), the scene's own mesh family
 in the matrix, and config/sweeps3d.yaml planned by the workflow."""

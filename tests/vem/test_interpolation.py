@@ -1,4 +1,4 @@
-"""Generalized barycentric interpolation (Wachspress / mean value) and the paper's error measure (SPEC §5)."""
+"""Generalized barycentric interpolation (Wachspress / mean value) and the paper's error measure (docs/reference/mathematics.md)."""
 
 import numpy as np
 import pytest

@@ -32,7 +32,7 @@ def quadratic_stacked(A):
 
 
 def quadratic_stress(x, y, A=QUADRATIC):
-    """sigma (s11, s22, s12) of the quadratic field at (x, y) (SPEC §1)."""
+    """sigma (s11, s22, s12) of the quadratic field at (x, y) (docs/reference/mathematics.md)."""
     a, b = A
     u1x, u1y = a[1] + 2 * a[3] * x + a[4] * y, a[2] + a[4] * x + 2 * a[5] * y
     u2x, u2y = b[1] + 2 * b[3] * x + b[4] * y, b[2] + b[4] * x + 2 * b[5] * y

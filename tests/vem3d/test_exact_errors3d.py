@@ -1,4 +1,4 @@
-"""SPEC §7's exact errors on 3D meshes (``vemkit.vem.norms`` with ``exact: {displacement: [u1, u2,
+"""docs/reference/files.md's exact errors on 3D meshes (``vemkit.vem.norms`` with ``exact: {displacement: [u1, u2,
 u3]}``): the norms of a known field integrate exactly, a linear field is reproduced (patch test) and
 the scene's solution file reports error_h1 / error_l2 on every 3D family."""
 

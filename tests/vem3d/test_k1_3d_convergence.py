@@ -89,7 +89,7 @@ def test_amg_with_the_six_rigid_motions_solves_the_3d_system():
     assert np.abs(u_amg - u_direct).max() < 1e-8 * np.abs(u_direct).max()
 
 
-FAMILY_MESHES = {  # every 3D family of SPEC §10 on the unit cube, as a scene would build it
+FAMILY_MESHES = {  # every 3D family of docs/reference/files.md on the unit cube, as a scene would build it
     "tet": lambda n: build_mesh3d("tet", CUBE, n=n),
     "octree": lambda n: build_mesh3d("octree", CUBE, n=n, rule="random", fraction=0.3, seed=1),
     "voronoi": lambda n: build_mesh3d("voronoi", CUBE, n=n, seed=2),

@@ -1,11 +1,11 @@
-"""The 3D element against the 2D models on extruded bodies (SPEC §10, issue 20 item 7).
+"""The 3D element against the 2D models on extruded bodies (docs/reference/files.md, issue 20 item 7).
 
 The paper's body without contact (config/scenes/3d/extruded_paper.yaml: unit square, clamped on the
 right, the traction (200 (5 - y), -200) on the left, the contact side `bottom` traction-free,
 E = 2000, nu = 0.4), extruded along z; the 2D scene of its base (``three_d.base_scene``) is solved
 on the same base mesh (the 3D mesh is the prisms over the 2D family mesh of the same keys).
 
-Plane strain (rollers u3 = 0 on both end faces): SPEC §10 says the 3D u1, u2 equal the 2D
+Plane strain (rollers u3 = 0 on both end faces): docs/reference/files.md says the 3D u1, u2 equal the 2D
 `plane_strain` solve. They do to round-off on prisms over triangles, squares and Voronoi polygons,
 one layer or several (measured <= 3.4e-14): for a z-independent field with u3 = 0 the consistency
 term of a prism of height t is t times the 2D one, and its dofi-dofi stabilization too, because the

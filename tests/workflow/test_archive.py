@@ -1,7 +1,7 @@
 """The archived Table 1 (results/archive/table1.nc) against a fresh computation of its coarse rows.
 
 For every archived stabilization: solve the 2^-8 square reference and the h = 2^-2, 2^-3 square
-meshes from the archived scene, measure the errors as the workflow does (SPEC §5: the paper's
+meshes from the archived scene, measure the errors as the workflow does (docs/reference/mathematics.md: the paper's
 measure and Pi_1 on each mesh) and compare them with the archive. The archived paper's measure
 with the default stabilization is checked against the paper's printed Table 1, and the archived
 convergence study (results/archive/convergence.nc) for the paper's measure on every family. The

@@ -1,6 +1,6 @@
 """Layer 1, input: scene files and the expressions inside them.
 
-Owns the body (``domain``: :class:`Domain`, an outer polygon and holes with named sides, SPEC §7),
+Owns the body (``domain``: :class:`Domain`, an outer polygon and holes with named sides, docs/reference/files.md),
 the scene schema (``schemas/scene.schema.json``: keys, types, bounds, defaults), loading and
 validating a scene (:func:`load_scene`, one-line :class:`~vemkit.exceptions.SceneError`), and the
 whitelisted expression compiler (never ``eval``). Imports from vemkit: ``vemkit.exceptions`` only.

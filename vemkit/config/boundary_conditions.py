@@ -1,4 +1,4 @@
-"""Boundary data and mesh size of a scene (SPEC §7), checked and compiled: Dirichlet sides with their
+"""Boundary data and mesh size of a scene (docs/reference/files.md), checked and compiled: Dirichlet sides with their
 components, Neumann tractions and pressures, the contact gap or foundation line, the exact solution.
 
 Each expression is compiled once (:mod:`vemkit.config.expressions`, never ``eval``) and
@@ -74,7 +74,7 @@ def inside_points(domain: Domain):
 
 def compile_checked(key: str, value, dimension: int = 2) -> Expression:
     """The expression of scene key ``key``; a 2D scene's expressions take x and y only, a 3D scene's
-    x, y and z (SPEC §10)."""
+    x, y and z (docs/reference/files.md)."""
     try:
         expression = compile_expression(value, name=key)
     except ExpressionError as error:
@@ -120,7 +120,7 @@ class PlaneProbes:
 
 
 def _components(key: str, value, dimension: int) -> list:
-    """The list of a vector entry, which has one component per dimension (SPEC §10)."""
+    """The list of a vector entry, which has one component per dimension (docs/reference/files.md)."""
     if len(value) != dimension:
         names = ", ".join(
             f"u{i + 1}" if "dirichlet" in key or "exact" in key else f"f_{'xyz'[i]}" for i in range(dimension)

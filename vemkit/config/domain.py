@@ -1,13 +1,13 @@
-"""The body a mesh covers (SPEC §7): an outer polygon and holes, every edge with a side name.
+"""The body a mesh covers (docs/reference/files.md): an outer polygon and holes, every edge with a side name.
 
 A :class:`Domain` is plain data: the outer polygon (counter-clockwise), one side name per outer
 edge (edge i runs from corner i to corner i + 1), and holes, each a polygon with one side name per
 edge or a circle ``(cx, cy, r)`` with one side name. An outer edge may be an arc (``arcs``, an
-extension of SPEC §7): ``arcs[i] = (cx, cy)`` makes edge i the shorter arc (less than a half circle)
+extension of docs/reference/files.md): ``arcs[i] = (cx, cy)`` makes edge i the shorter arc (less than a half circle)
 of the circle through its two corners centred at (cx, cy); ``None`` keeps it straight. The arc
 bulges away from its centre: outwards when the centre lies on the body's side of the chord.
 ``domain_from_spec`` builds it from the scene
-mapping of SPEC §7 (or ``"unit_square"``) and refuses a broken domain with a one-line
+mapping of docs/reference/files.md (or ``"unit_square"``) and refuses a broken domain with a one-line
 ``InputError`` whose ``key`` names the entry (``domain.polygon``, ``domain.holes[1]`` ...).
 
 Meshing needs polygons only: ``Domain.discretize(h)`` replaces every circle by the polygon whose
@@ -31,7 +31,7 @@ import shapely
 
 from vemkit.exceptions import InputError
 
-#: the sides of the unit square (SPEC §6): name -> (axis, value) of the line x_axis = value it lies on
+#: the sides of the unit square (docs/reference/files.md): name -> (axis, value) of the line x_axis = value it lies on
 UNIT_SQUARE_SIDE_LINES = {"left": (0, 0.0), "right": (0, 1.0), "bottom": (1, 0.0), "top": (1, 1.0)}
 UNIT_SQUARE_SIDES = tuple(UNIT_SQUARE_SIDE_LINES)
 UNIT_SQUARE_CORNERS = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
@@ -223,7 +223,7 @@ class Domain:
         return float(area)
 
     def to_spec(self):
-        """The SPEC §7 mapping of this domain (``"unit_square"`` for the default): JSON-ready."""
+        """The docs/reference/files.md mapping of this domain (``"unit_square"`` for the default): JSON-ready."""
         if self.is_unit_square:
             return "unit_square"
         holes = [
@@ -244,7 +244,7 @@ UNIT_SQUARE = Domain()
 
 
 def cells_per_length(domain: Domain, n=None, h=None, cells=None, cells_per_square: float = 1.0):
-    """The mesh density n (cells per unit length, SPEC §7) from exactly one of n, h (n = 1/h) and
+    """The mesh density n (cells per unit length, docs/reference/files.md) from exactly one of n, h (n = 1/h) and
     cells (about that many cells; a family with ``cells_per_square`` cells per n x n square, such
     as triangles with 2, gets n = √(cells / (cells_per_square · area))). Whole numbers come back as int."""
     return mesh_density(n, h, cells, lambda count: math.sqrt(count / (cells_per_square * domain.exact_area)))
@@ -271,7 +271,7 @@ def mesh_density(n, h, cells, from_cells, error=InputError, where: str | None = 
 
 
 def domain_from_spec(spec=None) -> Domain:
-    """The Domain of a SPEC §7 ``domain:`` entry (``None`` or ``"unit_square"``: the unit square)."""
+    """The Domain of a docs/reference/files.md ``domain:`` entry (``None`` or ``"unit_square"``: the unit square)."""
     if spec is None or isinstance(spec, Domain):
         return UNIT_SQUARE if spec is None else spec
     if isinstance(spec, str):

@@ -1,4 +1,4 @@
-"""3D bodies (SPEC §10): a box, or a §7 domain extruded along z; parsed, validated and meshed.
+"""3D bodies (docs/reference/files.md): a box, or a 2D domain extruded along z; parsed, validated and meshed.
 
 ```yaml
 domain: {box: [[0, 0, 0], [1, 1, 0.5]], sides: [left, right, front, back, bottom, top]}
@@ -15,7 +15,7 @@ domain, n=/h=/cells=)`` meshes it: on a box the 3D families ``hex``, ``tet``, ``
 on an extruded domain the prisms over the 2D family's mesh of the base (exactly ``build_mesh(family, ...)`` of the same
 keys) in ``layers`` layers (default ``max(1, round(depth n))``, about depth / h), or ``tet``: a 3D
 family, not a 2D one, so on an extruded domain it means gmsh's Delaunay tetrahedra of the extruded
-body (lateral faces named by the §7 sides, end faces by ``ends``), not prisms.
+body (lateral faces named by the 2D sides, end faces by ``ends``), not prisms.
 ``tet`` has ``kind: delaunay`` (the default, gmsh; boxes and extruded domains) or ``kind: structured``
 (the Kuhn tetrahedra of the hex grid, boxes only).
 Sizes: ``n`` cells per unit length (about n³ cells per unit volume; tet: about 6 n³), ``h = 1 / n`` or ``cells``.
@@ -57,7 +57,7 @@ class Box:
 
 @dataclass(frozen=True)
 class Extruded:
-    """A SPEC §7 domain extruded along z to ``depth``, its end faces named ``ends`` (z = 0, z = depth)."""
+    """A docs/reference/files.md domain extruded along z to ``depth``, its end faces named ``ends`` (z = 0, z = depth)."""
 
     base: Domain
     depth: float
@@ -75,7 +75,7 @@ def is_3d_domain(spec) -> bool:
 
 
 def domain3d_from_spec(spec):
-    """The Box or Extruded of a SPEC §10 ``domain:`` mapping; SceneError naming the key otherwise."""
+    """The Box or Extruded of a docs/reference/files.md ``domain:`` mapping; SceneError naming the key otherwise."""
     if isinstance(spec, (Box, Extruded)):
         return spec
     if not is_3d_domain(spec):

@@ -1,4 +1,4 @@
-"""The whitelisted expression language of scene values (SPEC §6, §10), parsed into a small tree.
+"""The whitelisted expression language of scene values (docs/reference/files.md), parsed into a small tree.
 
 User text is parsed by :func:`ast.parse` in ``mode="eval"`` and translated node by node, from a
 whitelist only, into :class:`Node` trees; nothing the user writes is ever passed to ``eval``/``exec``.

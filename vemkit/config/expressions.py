@@ -1,6 +1,6 @@
 """Safe, vectorised scalar expressions for scene values such as ``"200*(5-y)"``.
 
-Language (SPEC §6, §10; README "Input rules and limits"): numbers (ints, floats, scientific notation),
+Language (docs/reference/files.md; README "Input rules and limits"): numbers (ints, floats, scientific notation),
 the variables ``x``, ``y`` and ``z`` (a 2D scene refuses z: ``vemkit.config.boundary_conditions``),
 the constant ``pi``, the operators ``+ - * / **``, unary ``-`` and ``+``, parentheses, the functions
 ``sin cos tan asin acos atan sinh cosh tanh exp log sqrt abs sign`` (one argument), ``atan2(p, q)``

@@ -123,7 +123,7 @@ def estimate_resources3d(cells: int, vertices: int, faces: int) -> Resources:
 
 
 def domain_area(domain) -> float:
-    """Area of a scene's ``domain`` (SPEC §7): 1 for the unit square, else the shoelace area of
+    """Area of a scene's ``domain`` (docs/reference/files.md): 1 for the unit square, else the shoelace area of
     its outer polygon (holes ignored: an upper bound)."""
     if not isinstance(domain, dict) or "polygon" not in domain:
         return 1.0

@@ -1,4 +1,4 @@
-"""The material law of a scene's model (SPEC §1, §10): the Lamé parameters of C, the one home of the formulas.
+"""The material law of a scene's model (docs/reference/mathematics.md and docs/reference/files.md): the Lamé parameters of C, the one home of the formulas.
 
 - ``plane_stress`` (the default, the paper's C): lambda* = E nu / (1 - nu^2), mu = E / (2 (1 + nu));
 - ``plane_strain`` (a long prism with u3 = 0): lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)),

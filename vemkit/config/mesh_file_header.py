@@ -1,4 +1,4 @@
-"""What a mesh file (SPEC §8) declares, read before the file is parsed: the input checks of issue 9.
+"""What a mesh file (docs/reference/files.md) declares, read before the file is parsed: the input checks of issue 9.
 
 A scene's ``discretization.mesh.file`` is user input like the scene itself, so it is looked at
 before any mesh is built: :func:`mesh_file_header` opens only a regular file (a FIFO, a device or a
@@ -83,7 +83,7 @@ CELLS_PER_VERTEX = {2: 2, 3: 10}
 
 def mesh_file_header(path, dimension: int = 2) -> MeshFileHeader:
     """The counts and sides the mesh file ``path`` declares (see the module doc); MeshError if
-    the file cannot be a mesh vemkit reads. ``dimension`` 3: a 3D mesh (SPEC §10; gmsh physical
+    the file cannot be a mesh vemkit reads. ``dimension`` 3: a 3D mesh (docs/reference/files.md; gmsh physical
     surfaces as sides, a ``mesh3d`` netCDF file)."""
     path = Path(path)
     if path.suffix not in MESH_SUFFIXES:
@@ -244,7 +244,7 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
     if str(getattr(topology, "topology_dimension", "2")) == "3":
-        raise _fail(path, "is a 3D mesh (mesh3d, SPEC §10) but the scene is 2D; set model: 3d")
+        raise _fail(path, "is a 3D mesh (mesh3d) but the scene is 2D; set model: 3d")
     if len(coordinates) != 2:
         raise _fail(path, "cannot be read as UGRID netCDF: node_coordinates must name two variables (x y)")
     x, y = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
@@ -264,7 +264,7 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
 
 
 def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
-    """The counts and sides of a ``mesh3d`` file (SPEC §10) from its dimensions and attributes."""
+    """The counts and sides of a ``mesh3d`` file (docs/reference/files.md) from its dimensions and attributes."""
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
     if len(topologies) != 1 or str(getattr(topologies[0], "topology_dimension", "")) != "3":
         raise _fail(

@@ -1,4 +1,4 @@
-"""Whether a mesh size suits the body (SPEC §7, issue 9): checked before any mesh is built.
+"""Whether a mesh size suits the body (docs/reference/files.md, issue 9): checked before any mesh is built.
 
 The mesh families work in double precision with tolerances relative to the cell size h (points
 closer than 1e-9 h are one vertex); a size far from the body's own scales breaks them, with an
@@ -59,7 +59,7 @@ def cell_size(mesh: dict, domain: Domain) -> float:
 
 
 def scene_cells_per_length(scene) -> float:
-    """n = 1/h of a scene with a mesh family (SPEC §7)."""
+    """n = 1/h of a scene with a mesh family (docs/reference/files.md)."""
     return 1.0 / cell_size(scene.mesh_options, domain_from_spec(scene.domain))
 
 

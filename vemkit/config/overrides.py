@@ -1,7 +1,7 @@
 """``--set key.path=value`` overrides of a scene, checked key by key against the scene schema.
 
 Every key must exist in the schema (a close match is suggested), every index in the list it
-indexes; a new mesh size replaces the scene's own (one size, SPEC §7). Imports from vemkit:
+indexes; a new mesh size replaces the scene's own (one size, docs/reference/files.md). Imports from vemkit:
 :mod:`vemkit.config.scene_schema`, :mod:`vemkit.config.safe_yaml`, ``vemkit.exceptions``.
 """
 
@@ -14,7 +14,7 @@ from vemkit.config.safe_yaml import parse_yaml
 from vemkit.config.scene_schema import key_name, resolve, schema_root, show, suggest
 from vemkit.exceptions import SceneError
 
-#: an override of discretization.mesh.KEY removes these keys: one size (SPEC §7), or a file
+#: an override of discretization.mesh.KEY removes these keys: one size (docs/reference/files.md), or a file
 _MESH_SIZE_KEYS = {
     "n": ("h", "cells", "file"),
     "h": ("n", "cells", "file"),

@@ -1,4 +1,4 @@
-"""Which rigid motion a Dirichlet set leaves free (SPEC §7, §10), in linear time and memory.
+"""Which rigid motion a Dirichlet set leaves free (docs/reference/files.md), in linear time and memory.
 
 A rigid motion is u(x) = a + ω × x: in 2D u = (a1 − θ y, a2 + θ x) (three modes), in 3D six. A
 prescribed component i at a point x holds the functional r = e_i·a + (ω × x)_i. The motion is held

@@ -1,4 +1,4 @@
-"""Scene files (SPEC §6): read the YAML, apply ``--set`` overrides, validate, fill the defaults.
+"""Scene files (docs/reference/files.md): read the YAML, apply ``--set`` overrides, validate, fill the defaults.
 
 One source of truth: ``vemkit/config/schemas/scene.schema.json`` holds the keys, the bounds and the
 ``default`` values (:mod:`vemkit.config.scene_schema` walks it, :mod:`vemkit.config.overrides` applies
@@ -135,7 +135,7 @@ class Scene:
 
     name = _field("name")
     domain = _field("domain")
-    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d (SPEC §10)")
+    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d")
     E = _field("material", "E", doc="Young's modulus")
     nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
     dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
@@ -167,7 +167,7 @@ class Scene:
     adaptivity_options = _field(
         "adaptivity",
         convert=copy.deepcopy,
-        doc="adaptivity (SPEC §9), defaults filled; max_hanging/reference may be None (a copy)",
+        doc="adaptivity (docs/reference/files.md), defaults filled; max_hanging/reference may be None (a copy)",
     )
     body_force = property(
         lambda self: self._expressions["body_force"], doc="(Expression, Expression) (3D: three): the volume force f1"
@@ -179,7 +179,7 @@ class Scene:
 
     @property
     def dimension(self) -> int:
-        """3 for a ``model: 3d`` scene (SPEC §10), 2 otherwise."""
+        """3 for a ``model: 3d`` scene (docs/reference/files.md), 2 otherwise."""
         return 3 if self.model == "3d" else 2
 
     @property
@@ -192,7 +192,7 @@ class Scene:
 
     def lame(self) -> tuple[float, float]:
         """``(lambda, mu)`` of C for the scene's model (``vemkit.config.material``; plane stress: the
-        paper's Eν/(1−ν²), E/(2(1+ν)), SPEC §1)."""
+        paper's Eν/(1−ν²), E/(2(1+ν)), docs/reference/mathematics.md)."""
         return lame_parameters(self.E, self.nu, self.model)
 
     def traction(self, side: str) -> tuple[Expression, Expression]:
@@ -212,12 +212,12 @@ class Scene:
     @property
     def dirichlet(self) -> dict:
         """side -> (u1, u2) (3D: (u1, u2, u3)) prescribed on Gamma_D: Expressions, None for a free
-        component (SPEC §7, §10)."""
+        component (docs/reference/files.md)."""
         return {side: self._expressions[f"boundary.dirichlet.{side}"] for side in self.dirichlet_sides}
 
     @property
     def exact_displacement(self) -> tuple[Expression, Expression] | None:
-        """The scene's exact displacement (SPEC §7 ``exact:``), None if it gives none."""
+        """The scene's exact displacement (docs/reference/files.md ``exact:``), None if it gives none."""
         return self._expressions.get("exact.displacement")
 
     @property
@@ -229,7 +229,7 @@ class Scene:
 
     @property
     def mesh_file(self) -> Path | None:
-        """discretization.mesh.file resolved against the scene file's folder (SPEC §8), or None."""
+        """discretization.mesh.file resolved against the scene file's folder (docs/reference/files.md), or None."""
         name = self._data["discretization"]["mesh"].get("file")
         if name is None:
             return None

@@ -1,11 +1,11 @@
-"""The checks of a 3D scene (SPEC §10, ``model: 3d``) beyond the schema, and where its expressions are probed.
+"""The checks of a 3D scene (docs/reference/files.md, ``model: 3d``) beyond the schema, and where its expressions are probed.
 
 A 3D scene is a box, an ``extrude`` domain or a 3D mesh file with ``model: 3d``; its vectors have
 three components and its expressions take x, y and z. Before any mesh is built every expression is
 test-evaluated on its side (:class:`BodyProbes`: a grid on each face of a box; on an extruded body the
 2D probes of a lateral side at several heights, the base's boundary on the end faces), the Dirichlet
-sides are tested for a free rigid motion (SPEC §10 names it), and what 3D does not have yet is refused
-in one line: order 2 and the k = 2 load options. Contact (SPEC §10): a foundation
+sides are tested for a free rigid motion (docs/reference/files.md names it), and what 3D does not have yet is refused
+in one line: order 2 and the k = 2 load options. Contact (docs/reference/files.md): a foundation
 plane (a point and a non-zero normal of three components, every contact side on its body side) or a
 gap expression of x, y, z that is >= 0 on the contact sides (:func:`check_contact_3d`).
 """

@@ -1,7 +1,7 @@
 """The discrete contact boundary: Gamma_C contact points with their quadrature weights, normals and gaps.
 
 One contact boundary for every element, built from the space's trace on Gamma_C
-(``vemkit.contact.trace_nodes``): ``nodal`` quadrature (SPEC §3) puts the contact points at the
+(``vemkit.contact.trace_nodes``): ``nodal`` quadrature (docs/reference/mathematics.md) puts the contact points at the
 trace nodes with the element's nodal rule -- the trapezoid at the Gamma_C vertices for k = 1 (half
 the length of each adjacent contact edge as weight), Simpson's rule at the vertices and edge
 midpoints for k = 2. The outward normal of a vertex is the length-weighted mean of the outward

@@ -1,7 +1,7 @@
-"""The contact boundary of a 3D body (SPEC §10): Gamma_C any set of boundary faces, the nodal or the gauss rule.
+"""The contact boundary of a 3D body (docs/reference/files.md): Gamma_C any set of boundary faces, the nodal or the gauss rule.
 
 Contact points: the vertices of the Gamma_C faces (k = 1). Weight of vertex i (the nodal rule,
-SPEC §3, on polygonal faces):
+docs/reference/mathematics.md, on polygonal faces):
 
     w_i = sum_{F in Gamma_C, i in F} int_F Pi^F phi_i ds = sum_F |F| (1/m_F + grad_i^F . (c_F - xbar_F)),
 

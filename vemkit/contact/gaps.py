@@ -9,7 +9,7 @@ from vemkit.exceptions import SceneError
 
 
 class FoundationLine:
-    """The foundation as a line (SPEC §7 ``contact.foundation``), or a plane in 3D (SPEC §10, a point and
+    """The foundation as a line (docs/reference/files.md ``contact.foundation``), or a plane in 3D (docs/reference/files.md, a point and
     a normal of three components): the gap of a boundary point x with
     outward normal nu is the distance from x along nu to the line, d / cos with d = (x - point) . n
     (n the unit normal of the line towards the body) and cos = -nu . n; a surface turned away from

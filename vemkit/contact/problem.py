@@ -178,7 +178,7 @@ def discrete_problem(
 
 
 def scene_gap(scene):
-    """The gap of the scene: its foundation line or plane (SPEC §7, §10) or its gap expression of the
+    """The gap of the scene: its foundation line or plane (docs/reference/files.md) or its gap expression of the
     coordinates (zero if none), as ``ContactBoundary.with_gap`` takes it."""
     if scene.foundation is not None:
         return FoundationLine(*scene.foundation)
@@ -220,4 +220,5 @@ def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
     problem = discrete_problem(mesh, scene.E, scene.nu, **scene_problem_data(scene))
     problem.info["assembly_time"] = time.perf_counter() - t0
     problem.info["order"] = scene.order
+    problem.info["scene"] = scene  # the solution Dataset records it as the file of vemkit solve does
     return problem

@@ -3,7 +3,7 @@
 Quadrature (``Element.contact_rule``): the contact terms of (3.16) are integrated by a rule whose
 points are the nodes of the trace on each Gamma_C edge e = (a, b):
 
-- k = 1, the trapezoid (SPEC §3): |e|/2 at each end (a Gamma_C vertex gets half of each adjacent edge);
+- k = 1, the trapezoid (docs/reference/mathematics.md): |e|/2 at each end (a Gamma_C vertex gets half of each adjacent edge);
 - k = 2, Simpson's rule (three-point Gauss-Lobatto): |e|/6 at each end, 4|e|/6 at the midpoint x_m.
 
 Both are the rule whose points are the nodes of the trace, so the terms stay a sum of independent

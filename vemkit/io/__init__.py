@@ -1,4 +1,4 @@
-"""Layer 6, result files: solution files (SPEC §6), tables with fill values, provenance.
+"""Layer 6, result files: solution files (docs/reference/files.md), tables with fill values, provenance.
 
 Owns the solution Dataset and its netCDF file (``solution_file``: UGRID mesh, fields, contact
 boundary, history, attributes; atomic writes), table files whose undefined entries are fill values

@@ -1,4 +1,4 @@
-"""A solved problem as a self-describing netCDF file or xarray Dataset, written safely (SPEC §6).
+"""A solved problem as a self-describing netCDF file or xarray Dataset, written safely (docs/reference/files.md).
 
 :func:`solution_description` spells out the file once (a
 :class:`~vemkit.mesh.file_description.FileDescription`); :func:`solution_dataset` is its xarray
@@ -113,7 +113,7 @@ def solution_description(problem, solution, *, scene_yaml: str = "", extra_attrs
 
 
 def with_solver_record(ds: FileDescription, problem, solution, scene_yaml: str, extra_attrs=None) -> FileDescription:
-    """``ds`` with the solver history (``iteration``) and the global attributes of SPEC §6 (2D and 3D)."""
+    """``ds`` with the solver history (``iteration``) and the global attributes of docs/reference/files.md (2D and 3D)."""
     for key, values in solution.history.items():
         ds.add(f"history_{key}", "iteration", np.asarray(values, dtype=float), {"long_name": f"solver history: {key}"})
     ds.attrs.update(
@@ -216,7 +216,7 @@ def write_netcdf(ds: xr.Dataset | FileDescription, path) -> Path:
 def read_solution(path):
     """(Mesh, Dataset) of a solution file written by ``vemkit solve`` or the workflow: a
     :class:`~vemkit.mesh.mesh.Mesh` (``mesh2d``) or a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
-    (``mesh3d``, SPEC §10)."""
+    (``mesh3d``, docs/reference/files.md)."""
     import xarray as xr
 
     with xr.open_dataset(path) as ds:

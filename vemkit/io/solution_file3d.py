@@ -1,4 +1,4 @@
-"""The solution file of a 3D body (SPEC §10): the ``mesh3d`` topology and the fields of one solve.
+"""The solution file of a 3D body (docs/reference/files.md): the ``mesh3d`` topology and the fields of one solve.
 
 On top of :func:`vemkit.mesh.files3d.mesh3d_description` (nodes, polygonal faces, the signed faces
 of each volume, the named boundary parts): node variables ``u1``, ``u2``, ``u3``
@@ -7,7 +7,7 @@ of each volume, the named boundary parts): node variables ``u1``, ``u2``, ``u3``
 ``von_mises`` (``mesh3d_nVolumes``); the solver history and the global attributes of a 2D file
 (:func:`vemkit.io.solution_file.with_solver_record`).
 
-With contact (dimension ``contact_node``, sorted by x, y, z), the §6 contact node variables:
+With contact (dimension ``contact_node``, sorted by x, y, z), the 2D contact node variables:
 coordinates ``contact_x``, ``contact_y``, ``contact_z``, ``contact_vertex`` (mesh3d node index),
 ``contact_weight`` (the nodal weight int Pi^F phi_i over the Gamma_C faces), ``normal_pressure``,
 ``penetration``, ``friction_bound``, ``contact_state``, the outward normal ``contact_normal_x..z``

@@ -1,4 +1,4 @@
-"""Validation of a polyhedral mesh (SPEC §10): every way it can be broken, with a one-line message.
+"""Validation of a polyhedral mesh (docs/reference/files.md): every way it can be broken, with a one-line message.
 
 ``validate_mesh3d(mesh)`` returns ``None`` for a valid mesh and raises ``MeshError`` naming the
 offending cell, face or vertex and the defect, for the first problem found. In order:

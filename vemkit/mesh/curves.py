@@ -1,4 +1,4 @@
-"""The pieces of a body's boundary, and new boundary points moved onto their own piece (SPEC §7, §9).
+"""The pieces of a body's boundary, and new boundary points moved onto their own piece (docs/reference/files.md).
 
 A piece is one curved or straight part of the boundary: a circular hole (the whole circle), an arc of
 the outer boundary (``domain.arcs``), a straight outer edge or an edge of a polygonal hole. Refinement

@@ -2,7 +2,7 @@
 
 A :class:`FileDescription` holds, in file order, each variable's dimensions, data and attributes
 (and an xarray ``encoding``, only ``_FillValue``), which variables are coordinates, and the global
-attributes. It is where the mesh and solution files' contents (SPEC §6, §7, §10) are spelled out;
+attributes. It is where the mesh and solution files' contents (docs/reference/files.md) are spelled out;
 the two sinks only translate it:
 
 - :meth:`FileDescription.to_dataset`: the ``xarray.Dataset`` of the Python API and the studies;

@@ -2,7 +2,7 @@
 
 ``read_mesh(path)`` reads ``.nc`` (UGRID) or ``.msh`` (gmsh, versions 2 and 4 through meshio) and
 validates the mesh like a family's: a broken mesh is refused with a one-line ``MeshError`` naming
-the file and the cell or vertex (SPEC §8). Before parsing, the file must be a regular file whose
+the file and the cell or vertex (docs/reference/files.md). Before parsing, the file must be a regular file whose
 declared counts fit its size, a plane mesh and the machine (``vemkit.config.mesh_file_header``);
 the parser runs within a memory budget (``vemkit.config.limits.memory_budget``).
 

@@ -1,4 +1,4 @@
-"""3D mesh files (SPEC §10): the ``mesh3d`` UGRID-style netCDF topology (round trip), VTU with VTK
+"""3D mesh files (docs/reference/files.md): the ``mesh3d`` UGRID-style netCDF topology (round trip), VTU with VTK
 polyhedron cells (type 42, for ParaView) and gmsh ``.msh`` 3D meshes (read, through meshio).
 
 netCDF layout (``mesh3d_description`` / ``read_ugrid3d``):

@@ -4,7 +4,7 @@ A mesh is
 - ``vertices``: ``(N, 2)`` float64 coordinates;
 - ``cell_offsets`` ``(M + 1,)`` and ``cell_vertices`` ``(offsets[-1],)`` int64: polygon ``K`` has the
   vertices ``cell_vertices[cell_offsets[K]:cell_offsets[K + 1]]`` in counter-clockwise order
-  (CSR form). Every vertex of a polygon is listed, hanging nodes included (SPEC §3);
+  (CSR form). Every vertex of a polygon is listed, hanging nodes included (docs/reference/mathematics.md);
 - ``boundary``: named boundary parts, each a ``(k, 2)`` int64 array of boundary edges given as
   vertex pairs ``(a, b)`` in the counter-clockwise order in which they appear in their cell;
 - ``meta``: how the mesh was made (family, n, seed, ...), stored with every result.

@@ -1,4 +1,4 @@
-"""The polyhedral mesh (SPEC §10): plain arrays, as the polygonal :class:`~vemkit.mesh.mesh.Mesh`.
+"""The polyhedral mesh (docs/reference/files.md): plain arrays, as the polygonal :class:`~vemkit.mesh.mesh.Mesh`.
 
 A 3D mesh is
 - ``vertices``: ``(N, 3)`` float64 coordinates;

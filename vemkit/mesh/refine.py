@@ -1,4 +1,4 @@
-"""Local refinement of polygonal meshes; neighbours gain hanging nodes as plain vertices (SPEC §9).
+"""Local refinement of polygonal meshes; neighbours gain hanging nodes as plain vertices (docs/reference/files.md).
 
 A marked cell with geometric corners c_0 … c_{m−1} (the vertices where its boundary turns; a
 hanging node on a straight edge is a vertex but not a corner) is split into m polygons
@@ -15,7 +15,7 @@ polygon). A cell whose new vertices on a circle leave it no kernel gets them on 
 a cell without a kernel at all (not star-shaped) is left whole (reported in ``RefinedMesh.skipped``).
 
 A new edge midpoint is inserted as a vertex into the one or two cells sharing that edge, so the mesh
-stays vertex-conforming: the neighbour is not refined, it simply gains a vertex (SPEC §3).
+stays vertex-conforming: the neighbour is not refined, it simply gains a vertex (docs/reference/mathematics.md).
 ``max_hanging = k`` also refines every cell that would otherwise carry more than k vertices inside
 one of its geometric edges (repeated until none does). A new vertex of a boundary edge of a curved
 piece (a circular hole or an arc: ``circles``, ``vemkit.mesh.curves``) is placed on that piece's own
@@ -72,7 +72,7 @@ class _Splits(NamedTuple):
 
 
 def _plan(mesh: Mesh, cells: np.ndarray, corner: np.ndarray, circles: list) -> _Splits:
-    """Midpoints of the geometric edges of ``cells``, merged per old edge (SPEC §9)."""
+    """Midpoints of the geometric edges of ``cells``, merged per old edge (docs/reference/files.md)."""
     a, b, t = midpoint_requests(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, corner, cells)
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     t = np.where(a < b, t, 1.0 - t)

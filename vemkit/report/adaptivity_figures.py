@@ -1,4 +1,4 @@
-"""Figures of the adaptive runs (SPEC §9), matplotlib's object API.
+"""Figures of the adaptive runs (docs/reference/files.md), matplotlib's object API.
 
 - :func:`adaptive_convergence_figure`: true error and estimate against DOFs, adaptive and uniform
   refinement on one log-log plot, with the fitted rates (``vemkit.studies.adaptivity_compare``) and

@@ -12,7 +12,7 @@
   the paper's Table 1 and a slope-1 guide.
 
 Every function returns a ``matplotlib.figure.Figure``; :func:`save` writes it as PNG and PDF.
-They read solution Datasets as written by ``vemkit solve`` (SPEC §6) and convergence Datasets
+They read solution Datasets as written by ``vemkit solve`` (docs/reference/files.md) and convergence Datasets
 (``vemkit.studies.convergence``).
 """
 
@@ -101,7 +101,7 @@ def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "
     """The deformed mesh x + M u, grey = shear energy density per cell, Gamma_C penetration in red.
 
     The foundation's surface lies at distance g_a below Gamma_C: drawn at y = -M g_a, so that a
-    point of Gamma_C lies below the line exactly where it penetrates (u_nu > g_a, SPEC §1).
+    point of Gamma_C lies below the line exactly where it penetrates (u_nu > g_a, docs/reference/mathematics.md).
     """
     u = np.stack([ds["u1"].values, ds["u2"].values], axis=1)
     m = auto_magnification(u) if magnification is None else float(magnification)

@@ -5,7 +5,7 @@ Unknowns u (free dofs) and the friction multiplier lambda (one per contact verte
     R(u, lambda) = K u + sum_c w_c [p_nu(t_c) nu_c + b_c lambda_c tau_c] - f = 0,  t = u_nu - g, b = p_tau(t)
     C(u, lambda) = lambda - P(lambda + gamma u_tau) = 0,   P: projection onto [-1, 1].
 
-On a 3D body (SPEC §10) lambda and u_tau have two components in the vertex basis (t1, t2), P is the
+On a 3D body (docs/reference/files.md) lambda and u_tau have two components in the vertex basis (t1, t2), P is the
 projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk.
 
 C = 0 is |lambda| <= 1, lambda u_tau = |u_tau| for any gamma > 0. The choice only steers the active

@@ -32,7 +32,7 @@ R_c . tau_c = -w_c sigma_tau,c:
     stick           (2.9)  where |R_c . tau_c| < w_c p_tau - tol F: |u_tau| / max|u|
 
 F = ||f|| (||f|| + ||contact forces|| without load), the scale of ``contact_residual``.
-In 3D (SPEC §10) R_c . tau_c, u_tau and sign(u_tau) are vectors of the tangent plane in the vertex
+In 3D (docs/reference/files.md) R_c . tau_c, u_tau and sign(u_tau) are vectors of the tangent plane in the vertex
 basis (t1, t2): |.| is their norm, sign(u_tau) = u_tau / |u_tau| (the slip direction, which the
 tangential force R_c . tau_c = w_c p_tau lambda_c must follow). The prescribed components of a
 contact vertex (a roller meeting Gamma_C) are left out of R_c: the constraint takes their force.

@@ -1,4 +1,4 @@
-"""The adaptive loop of SPEC §9: solve → estimate → mark → refine, until the estimate is small enough.
+"""The adaptive loop of docs/reference/files.md: solve → estimate → mark → refine, until the estimate is small enough.
 
 Each step solves the scene's contact problem on the current mesh, checks the solution
 independently (as ``vemkit solve`` does), computes the indicators η_K of ``vemkit.vem.estimator``
@@ -47,7 +47,7 @@ from vemkit.vem.space import VirtualElementSpace
 
 @dataclass(frozen=True)
 class AdaptivitySettings:
-    """The scene's ``adaptivity`` block (SPEC §9)."""
+    """The scene's ``adaptivity`` block (docs/reference/files.md)."""
 
     theta: float = 0.5  # Dörfler bulk parameter
     target: float = 0.01  # relative estimate to reach
@@ -336,8 +336,8 @@ _INTEGER_HISTORY = ("n_dofs", "n_cells", "marked", "skipped", "iterations", "lin
 
 
 def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
-    """The final solution file (SPEC §6) plus ``error_indicator`` per face and the per-step history
-    on the ``adapt_step`` dimension (SPEC §9). Entries a step does not have are not stored."""
+    """The final solution file (docs/reference/files.md) plus ``error_indicator`` per face and the per-step history
+    on the ``adapt_step`` dimension (docs/reference/files.md). Entries a step does not have are not stored."""
     attrs = {"mesh_family": str(run.problem.mesh.meta.get("family", "")), **run.checks, **(extra_attrs or {})}
     try:
         with floating_point_errors_raise():

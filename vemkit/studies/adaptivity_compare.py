@@ -1,4 +1,4 @@
-"""Adaptive against uniform refinement, read from two ``vemkit adapt`` files (SPEC §9).
+"""Adaptive against uniform refinement, read from two ``vemkit adapt`` files (docs/reference/files.md).
 
 Both runs start from the scene's mesh; the uniform one marks every cell (``adaptivity.marking.dorfler
 = 1``), so both record the same history (``adapt_*``). Compared here:

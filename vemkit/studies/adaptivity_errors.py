@@ -1,10 +1,10 @@
-"""The true error of each adaptive step (SPEC §9): against the scene's exact solution or a reference.
+"""The true error of each adaptive step (docs/reference/files.md): against the scene's exact solution or a reference.
 
-- ``exact:`` in the scene (SPEC §7): :func:`vemkit.vem.norms.relative_exact_errors`, the relative
+- ``exact:`` in the scene (docs/reference/files.md): :func:`vemkit.vem.norms.relative_exact_errors`, the relative
   errors of Π_1 u_h against the exact field, as ``vemkit solve`` reports them.
 - ``adaptivity.reference: FILE`` (a solution file of the same scene on a fine mesh, relative to the
   scene file): :func:`reference_errors`, ‖Π_1(u_h − u_ref)‖ / ‖Π_1 u_ref‖ (full H1 norm, H1 seminorm,
-  L2) with Π_1 on each solution's own mesh, as ``vemkit.vem.norms.projection_error`` (SPEC §5) —
+  L2) with Π_1 on each solution's own mesh, as ``vemkit.vem.norms.projection_error`` (docs/reference/mathematics.md) —
   but an adapted mesh is finer than the reference in places (the corners), where a reference cell
   holds several adapted cells. The quadrature is therefore taken on the common refinement: the
   degree-2 rule on the reference cells that lie in one adapted cell, and the same rule on the

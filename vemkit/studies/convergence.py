@@ -1,6 +1,6 @@
 """Convergence studies: per-run error records -> one self-describing ``xarray.Dataset``.
 
-The records (one coarse solve against the reference of the same stabilization, SPEC §5) are
+The records (one coarse solve against the reference of the same stabilization, docs/reference/mathematics.md) are
 ``vemkit.studies.error_records``; :func:`convergence_dataset` gathers them on the grid ``family x
 stabilization x h`` and :func:`write_convergence` stores the result as netCDF4.
 
@@ -194,7 +194,7 @@ def _provenance(title, scene_yaml, parameters, commit) -> dict:
         "title": title,
         "Conventions": "CF-1.8",
         "error_measure": "relative errors of Pi_1 u_h against Pi_1 u_ref in the broken norms over the "
-        "reference mesh (SPEC 5); error_h1: full H1 norm, error_h1_semi: H1 seminorm; "
+        "reference mesh (docs/reference/mathematics.md); error_h1: full H1 norm, error_h1_semi: H1 seminorm; "
         "error_paper: the paper's own measure |Pi_1^ref(I_ref u_h - u_ref)|_H1 / "
         "|Pi_1^ref u_ref|_H1 (interpolation at the reference vertices, projection on the "
         "reference mesh, H1 seminorm), the one its Table 1 prints",
@@ -239,7 +239,7 @@ def convergence_dataset(
             "stabilization": (
                 "stabilization",
                 np.array(stabs, dtype=str),
-                {"long_name": "stabilization alpha_K of the dofi-dofi form (SPEC 3)"},
+                {"long_name": "stabilization alpha_K of the dofi-dofi form (docs/reference/mathematics.md)"},
             ),
             "h": ("h", h, {"long_name": "nominal mesh size h = 1/n", "units": "mm"}),
             "n": ("h", np.asarray(ns, dtype=np.int64), {"long_name": "cells per side n = 1/h"}),

@@ -1,4 +1,4 @@
-"""Error records of convergence studies: one coarse solve against the reference solution (SPEC §5).
+"""Error records of convergence studies: one coarse solve against the reference solution (docs/reference/mathematics.md).
 
 A *record* is a dict with the keys of :data:`RECORD_KEYS`: :func:`error_records` and
 :func:`family_error_records` compute them from solution files, :func:`solved_error_records` solves
@@ -28,13 +28,13 @@ RECORD_KEYS = {
     "h_max": ("largest cell diameter of the mesh", "mm"),
     "n_cells": ("number of cells", "1"),
     "n_dofs": ("number of free displacement unknowns", "1"),
-    "error_h1": ("||Pi_1(u_h - u_ref)||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm, broken, SPEC 5)", "1"),
-    "error_h1_semi": ("|Pi_1(u_h - u_ref)|_H1 / |Pi_1 u_ref|_H1 (H1 seminorm, broken, SPEC 5)", "1"),
+    "error_h1": ("||Pi_1(u_h - u_ref)||_H1 / ||Pi_1 u_ref||_H1 (full H1 norm, broken)", "1"),
+    "error_h1_semi": ("|Pi_1(u_h - u_ref)|_H1 / |Pi_1 u_ref|_H1 (H1 seminorm, broken)", "1"),
     "error_l2": ("||Pi_1(u_h - u_ref)||_L2 / ||Pi_1 u_ref||_L2", "1"),
     "error_paper": (
         "|Pi_1^ref(I_ref u_h - u_ref)|_H1 / |Pi_1^ref u_ref|_H1: the paper's measure, I_ref the "
         "interpolant at the reference vertices (bilinear on squares, Wachspress / mean value "
-        "coordinates elsewhere), H1 seminorm broken over the reference cells (SPEC 5)",
+        "coordinates elsewhere), H1 seminorm broken over the reference cells (docs/reference/mathematics.md)",
         "1",
     ),
     "iterations": ("nonlinear contact solver iterations", "1"),
@@ -117,7 +117,7 @@ class ReferenceSolution:
         self.stabilization = str(self.dataset.attrs.get("stabilization", ""))
 
     def errors(self, mesh, dataset) -> dict:
-        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), SPEC 5.
+        """{"h1", "h1_semi", "l2"} (Pi_1 on each mesh) and "paper" (the paper's measure), docs/reference/mathematics.md.
         Both are k = 1 measures of vertex values: a k = 2 solution or reference is refused."""
         from vemkit.vem.norms import paper_error, projection_error
 

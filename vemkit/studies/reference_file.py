@@ -1,4 +1,4 @@
-"""A reference solution file a user names (``adaptivity.reference``, SPEC §9) read as an input.
+"""A reference solution file a user names (``adaptivity.reference``, docs/reference/files.md) read as an input.
 
 The file is user input like a scene or a mesh file, so it is read the same careful way:
 

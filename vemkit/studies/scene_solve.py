@@ -25,6 +25,8 @@ from vemkit.solvers.verification import CHECK_KEYS, verify_solution
 CHECK_FACTOR = 1e3
 CHECK_FLOOR = 1e-6
 CHECK_CAP = 1e-3
+#: solver.tol of a problem built without a scene (the scene schema's default)
+DEFAULT_SOLVER_TOL = 1e-10
 
 
 def check_tolerance(solver_options: dict) -> float:
@@ -32,6 +34,14 @@ def check_tolerance(solver_options: dict) -> float:
     CHECK_CAP), tol the loosest of solver.tol, eps_u and eps_lambda (README "Input rules and limits")."""
     loosest = max(float(solver_options[k]) for k in ("tol", "eps_u", "eps_lambda") if solver_options.get(k) is not None)
     return min(max(CHECK_FACTOR * loosest, CHECK_FLOOR), CHECK_CAP)
+
+
+def checked(problem, solution, solver_options) -> dict:
+    """The independent check at :func:`check_tolerance`, recorded and not enforced:
+    {check_worst, check_tolerance} (the Python API's Dataset; :func:`verified` enforces it)."""
+    tol = check_tolerance(solver_options)
+    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
+    return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
 
 
 def verified(problem, solution, solver_options, where: str = "", source: str = " (from solver.tol)") -> dict:
@@ -52,7 +62,7 @@ def verified(problem, solution, solver_options, where: str = "", source: str = "
 
 
 def mesh_family(mesh) -> str:
-    """The family that made ``mesh``; prisms over a 2D mesh (SPEC §10): ``extrude:`` and the base's family."""
+    """The family that made ``mesh``; prisms over a 2D mesh (docs/reference/files.md): ``extrude:`` and the base's family."""
     family = str(mesh.meta.get("family", ""))
     if family == "extrude":
         family += ":" + str(mesh.meta.get("base", {}).get("family", ""))
@@ -75,10 +85,25 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
             key="discretization.mesh",
         )
     solution = solve(problem, scene.solver_options, progress=progress)
+    contents = solution_contents(problem, solution, scene, verify=verify, check=verify)
+    return problem, solution, contents.to_dataset() if dataset else contents
+
+
+def solution_contents(problem, solution, scene=None, *, verify: bool = False, check: bool = True):
+    """The solution file's :class:`~vemkit.mesh.file_description.FileDescription`, exactly as
+    ``vemkit solve`` writes it: one function for the command and the Python API
+    (:func:`solution_dataset`). ``scene``: the scene of the problem (default: the one
+    :func:`vemkit.scene_problem` recorded in ``problem.info``); its YAML text, the mesh family, the
+    assembly time, the independent check (``verify``: enforced; else recorded unless ``check`` is
+    False) and, with ``exact:``, the relative errors become global attributes."""
+    if scene is None:
+        scene = problem.info.get("scene")
     attrs = {"assembly_time": float(problem.info.get("assembly_time", 0.0)), "mesh_family": mesh_family(problem.mesh)}
-    if verify:
-        attrs.update(verified(problem, solution, scene.solver_options))
-    if scene.exact_displacement is not None:  # SPEC §7: relative errors of Pi u_h against the exact field
+    solver_options = scene.solver_options if scene is not None else {"tol": DEFAULT_SOLVER_TOL}
+    if verify or check:
+        attrs.update((verified if verify else checked)(problem, solution, solver_options))
+    # with exact: the relative errors of Pi u_h against the exact field (docs/reference/files.md)
+    if scene is not None and scene.exact_displacement is not None:
         from vemkit.vem.norms import relative_exact_errors  # here: a solve without exact: never imports it
 
         attrs.update(
@@ -86,10 +111,19 @@ def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool 
         )
     try:
         with floating_point_errors_raise():
-            contents = solution_description(problem, solution, scene_yaml=scene.to_yaml(), extra_attrs=attrs)
+            return solution_description(
+                problem, solution, scene_yaml=scene.to_yaml() if scene is not None else "", extra_attrs=attrs
+            )
     except (FloatingPointError, OverflowError, ZeroDivisionError, RuntimeWarning) as error:
         raise ResultError(
             f"the stresses of the solution overflow double precision ({error}); "
             "rescale the units of the scene (E, k, tractions)"
         ) from None
-    return problem, solution, contents.to_dataset() if dataset else contents
+
+
+def solution_dataset(problem, solution, scene=None):
+    """Everything a user needs from one solve as an xarray Dataset: the same variables and global
+    attributes as the file ``vemkit solve`` writes for the scene (:func:`solution_contents`; the
+    scene is the one :func:`vemkit.scene_problem` built ``problem`` from, unless given). The
+    independent check is recorded (``check_worst`` against ``check_tolerance``), not enforced."""
+    return solution_contents(problem, solution, scene).to_dataset()

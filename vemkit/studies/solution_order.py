@@ -1,5 +1,5 @@
 """The space of a solution file, for the studies: its order k, its degrees of freedom and Pi of them, and
-the refusals of k = 2 where a study measures Pi_1 of vertex values (SPEC 5), which would mis-measure it."""
+the refusals of k = 2 where a study measures Pi_1 of vertex values (docs/reference/mathematics.md), which would mis-measure it."""
 
 from __future__ import annotations
 
@@ -15,19 +15,19 @@ def solution_order(ds) -> int:
 
 def refuse_order2(ds, what: str) -> None:
     """InputError unless ``ds`` is a k = 1 solution: Pi_1 of vertex values and the paper's measure
-    (SPEC 5) would mis-measure a k = 2 solution (its edge and cell means are ignored)."""
+    (docs/reference/mathematics.md) would mis-measure a k = 2 solution (its edge and cell means are ignored)."""
     if solution_order(ds) != 1:
         raise InputError(
             f"{what} has discretization.order = {solution_order(ds)}: this error measure (Pi_1 of vertex "
-            "values, SPEC 5) is for k = 1 only; use discretization.order=1 or the order2 study "
-            "(snakemake -j2 order2)",
+            "values) is for k = 1 only; use discretization.order=1 or the order2 study "
+            "(.venv/bin/snakemake -j2 order2)",
             key="discretization.order",
         )
 
 
 def require_order1(scene, what: str) -> None:
     """SceneError unless ``scene`` has discretization.order 1: ``what`` measures errors with Pi_1 of
-    vertex values (SPEC 5), which would mis-measure a k = 2 solution."""
+    vertex values (docs/reference/mathematics.md), which would mis-measure a k = 2 solution."""
     from vemkit.exceptions import SceneError
 
     if scene.order != 1:

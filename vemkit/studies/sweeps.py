@@ -53,7 +53,7 @@ QUANTITIES = {  # name: (long name, units)
     "tangential_force": ("resultant tangential contact stress sum_c w_c sigma_tau (all Gamma_C vertices)", "daN/mm"),
     "residual": ("worst independent check of the discrete conditions (vemkit.studies.robustness)", "1"),
 }
-#: a 3D body (SPEC §10): Gamma_C is a surface, so areas instead of lengths, forces instead of forces per
+#: a 3D body (docs/reference/files.md): Gamma_C is a surface, so areas instead of lengths, forces instead of forces per
 #: unit depth, and the tangential force is the magnitude of the resultant vector sum_c w_c sigma_tau,c
 QUANTITIES_3D = {
     "max_penetration": QUANTITIES["max_penetration"],
@@ -274,7 +274,7 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
     sizes = {p["x"].tobytes() + p["y"].tobytes() for p in profiles}
     keep_profiles = len(sizes) == 1
     n_c = len(profiles[0]["x"]) if keep_profiles else 0
-    # 3D: tangential profiles have two components in the vertex basis (contact_tangent, SPEC §10)
+    # 3D: tangential profiles have two components in the vertex basis (contact_tangent, docs/reference/files.md)
     tangent_shape = (
         {k: (2,) if dimension == 3 and np.ndim(profiles[0][k]) == 2 else () for k in PROFILES} if keep_profiles else {}
     )
@@ -339,7 +339,9 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             extra = ("contact_tangent",) if tangent_shape.get(k) else ()
             meta = {"long_name": long_name, "units": units}
             if extra:
-                meta["comment"] = "components along the vertex's tangent basis (t1, t2) of the solution file (SPEC §10)"
+                meta["comment"] = (
+                    "components along the vertex's tangent basis (t1, t2) of the solution file (docs/reference/files.md)"
+                )
             ds[f"profile_{k}"] = (pdims + extra, profile_data[k], meta)
         ds["profile_state"] = (
             pdims,

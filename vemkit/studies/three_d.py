@@ -1,4 +1,4 @@
-"""The 3D verification studies (SPEC §10, issue 20 items 7-8): what `snakemake three_d` and
+"""The 3D verification studies (docs/reference/files.md, issue 20 items 7-8): what `snakemake three_d` and
 tests/vem3d/test_*closed_forms*.py run.
 
 - Manufactured convergence (:func:`manufactured_run`, :func:`convergence_dataset`): a scene with
@@ -11,7 +11,7 @@ tests/vem3d/test_*closed_forms*.py run.
 - The extruded body against the 2D models (:func:`base_scene`, :func:`plane_strain_difference`,
   :func:`plane_stress_difference`): a 3D scene on an ``extrude`` domain and the 2D scene of its base
   (the end faces' conditions dropped, the third components dropped), solved on the same base mesh
-  (the 3D mesh is the prisms over the 2D family mesh of the same keys, SPEC §10).
+  (the 3D mesh is the prisms over the 2D family mesh of the same keys, docs/reference/files.md).
 - :func:`boundary_polygons`: the boundary faces of a 3D mesh as polygons, for the figures.
 
 Every run returns a plain record (a dict of numbers and strings) and, where asked, the Dataset.

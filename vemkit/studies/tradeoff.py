@@ -3,7 +3,7 @@
 Every run solves the scene on one mesh with one configuration and measures
 
 - the error ||Pi_1(u_h - u_ref)|| / ||Pi_1 u_ref|| (full H1 norm, also the seminorm and L2) against
-  ONE reference solution (the 2^-8 square mesh, SPEC §5), the same yardstick for every
+  ONE reference solution (the 2^-8 square mesh, docs/reference/mathematics.md), the same yardstick for every
   stabilization (``vemkit.vem.norms.projection_error``);
 - the cost: ``cost_time`` = assembly + contact solve (with its linear solver set-up, nothing
   reused between runs; the fastest of ``repeats`` solves, after an untimed warm-up of the compiled

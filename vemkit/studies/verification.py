@@ -8,7 +8,7 @@ Each case solves one scene of ``config/scenes`` on every mesh family at several 
   is the mid-edge one: the top corner (48, 60), also recorded, still rises with refinement (25.1
   at 46 000 unknowns). A point of an edge is evaluated on that edge: u_h is linear along edges.
 - ``kirsch`` (plate with a hole under remote tension S): the relative errors of Π_1 u_h against the
-  exact field (``error_h1``, ``error_h1_semi``, ``error_l2`` of the solution, SPEC §7) with their
+  exact field (``error_h1``, ``error_h1_semi``, ``error_l2`` of the solution, docs/reference/files.md) with their
   observed orders, and the stress concentration σ11(0, a)/S against 3 (Kirsch 1898). On the
   traction-free hole σ11 = σ_tt = E ε_tt (plane stress), ε_tt the stretch of the hole's chord
   within ``STRESS_WINDOW`` h of the top (:func:`free_boundary_stress`): the cell stresses are

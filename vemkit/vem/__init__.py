@@ -12,6 +12,6 @@
 - ``quadrature`` (rules, data sampled on edges and cells), ``elasticity`` (the material law of the
   paper's C, rigid-body modes), ``projection`` (stress, shear energy density), ``norms`` (error
   measures), ``interpolation`` (generalized barycentric coordinates, the paper's measure),
-  ``estimator`` (a posteriori indicators, SPEC §9).
+  ``estimator`` (a posteriori indicators, docs/reference/files.md).
 Imports from vemkit: ``exceptions``, ``config``, ``mesh``.
 """

@@ -1,4 +1,4 @@
-"""The material law (SPEC §1, §10: ``vemkit.config.material``) and the rigid-body motions it leaves free."""
+"""The material law (docs/reference/mathematics.md and docs/reference/files.md: ``vemkit.config.material``) and the rigid-body motions it leaves free."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from vemkit.config.material import lame_parameters  # noqa: F401  (the formulas'
 
 
 def elasticity_matrix(lam: float, mu: float) -> np.ndarray:
-    """Voigt matrix D of C (SPEC §1) for the strain vector (eps11, eps22, 2 eps12)."""
+    """Voigt matrix D of C (docs/reference/mathematics.md) for the strain vector (eps11, eps22, 2 eps12)."""
     return np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
 
 

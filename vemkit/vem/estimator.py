@@ -1,4 +1,4 @@
-"""A posteriori error indicators η_K of the VEM solution of the contact problem, for any element (SPEC §9).
+"""A posteriori error indicators η_K of the VEM solution of the contact problem, for any element (docs/reference/files.md).
 
 Computable from u_h and the data only. With σ_K = C ε(Π u_h) on cell K (constant for k = 1, so
 div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of the body force, and n_e

@@ -1,4 +1,4 @@
-"""Generalized barycentric interpolation of vertex values on polygonal meshes (SPEC §5).
+"""Generalized barycentric interpolation of vertex values on polygonal meshes (docs/reference/mathematics.md).
 
 The paper's error measure interpolates a coarse solution u_h, known at the coarse vertices, at
 the vertices of the 2^-8 reference mesh: I u_h(x) = sum_i phi_i(x) u_h(v_i), x in the coarse cell

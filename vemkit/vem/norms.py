@@ -1,4 +1,4 @@
-"""Error measures, for every element: Table 1's (SPEC §5), against exact solutions (SPEC §7) and on Gamma_C.
+"""Error measures, for every element: Table 1's (docs/reference/mathematics.md), against exact solutions (docs/reference/files.md) and on Gamma_C.
 
 Between a coarse solution u_h and the reference u_ref (the 2^-8 square mesh):
 
@@ -46,7 +46,7 @@ __all__ = [
 
 
 def projection_error(coarse_mesh: Mesh, coarse, ref_mesh: Mesh, ref, quadrature=None, regions=None) -> dict:
-    """Relative errors of Pi u_h against Pi u_ref over the reference mesh (SPEC §5).
+    """Relative errors of Pi u_h against Pi u_ref over the reference mesh (docs/reference/mathematics.md).
 
     Returns {"h1": full H1 norm ratio, "h1_semi": seminorm ratio, "l2": L2 ratio} and, for every
     ``regions`` entry name -> mask(points) -> bool array, "share_<name>": the part of the squared
@@ -89,7 +89,7 @@ def paper_error(
     ref_projected: ProjectedSolution | None = None,
     ref_areas: np.ndarray | None = None,
 ) -> float:
-    """The paper's measure |Pi_1^ref (I_ref u_h - u_ref)|_{H1} / |Pi_1^ref u_ref|_{H1} (SPEC §5).
+    """The paper's measure |Pi_1^ref (I_ref u_h - u_ref)|_{H1} / |Pi_1^ref u_ref|_{H1} (docs/reference/mathematics.md).
 
     ``u_coarse`` (N_h, 2) and ``u_ref`` (N_ref, 2) are vertex values. ``ref_projected``
     (Pi_1^ref u_ref) and ``ref_areas`` (``ref_mesh.cell_areas``) may be passed to reuse them.
@@ -169,12 +169,12 @@ def difference_gradient(field, step: float):
 
 
 def relative_exact_errors(mesh: Mesh, proj, u_exact) -> dict:
-    """SPEC §7: relative errors of Pi u_h (``proj``, any element's projection) against
+    """docs/reference/files.md: relative errors of Pi u_h (``proj``, any element's projection) against
     u_exact(x, y) -> (u1, u2): ``error_l2`` = ||Pi u_h - u|| / ||u||, ``error_h1_semi`` = |.|_1 / |u|_1,
     ``error_h1`` with the full H1 norm; a degree-5 rule on a triangulation of every cell, the
     gradient of u exact (``u_exact.gradient``, e.g. of ``vemkit.config.expressions.vector_field``) or,
     for a plain callable, by :func:`difference_gradient` with a step of 1e-3 times the body's size.
-    On a 3D mesh (SPEC §10) the same with u_exact(x, y, z) -> (u1, u2, u3) and the tetrahedral-fan
+    On a 3D mesh (docs/reference/files.md) the same with u_exact(x, y, z) -> (u1, u2, u3) and the tetrahedral-fan
     rule of :func:`error_quadrature`."""
     quadrature = error_quadrature(mesh)
     step = 1e-3 * float(np.ptp(mesh.vertices, axis=0).max())

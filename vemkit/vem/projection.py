@@ -1,4 +1,4 @@
-"""What follows from a projected displacement for every element: stress (SPEC §1) and the shear
+"""What follows from a projected displacement for every element: stress (docs/reference/mathematics.md) and the shear
 energy density of the paper's Fig. 6. The projections Pi u_h themselves belong to the elements
 (``VirtualElementSpace.project``)."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-#: the strain and stress components of a 3D body, in the solution file's order (SPEC §10)
+#: the strain and stress components of a 3D body, in the solution file's order (docs/reference/files.md)
 COMPONENTS_3D = ("11", "22", "33", "12", "13", "23")
 _PAIRS_3D = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
@@ -20,7 +20,7 @@ def strain_of(gradient: np.ndarray) -> np.ndarray:
 
 
 def stress(strain: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """sigma = C eps = lam tr(eps) I + 2 mu eps (SPEC §1): (M, 3) sigma11, sigma22, sigma12 from
+    """sigma = C eps = lam tr(eps) I + 2 mu eps (docs/reference/mathematics.md): (M, 3) sigma11, sigma22, sigma12 from
     (eps11, eps22, eps12), or in 3D (M, 6) from (M, 6) in the order of ``COMPONENTS_3D``."""
     diagonal = 3 if strain.shape[1] == 6 else 2
     tr = strain[:, :diagonal].sum(axis=1)
@@ -40,7 +40,7 @@ def shear_energy_density(sig: np.ndarray, lam: float, mu: float, model: str = "p
 
     |dev sigma|^2 = (mu^2 / (6 (mu + lam)^2) + 1/2) (s11 + s22)^2 + 2 (s12^2 - s11 s22),
 
-    lam being the lambda* of the paper's C (SPEC §1). Plane strain: the deviator of the 3D stress with
+    lam being the lambda* of the paper's C (docs/reference/mathematics.md). Plane strain: the deviator of the 3D stress with
     s33 = nu (s11 + s22), nu = lam / (2 (lam + mu)): |dev sigma|^2 = sum s_ii^2 + 2 s12^2 - (sum s_ii)^2 / 3.
     """
     s11, s22, s12 = sig[:, 0], sig[:, 1], sig[:, 2]

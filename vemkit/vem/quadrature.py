@@ -3,7 +3,7 @@
 - ``TRIANGLE_RULE``: the 7-point degree-5 rule on triangles; ``reference_quadrature``: a degree-2 or
   degree-5 rule on a triangulation of every cell (errors, projections of data);
 - ``edge_quadrature``: Gauss-Legendre on [0, 1]; ``traction_samples``: a traction at the Gauss points
-  of boundary edges; ``pressure_traction``: the traction -p nu of a normal pressure (SPEC §7);
+  of boundary edges; ``pressure_traction``: the traction -p nu of a normal pressure (docs/reference/files.md);
 - ``cell_averages``: P_0 f of a vector field on every cell.
 """
 

@@ -148,7 +148,7 @@ class VirtualElementSpace:
         return self.element.traction_load(self.mesh, edges, traction)
 
     def pressure_load(self, edges: np.ndarray, pressure) -> np.ndarray:
-        """(n_nodes, d) the load of a normal pressure p (traction -p nu, SPEC §7) on boundary edges
+        """(n_nodes, d) the load of a normal pressure p (traction -p nu, docs/reference/files.md) on boundary edges
         (3D: faces)."""
         return self.element.pressure_load(self.mesh, edges, pressure)
 

@@ -1,4 +1,4 @@
-# Adaptive against uniform refinement (vemkit.studies.adaptivity, SPEC §9) for the scenes of
+# Adaptive against uniform refinement (vemkit.studies.adaptivity, docs/reference/files.md) for the scenes of
 # config/adaptivity.yaml: per scene a reference solution (unless the scene has an exact one), the
 # adaptive and the uniform run (each a `vemkit adapt` file: final solution, error_indicator, adapt_*
 # history; plus the meshes of the sequence figure), the figures; one summary of every scene.

@@ -90,11 +90,11 @@ def _check_config():
                                 "non-integer n; give an integer")
     if REF["n"] not in (2 ** k for k in range(1, 16)) or MESHES[REF["mesh"]]["family"] != "square":
         raise WorkflowError(f"config reference = {REF}: the error measure needs a square mesh with n a power "
-                            "of 2 (nested with the square levels, SPEC 5)")
+                            "of 2 (nested with the square levels, docs/reference/mathematics.md)")
 
 
 def _check_order():
-    """The paper workflow measures errors with Pi_1 of vertex values (SPEC 5): k = 1 only."""
+    """The paper workflow measures errors with Pi_1 of vertex values (docs/reference/mathematics.md): k = 1 only."""
     from vemkit.config.scene import load_scene
     from vemkit.exceptions import SceneError
     from vemkit.studies.solution_order import require_order1
@@ -116,7 +116,7 @@ def ntag(n):
 
 
 def stabilization_free(label):
-    """All-triangle families: the VEM space is P1 and the stabilization vanishes (SPEC 3)."""
+    """All-triangle families: the VEM space is P1 and the stabilization vanishes (docs/reference/mathematics.md)."""
     return MESHES[label]["family"] == "triangle"
 
 

@@ -1,4 +1,4 @@
-# Errors against the 2^-8 square reference of the same stabilization (SPEC 5), one job per
+# Errors against the 2^-8 square reference of the same stabilization (docs/reference/mathematics.md), one job per
 # family: the references and their quadrature are loaded once for all levels and stabilizations.
 
 

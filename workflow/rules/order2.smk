@@ -4,7 +4,7 @@
 # u: sliding, sticking, and a separation point inside Gamma_C), observed orders, figures. Not in the
 # default target: `snakemake -j2 order2`.
 #
-#   results/order2/solutions/{case}/n{n}.nc    one solve (SPEC §6 file; k = 2 adds edge/cell means)
+#   results/order2/solutions/{case}/n{n}.nc    one solve (the solution file of docs/reference/files.md; k = 2 adds edge/cell means)
 #   results/order2/reference.nc                the k = 2 reference (square, ORDER2["reference"]["n"])
 #   results/order2/errors/{case}.json          the errors of one case at every level
 #   results/order2/order2.nc, orders.md        every run, the observed orders (per DOF), the table
@@ -12,7 +12,7 @@
 #   results/order2/manufactured/{scene}/{case}/n{n}.nc, manufactured/errors/{scene}/{case}.json
 #   results/order2/manufactured.nc, manufactured.md, manufactured.png   the same for the exact solutions
 #
-# The paper's own measure (SPEC §5) needs vertex values on nested square meshes and a k = 1
+# The paper's own measure (docs/reference/mathematics.md) needs vertex values on nested square meshes and a k = 1
 # reference: it is reported for the k = 1 cases against the main workflow's 2^-8 reference.
 import re
 

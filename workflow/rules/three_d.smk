@@ -1,8 +1,8 @@
-# 3D verification (SPEC §10, issue 20 items 7-8; vemkit.studies.three_d), configured by
+# 3D verification (docs/reference/files.md, issue 20 items 7-8; vemkit.studies.three_d), configured by
 # config/three_d.yaml. Not in the default target: `snakemake -j2 three_d`.
 #
 #   results/3d/manufactured/{case}.json       the errors of one manufactured case at every level
-#   results/3d/solutions/{case}.nc            its solution at figure_level (mesh3d file, SPEC §10)
+#   results/3d/solutions/{case}.nc            its solution at figure_level (mesh3d file, docs/reference/files.md)
 #   results/3d/vtu/{case}.vtu                 the same as VTK polyhedra (ParaView)
 #   results/3d/convergence.nc, convergence.md every case x level: errors, observed orders
 #   results/3d/lame.nc, lame.md               Lame's cylinder against the closed form

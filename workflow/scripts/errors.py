@@ -1,4 +1,4 @@
-"""Rule errors: every level and stabilization of one family against the reference (SPEC 5): the
+"""Rule errors: every level and stabilization of one family against the reference (docs/reference/mathematics.md): the
 three measures (the paper's, and Pi_1 on each mesh in the full H1 norm and the H1 seminorm)."""
 
 from _helpers import level, logged

@@ -1,5 +1,5 @@
 """Rule errors_gauss: Table 1's family and the reference solved with Gauss quadrature on Gamma_C
-(config table1.gauss), and measured like rule errors (SPEC 5)."""
+(config table1.gauss), and measured like rule errors (docs/reference/mathematics.md)."""
 
 from _helpers import logged
 

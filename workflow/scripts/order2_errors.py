@@ -5,7 +5,7 @@ cells (``vemkit.vem.norms.projection_error``), the trace errors on Gamma_C
 (``trace_error``: ||u_h - u_ref||; ``trace_errors``: ||u_ref - I_h u_ref||, the interpolant of order k
 of the reference, the term of the paper's a priori estimate), and where the squared H1-seminorm error sits: within ``region_radius`` of each
 corner of the body and of the contact-zone boundary (the points of Gamma_C where the reference's
-contact state changes between separated and in contact). For k = 1 also the paper's measure (SPEC §5)
+contact state changes between separated and in contact). For k = 1 also the paper's measure (docs/reference/mathematics.md)
 against the main workflow's k = 1 reference.
 """
 

@@ -80,7 +80,7 @@ def dataset(records, settings, title, measure):
 MEASURES = (
     "relative errors of Pi_k u_h; error_contact_l2: ||u - u_h||_L2(Gamma_C) / ||u||; "
     "error_interpolation_contact_l2: ||u - I_h u||_L2(Gamma_C) / ||u||, I_h the interpolant of order k; "
-    "error_paper: SPEC 5 against the k = 1 2^-8 reference (k = 1, paper scene only); share_*: part of the "
+    "error_paper: the paper's measure (docs/reference/mathematics.md) against the k = 1 2^-8 reference (k = 1, paper scene only); share_*: part of the "
     "squared H1-seminorm error within region_radius of a corner or of the contact-zone boundary"
 )
 

@@ -1,7 +1,7 @@
 """Rule order2_manufactured_errors: the errors of one case of the Section 4 study on one manufactured
 contact solution, at every level, against the exact u of the scene (``exact:``).
 
-H1, H1-seminorm and L2 errors of Pi_k u_h are the solve's own attributes (SPEC §7, relative); on
+H1, H1-seminorm and L2 errors of Pi_k u_h are the solve's own attributes (docs/reference/files.md, relative); on
 Gamma_C, ``vemkit.vem.norms.trace_errors`` gives ||u - u_h|| and ||u - I_h u|| (the interpolant of
 the same order: the term of the paper's a priori estimate). Where the discrete solution changes
 between separated and in contact is recorded (the exact one separates at x0 = 3/5 in ``separation``).

@@ -33,7 +33,7 @@ with logged(smk):
     out.to_netcdf(smk.output.nc)
     text = (
         "# Extruded paper body against 2D plane strain\n\n"
-        "max_difference: max |u_3D - u_2D| (u1, u2, every vertex of every layer) / max |u_2D|. SPEC §10 asks "
+        "max_difference: max |u_3D - u_2D| (u1, u2, every vertex of every layer) / max |u_2D|. The 3D contract (docs/reference/files.md) asks "
         "for equality: the 3D consistency and stabilization of a right prism of height t are t times the 2D "
         "ones for z-independent fields (the stabilization length t / 2, k1_3d.stabilization_lengths; "
         "tests/vem3d/test_plane_models.py).\n\n"

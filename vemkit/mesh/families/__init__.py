@@ -1,4 +1,4 @@
-"""Mesh families by name: ``build_mesh("voronoi", 32, seed=1)``, on any domain (SPEC §7):
+"""Mesh families by name: ``build_mesh("voronoi", 32, seed=1)``, on any domain (docs/reference/files.md):
 ``build_mesh("square", h=2.0, domain={"polygon": ..., "sides": ..., "holes": ...})``.
 On the unit square (the default):
 
@@ -71,7 +71,7 @@ def build_mesh(
 ) -> Mesh:
     """The mesh of ``family`` on ``domain``, made with ``options``.
 
-    ``domain``: a :class:`~vemkit.config.domain.Domain`, its SPEC §7 mapping or None (the unit
+    ``domain``: a :class:`~vemkit.config.domain.Domain`, its docs/reference/files.md mapping or None (the unit
     square). Size: exactly one of ``n`` (cells per unit length, n = 1/h: about n² cells per unit
     area), ``h`` or ``cells`` (about that many cells). On the unit square with a whole n every
     family makes exactly the mesh it always made.
@@ -123,7 +123,7 @@ def checked_mesh(mesh: Mesh, what: str, fix: str) -> Mesh:
 
 def scene_mesh(scene) -> Mesh:
     """The validated mesh a scene (``vemkit.config.Scene``) asks for: its family on its domain with
-    one of n / h / cells (:func:`checked_mesh`), or its mesh file (SPEC §8, read and validated)."""
+    one of n / h / cells (:func:`checked_mesh`), or its mesh file (docs/reference/files.md, read and validated)."""
     three_d = scene.dimension == 3
     if scene.mesh_file is not None:
         read_mesh: Callable[..., Any]  # the 2D or the 3D reader
@@ -136,7 +136,7 @@ def scene_mesh(scene) -> Mesh:
     opts = scene.mesh_options
     family = opts.pop("family")
     sizes = {key: opts.pop(key) for key in ("n", "h", "cells") if key in opts}
-    # options were checked by the scene schema and build_mesh; the domain by the scene (SPEC §7, §10)
+    # options were checked by the scene schema and build_mesh; the domain by the scene (docs/reference/files.md)
     size = ", ".join(f"{key} = {value:g}" for key, value in sizes.items())
     build: Callable[..., Any]  # build_mesh or build_mesh3d
     if three_d:  # the 3D families build on the 2D ones (prisms): imported here, not at the top

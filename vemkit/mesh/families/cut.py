@@ -1,5 +1,5 @@
 """Cut cells: the Cartesian grid of squares clipped to a domain (``square`` and ``hanging`` on any
-domain, SPEC §7).
+domain, docs/reference/files.md).
 
 The grid starts at the lower-left corner of the domain's bounding box, with squares of side
 h = 1/n. A square inside the domain stays a square; a square the boundary passes through is

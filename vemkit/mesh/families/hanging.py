@@ -11,7 +11,7 @@ Each of ``levels`` rounds splits (quadrisection) a set of the current squares:
 
 Every square lists, counter-clockwise from its lower-left corner, all the vertices lying on its
 boundary: the corners of its smaller neighbours are hanging nodes, so a coarse square becomes a
-5-, 6-, ... vertex polygon with collinear vertices (SPEC §3). Coordinates are computed on the
+5-, 6-, ... vertex polygon with collinear vertices (docs/reference/mathematics.md). Coordinates are computed on the
 integer grid of the finest possible level and divided once, so shared vertices coincide exactly.
 
 On any other domain (``domain=``, a :class:`~vemkit.config.domain.Domain`) the same refinement runs on

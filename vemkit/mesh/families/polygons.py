@@ -3,7 +3,7 @@
 Families that cut shapes with shapely (clipped Voronoi cells, cut squares) get polygons whose
 shared corners were computed separately and may differ in the last bits. ``conforming_mesh``
 merges points closer than a tolerance, drops repeated points, inserts every vertex that lies on
-another cell's edge into that edge (hanging nodes: SPEC §3 wants them listed by both cells) and
+another cell's edge into that edge (hanging nodes: docs/reference/mathematics.md wants them listed by both cells) and
 orients every cell counter-clockwise. ``tag_sides`` names every boundary edge after the domain
 segment it lies on; ``merge_small_cells`` joins cells below an area threshold to a neighbour.
 """

@@ -1,4 +1,4 @@
-"""3D mesh families by name (SPEC §10): every one returns a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
+"""3D mesh families by name (docs/reference/files.md): every one returns a :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`
 with named sides and ``meta``, valid for :func:`~vemkit.mesh.checks3d.validate_mesh3d`.
 
 On a box ``[lower, upper]`` (sides xmin, xmax, ymin, ymax, zmin, zmax, default ``left, right, front,
@@ -13,7 +13,7 @@ back, bottom, top``):
 - ``voronoi``: about n³ per unit volume clipped centroidal Voronoi polyhedra (``seed``,
   ``lloyd_iterations``, ``jitter``).
 
-On an extruded §7 domain: ``tet`` (delaunay) meshes the body itself (``delaunay_tet_extruded``);
+On an extruded 2D domain: ``tet`` (delaunay) meshes the body itself (``delaunay_tet_extruded``);
 every 2D family gives prisms over its 2D mesh of the base.
 
 ``extrude(mesh2d, layers, depth)``: prisms over any 2D mesh (``families3d.extrude``). Domains and

@@ -1,4 +1,4 @@
-"""Meshing a 3D body (SPEC §10) by family name and size: ``build_mesh3d("voronoi", {"box": ...}, n=8)``.
+"""Meshing a 3D body (docs/reference/files.md) by family name and size: ``build_mesh3d("voronoi", {"box": ...}, n=8)``.
 
 The body is parsed by :func:`vemkit.config.domain3d.domain3d_from_spec` (module doc there); on a box
 the 3D families, on an extruded domain the prisms over the 2D family's mesh of the base, or (family

@@ -1,4 +1,4 @@
-"""Prisms over a polygonal mesh (SPEC §10): a 2D :class:`~vemkit.mesh.mesh.Mesh` extruded along z.
+"""Prisms over a polygonal mesh (docs/reference/files.md): a 2D :class:`~vemkit.mesh.mesh.Mesh` extruded along z.
 
 Every 2D cell K (any polygon: cut cells, holes around it, hanging nodes as extra vertices) becomes
 ``layers`` prisms K x [z_l, z_{l+1}], z_l = z0 + depth l / layers. A prism's faces are its two caps

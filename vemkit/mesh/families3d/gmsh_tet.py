@@ -1,4 +1,4 @@
-"""Quality Delaunay tetrahedra of a box or an extruded §7 domain, made by gmsh (SPEC §10, family ``tet``).
+"""Quality Delaunay tetrahedra of a box or an extruded 2D domain, made by gmsh (docs/reference/files.md, family ``tet``).
 
 ``delaunay_tet(n, box=..., sides=...)`` meshes a box; ``delaunay_tet_extruded(n, body)`` an
 :class:`~vemkit.config.domain3d.Extruded` body (its base polygon with circle arcs and circular or
@@ -20,7 +20,7 @@ the tetrahedra are a little smaller, so a body of volume V and surface A has abo
 ``6 n³ V + BOUNDARY_CELLS n² A`` of them (``tet_counts``, the prediction of ``resources.py``).
 Curved sides get at least ``CURVATURE_ELEMENTS`` edges per full circle.
 
-Naming: the box's faces by ``sides``; on an extruded body every lateral face by the §7 side name
+Naming: the box's faces by ``sides``; on an extruded body every lateral face by the 2D side name
 of the base curve it is swept from, the end faces z = 0 and z = depth by ``ends``.
 
 gmsh runs inside ``gmsh_session``: no terminal output, no files, its SIGINT handler not installed,
@@ -296,7 +296,7 @@ def _box_snapped(mesh: PolyhedralMesh, lower, upper, sides) -> PolyhedralMesh:
 
 
 def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
-    """gmsh's quality Delaunay tetrahedra of an extruded §7 body (``Extruded``; module doc)."""
+    """gmsh's quality Delaunay tetrahedra of an extruded 2D body (``Extruded``; module doc)."""
     optimize = _flag(optimize)
     from vemkit.config.domain import CircleHole
 

@@ -1,4 +1,4 @@
-"""Box meshes on a Cartesian grid (SPEC §10): ``hex`` (n x m x l hexahedra) and ``tet`` (each hexahedron
+"""Box meshes on a Cartesian grid (docs/reference/files.md): ``hex`` (n x m x l hexahedra) and ``tet`` (each hexahedron
 cut into the 6 Kuhn tetrahedra around its diagonal from the lowest to the highest corner: the same
 cut in every box, so neighbouring boxes agree on their shared faces' diagonals; the family ``tet``
 with ``kind: structured``, while its default kind, delaunay, is gmsh's: ``gmsh_tet``).

@@ -1,4 +1,4 @@
-"""Hexahedra with hanging nodes (SPEC §10): the box grid with some cells cut into 8 (one level).
+"""Hexahedra with hanging nodes (docs/reference/files.md): the box grid with some cells cut into 8 (one level).
 
 Refined are (``rule``) the cells touching ``contact_side`` (default ``bottom``, z = z0), or
 ``round(fraction x count)`` cells chosen with ``numpy.random.default_rng(seed)`` (``rule="random"``).

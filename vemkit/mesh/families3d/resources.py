@@ -1,6 +1,6 @@
 """What a 3D box mesh will hold before it is built: cells, vertices, faces, DOFs (3 per vertex).
 
-``estimate_mesh3d(family, domain, n=/h=/cells=, **options)`` on a box (SPEC §10):
+``estimate_mesh3d(family, domain, n=/h=/cells=, **options)`` on a box (docs/reference/files.md):
 
 - ``hex`` and ``tet`` with ``kind: structured``: exact, from the grid (nx, ny, nz) = max(1, round(n L)):
   hex has nx ny nz cells, (nx+1)(ny+1)(nz+1) vertices and (nx+1) ny nz + nx (ny+1) nz + nx ny (nz+1)

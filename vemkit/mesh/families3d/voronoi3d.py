@@ -1,4 +1,4 @@
-"""Centroidal Voronoi polyhedra of a box (SPEC §10), clipped exactly by the box.
+"""Centroidal Voronoi polyhedra of a box (docs/reference/files.md), clipped exactly by the box.
 
 Seeds: a jittered grid of ``count`` points (about n³ per unit volume; one per lattice cell of the
 box's best-fitting grid, jittered by ``jitter`` of a cell with ``numpy.random.default_rng(seed)``),

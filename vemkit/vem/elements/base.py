@@ -50,7 +50,7 @@ STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
 
 
 def stabilization_code(name: str) -> int:
-    """The kernels' code of a stabilization scaling alpha_K (SPEC §3): 0 dofi, 1 dofi-2mu, 2 trace."""
+    """The kernels' code of a stabilization scaling alpha_K (docs/reference/mathematics.md): 0 dofi, 1 dofi-2mu, 2 trace."""
     try:
         return STABILIZATIONS.index(name)
     except ValueError:
@@ -106,7 +106,7 @@ class Element:
         return mesh.vertices
 
     def pressure_load(self, mesh, edges, pressure):
-        """(n_nodes, d) the load of a normal pressure p on boundary ``edges`` (traction -p nu, SPEC §7):
+        """(n_nodes, d) the load of a normal pressure p on boundary ``edges`` (traction -p nu, docs/reference/files.md):
         the traction load of -p nu (``vemkit.vem.quadrature.pressure_traction``)."""
         from vemkit.vem.quadrature import pressure_traction
 

@@ -18,9 +18,11 @@ class FirstOrder(Element):
     condensed_nodes = 0
     numbering = "mesh"
     stress_degree = 0  # Pi_1 u is linear: a constant strain and stress per cell
-    polynomial_on_triangles = True  # SPEC §3: on triangles V_h is P1, the stiffness that of P1 finite elements
+    # docs/reference/mathematics.md: on triangles V_h is P1, the stiffness that of P1 finite elements
+    polynomial_on_triangles = True
     projection_uses_material = False  # Pi_1: the strain is the cell average of eps(v), from boundary values
-    contact_rule = ((0.0, 0.5), (1.0, 0.5))  # the trapezoid: half of each adjacent edge per vertex (SPEC §3)
+    # the trapezoid: half of each adjacent edge per vertex (docs/reference/mathematics.md)
+    contact_rule = ((0.0, 0.5), (1.0, 0.5))
 
     kernel_module = "vemkit.vem.elements.k1_kernel"
     fields_module = "vemkit.vem.elements.k1_fields"

@@ -1,5 +1,5 @@
 """The lowest-order element in three dimensions (k = 1, Section 3 for d = 3): the displacement at
-the vertices of polyhedra (SPEC §10).
+the vertices of polyhedra (docs/reference/files.md).
 
 Its kernel is ``k1_3d_kernel`` (the projection (3.8) from face integrals of the vertex values and
 the stiffness (3.9)), its loads and projected fields ``k1_3d_fields``, its numpy twin
@@ -63,7 +63,7 @@ def stabilization_lengths(mesh) -> np.ndarray:
     t. There a field independent of z with u3 = 0 has the stabilization 2 (mu t) sum_i e_i^2 over the
     two copies of each base vertex: t times the 2D dofi-2mu term, as its consistency term is t times
     the 2D one (plane strain), so that an extruded body with u3 = 0 on its end faces solves to the
-    2D plane-strain solution (SPEC §10). t / 2 scales like h_K on shape-regular prisms."""
+    2D plane-strain solution (docs/reference/files.md). t / 2 scales like h_K on shape-regular prisms."""
     areas = mesh.face_vector_areas
     nz = areas[:, 2] / np.linalg.norm(areas, axis=1)
     signed = mesh.cell_faces

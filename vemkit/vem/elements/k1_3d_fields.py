@@ -1,4 +1,4 @@
-"""The 3D k = 1 element's loads, Dirichlet data and projected fields (Section 3.3, (3.8), SPEC §10).
+"""The 3D k = 1 element's loads, Dirichlet data and projected fields (Section 3.3, (3.8), docs/reference/files.md).
 
 - Cell integrals by a signed tetrahedral fan: cell vertex mean, face vertex mean, one face edge;
   signed volumes make it exact for polynomials on any polyhedron with planar faces, non-convex

@@ -31,7 +31,7 @@ def element_stiffness_reference(coords, lam, mu, stabilization="dofi-2mu"):
     area = float(polygon_areas(coords, [0, n])[0])
     xb, yb = coords.mean(axis=0)
     mats, consts = _p1_basis(xb, yb)
-    C = lambda e: lam * np.trace(e) * np.eye(2) + 2 * mu * e  # noqa: E731  (SPEC §1)
+    C = lambda e: lam * np.trace(e) * np.eye(2) + 2 * mu * e  # noqa: E731  (docs/reference/mathematics.md)
     sym = lambda A: 0.5 * (A + A.T)  # noqa: E731
     stress = [C(sym(A)) for A in mats]
     # a_K(phi_j, q) = int_dK (C eps(q) n) . phi_j ds, phi_j linear on each edge (trapezoid exact)

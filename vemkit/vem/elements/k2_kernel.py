@@ -10,7 +10,7 @@ Local degrees of freedom of a polygon with n vertices (m = 4n + 2 scalars), node
 
 Scaling the paper's moments as means gives every degree of freedom the units of a displacement (a
 vertex value, an edge mean and a cell mean of a smooth field agree to O(h)), so the dofi-dofi form
-S_K of (3.9) weighs them alike; the three scalings alpha_K of SPEC §3 are then used unchanged.
+S_K of (3.9) weighs them alike; the three scalings alpha_K of docs/reference/mathematics.md are then used unchanged.
 The quadratic trace on edge e is v(t) = v_a L0(t) + v_mid Lh(t) + v_b L1(t) with the midpoint value
 v_mid = (6 mean_e - v_a - v_b) / 4 (Simpson's rule is exact for quadratics).
 
@@ -103,7 +103,7 @@ def cell_frame(px, py):
 
 @numba.njit(cache=True)
 def stress_table(lam, mu, h, sig):
-    """sig (9, 3, 3): sigma(q_b) = C eps(q_b) as (sigma11, sigma22, sigma12) x (1, xi, eta), SPEC §1."""
+    """sig (9, 3, 3): sigma(q_b) = C eps(q_b) as (sigma11, sigma22, sigma12) x (1, xi, eta), docs/reference/mathematics.md."""
     for b in range(9):
         for t in range(3):
             e11 = STRAIN[b, 0, t] / h
