@@ -108,7 +108,7 @@ def document_order(data, error) -> tuple:
     return tuple(position)
 
 
-def _branch_names(branches) -> str:
+def branch_names(branches) -> str:
     """What the alternatives of a oneOf accept, in words."""
     names = []
     for branch in map(resolve, branches):
@@ -140,7 +140,7 @@ def schema_error_message(error, fix=scene_fix) -> str:
         if deeper:
             return schema_error_message(jsonschema.exceptions.best_match(deeper), fix)
         title = f" ({schema['title']})" if "title" in schema else ""
-        return f"{key} = {show(value)}: must be {_branch_names(error.validator_value)}{title}; {fix(key)}"
+        return f"{key} = {show(value)}: must be {branch_names(error.validator_value)}{title}; {fix(key)}"
     if "propertyNames" in error.absolute_schema_path:
         return f"{key}: {show(value)} is not a side name (letters, digits, _ and -); fix the scene"
     if keyword == "minProperties":
