@@ -90,3 +90,19 @@ def test_set_names_a_key_of_another_form_of_the_entry(tmp_path):
     refused(run, out, "domain.box belongs to another form of domain (a mapping with box)", "--set 'domain={box: ...}'")
     run, out = solve(tmp_path, BOX, "domain.foo=1")
     refused(run, out, "unknown key 'domain.foo'; allowed here: box, sides")
+
+
+# -- the Poisson ratio's bound names the model ----------------------------------------------------
+@pytest.mark.parametrize(
+    "scene, sets, model",
+    [
+        (BOX, (), "Poisson ratio of the 3D model (model: 3d), below 0.5 where lambda = E nu/((1+nu)(1-2nu))"),
+        (PLATE, ("model=plane_strain",), "Poisson ratio of plane strain, below 0.5 where lambda"),
+        (PLATE, (), "(Poisson ratio of plane stress); fix the scene or --set material.nu=..."),
+    ],
+)
+def test_the_poisson_ratio_bound_names_the_model(tmp_path, scene, sets, model):
+    run, out = solve(tmp_path, scene, "material.nu=0.5", *sets)
+    refused(run, out, "material.nu = 0.5: must be < 0.5", model)
+    if scene is BOX:
+        assert "plane stress" not in run.stderr
