@@ -5,11 +5,13 @@ names the model, a mesh size or an option the body cannot take is one line namin
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import xarray as xr
 import yaml
 
+ROOT = Path(__file__).resolve().parents[2]
 BOX = {
     "name": "box",
     "model": "3d",
@@ -106,3 +108,84 @@ def test_the_poisson_ratio_bound_names_the_model(tmp_path, scene, sets, model):
     refused(run, out, "material.nu = 0.5: must be < 0.5", model)
     if scene is BOX:
         assert "plane stress" not in run.stderr
+
+
+# -- a mesh size or option the body cannot take: the rules of 2D ----------------------------------
+LAME = ROOT / "config" / "scenes" / "3d" / "lame.yaml"
+
+
+@pytest.mark.parametrize("family", ["hex", "voronoi", "tet", "octree"])
+def test_a_cell_size_beyond_any_memory_is_refused_on_a_box(tmp_path, family):
+    run, out = solve(tmp_path, BOX, f"discretization.mesh={{family: {family}, h: 1.0e-300}}")
+    refused(run, out, "discretization.mesh (h = 1e-300): about 1e+300 cells", "across a body of 1 x 1 x 1")
+
+
+@pytest.mark.parametrize("scene, family", [(EXTRUDED, "square"), (EXTRUDED, "voronoi"), (EXTRUDED, "tet")])
+def test_a_cell_size_beyond_any_memory_is_refused_on_an_extruded_body(tmp_path, scene, family):
+    run, out = solve(tmp_path, scene, f"discretization.mesh={{family: {family}, h: 1.0e-300}}")
+    refused(run, out, "discretization.mesh (h = 1e-300): about 1e+300 cells", "across a body of 1 x 1 x 0.5")
+
+
+def test_cells_larger_than_the_body_are_refused_as_in_2d(tmp_path):
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "vemkit.cli",
+            "solve",
+            LAME,
+            "-o",
+            tmp_path / "l.nc",
+            "--set",
+            "discretization.mesh.h=100",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    refused(run, tmp_path / "l.nc", "cells of size 100 on a body of 2 x 2 x 0.1; give h <= 2 (the body's larger side)")
+    run, out = solve(tmp_path, PLATE, "discretization.mesh.h=100", name="plate")
+    refused(run, out, "cells of size 100 on a body of 1 x 1; give h <= 1 (the body's larger side)")
+
+
+def test_a_box_far_from_the_origin_says_to_move_it(tmp_path):
+    run, out = solve(tmp_path, BOX, "domain.box=[[1.0e9, 0, 0], [1000000001, 1, 1]]")
+    refused(run, out, "at |x|, |y|, |z| up to 1e+09", "too fine for double precision there", "(shift domain.box)")
+
+
+@pytest.mark.parametrize(
+    "scene, mesh, says",
+    [
+        (
+            BOX,
+            "{family: octree, n: 2, contact_side: lid}",
+            "contact_side = 'lid': the octree family refines towards a side of the body; give one of left, right, "
+            "front, back, bottom, top",
+        ),
+        (BOX, "{family: octree, cells: 100, contact_side: lid}", "contact_side = 'lid'"),
+        (BOX, "{family: octree, n: 2, levels: 2}", "discretization.mesh.levels = 2: the octree family refines one"),
+        (
+            EXTRUDED,
+            "{family: hanging, n: 2, contact_side: lid}",
+            "contact_side = 'lid': the hanging family refines towards a side of the body; give one of bottom, right",
+        ),
+    ],
+)
+def test_a_refinement_option_the_body_cannot_take_names_the_key(tmp_path, scene, mesh, says):
+    run, out = solve(tmp_path, scene, f"discretization.mesh={mesh}")
+    refused(run, out, says)
+
+
+# -- a body beyond double precision says so -------------------------------------------------------
+@pytest.mark.parametrize(
+    "scene, override, says",
+    [
+        (EXTRUDED, "domain.extrude.depth=1.0e12", "domain.extrude.depth = 1e+12: a body of 1 x 1 x 1e+12 is 1.0e+12"),
+        (EXTRUDED, "domain.extrude.depth=1.0e-300", "domain.extrude.depth = 1e-300: a body of 1 x 1 x 1e-300"),
+        (BOX, "domain.box[1][2]=1.0e-7", "domain.box: a box of 1 x 1 x 1e-07 is 1.0e+07 times longer than thick"),
+    ],
+)
+def test_a_body_too_thin_for_double_precision_says_so(tmp_path, scene, override, says):
+    run, out = solve(tmp_path, scene, override, "boundary.dirichlet.bottom=[0, 0, 0]")
+    refused(run, out, says, "beyond what a mesh resolves in double precision")
+    assert "rotation" not in run.stderr
