@@ -189,3 +189,29 @@ def test_a_body_too_thin_for_double_precision_says_so(tmp_path, scene, override,
     run, out = solve(tmp_path, scene, override, "boundary.dirichlet.bottom=[0, 0, 0]")
     refused(run, out, says, "beyond what a mesh resolves in double precision")
     assert "rotation" not in run.stderr
+
+
+def _cube_file(path, x0):
+    """A gmsh 2.2 file of one hexahedron [x0, x0 + 1] x [0, 1]², its faces bottom, top and sides."""
+    corners = [(x0 + i, j, k) for k in (0, 1) for j in (0, 1) for i in (0, 1)]
+    faces = {10: [(1, 3, 4, 2)], 11: [(5, 6, 8, 7)], 12: [(1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)]}
+    rows = [(3, tag, face) for tag, group in faces.items() for face in group] + [(5, 1, (1, 2, 4, 3, 5, 6, 8, 7))]
+    lines = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", "4", '3 1 "body"', '2 10 "bottom"']
+    lines += ['2 11 "top"', '2 12 "sides"', "$EndPhysicalNames", "$Nodes", "8"]
+    lines += [f"{i + 1} {x!r} {float(y)!r} {float(z)!r}" for i, (x, y, z) in enumerate(corners)]
+    lines += ["$EndNodes", "$Elements", str(len(rows))]
+    lines += [f"{k + 1} {kind} 2 {tag} {tag} " + " ".join(map(str, nodes)) for k, (kind, tag, nodes) in enumerate(rows)]
+    path.write_text("\n".join([*lines, "$EndElements", ""]))
+
+
+def test_a_mesh_file_far_from_the_origin_says_so_as_in_2d(tmp_path):
+    scene = {k: v for k, v in BOX.items() if k != "domain"}
+    scene["discretization"] = {"mesh": {"file": "cube.msh"}}
+    _cube_file(tmp_path / "cube.msh", 0.0)
+    run, out = solve(tmp_path, scene)
+    assert run.returncode == 0, run.stderr
+    out.unlink()
+    _cube_file(tmp_path / "cube.msh", 1.0e9)
+    run, out = solve(tmp_path, scene)
+    refused(run, out, "cube.msh: edge (", "at |x|, |y|, |z| = 1e+09", "shift the mesh near the origin")
+    assert "not planar" not in run.stderr
