@@ -78,3 +78,18 @@ def test_a_million_points_take_well_under_a_second_and_linear_memory():
     strip = np.stack([np.linspace(0, 200, 200_001), np.zeros(200_001)], axis=1)  # clamped straight base
     assert free_rigid_motion(strip, np.ones_like(strip, bool)) is None
     assert free_rigid_motion(strip, np.array([[True, False]] * strip.shape[0])) == "a translation in y"
+
+
+def test_the_3d_test_is_relative_per_axis():
+    """A thin plate clamped on a narrow face holds the spin about its thin axis (an eigenvalue of S
+    1e-15 of the others); a clamped line in any direction, at any scale, leaves the spin about it."""
+    s = np.linspace(0.0, 1.0, 5)
+    for thin in (1e-3, 1e-7):  # the face x = 0 of [0, 1] x [0, 1] x [0, thin], and of its transpose
+        face = np.array([[0.0, y, z * thin] for y in s for z in s])
+        assert free_rigid_motion(face, np.ones_like(face, bool)) is None
+        assert free_rigid_motion(face[:, [1, 2, 0]] * 1e3, np.ones_like(face, bool)) is None
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        d, scale = rng.normal(size=3), 10 ** rng.uniform(-3, 6)
+        line = rng.normal(size=3) * scale + np.outer(rng.uniform(-1, 1, 20) * scale * 10 ** rng.uniform(-6, 3), d)
+        assert free_rigid_motion(line, np.ones_like(line, bool)).startswith("a rotation about the axis")

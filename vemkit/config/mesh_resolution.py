@@ -17,6 +17,13 @@ internal error, a hang or a mesh that silently lost a hole. Refused with one lin
   (1 in 8 seeds fail at 0.25 h; none at 0.3 h);
 - **hanging towards a side the body does not have** (``contact_side`` defaults to ``bottom``).
 
+A 3D body (a box, an extruded domain: :func:`check_mesh_resolution3d`) has the same size rules, its
+extent along z included (3D Voronoi fails from 4e5 cells from the origin, like the 2D one), the
+octree's finest cells h / 2 and its refined side, the base's own rules at the same h (prisms over
+its 2D mesh, or tet), and one more: its smallest side at least ``MIN_FEATURE`` x its largest (a box
+of 1 x 1 x 1e-7, a square extruded to 1e12: the rigid motions and the faces' planes of such a body
+are rounding noise).
+
 :func:`thin_part_triangles` predicts the triangles Triangle's quality mesh adds in parts of the body
 thinner than h (a strip of width w and length L needs about 2 L / w of them whatever h is): the
 resource estimate of :mod:`vemkit.config.limits` adds them, so a 1 x 1e-9 strip is refused with its
@@ -31,6 +38,7 @@ import numpy as np
 import shapely
 
 from vemkit.config.domain import CircleHole, Domain, cells_per_length, domain_from_spec
+from vemkit.config.domain3d import Box, Extruded, cells_per_length3d
 from vemkit.exceptions import SceneError
 
 __all__ = [
@@ -38,7 +46,10 @@ __all__ = [
     "MAX_COORDINATE_OVER_CELL",
     "MIN_FEATURE",
     "VORONOI_MIN_HOLE",
+    "check_cells",
     "check_mesh_resolution",
+    "check_mesh_resolution3d",
+    "check_refined_side",
     "scene_cells_per_length",
     "thin_part_triangles",
 ]
@@ -68,47 +79,131 @@ def _extent(domain: Domain) -> tuple:
     return max(x1 - x0, y1 - y0), max(abs(x0), abs(x1), abs(y0), abs(y1)), (x1 - x0, y1 - y0)
 
 
-def check_mesh_resolution(mesh: dict, domain: Domain) -> None:
-    """SceneError if the mesh size of ``discretization.mesh`` cannot mesh ``domain`` (module doc)."""
-    if "file" in mesh:
-        return
-    family, h = mesh["family"], cell_size(mesh, domain)
-    size, reach, (width, height) = _extent(domain)
-    given = ", ".join(f"{k} = {mesh[k]:g}" for k in ("n", "h", "cells") if k in mesh)
+def _given(mesh: dict) -> str:
+    return ", ".join(f"{k} = {mesh[k]:g}" for k in ("n", "h", "cells") if k in mesh)
+
+
+def check_cells(mesh: dict, h: float, finest: float, lower, upper, shift: str, structured: bool = False) -> None:
+    """The size rules of 2D and 3D bodies alike (module doc): cells much larger than the body (the box
+    ``lower``, ``upper`` around it, 2 or 3 coordinates), far too many across it, or too fine for double
+    precision at the body's distance from the origin (``finest``: the smallest cell; ``shift``: how
+    to move the body)."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    extents = upper - lower
+    size, reach = float(extents.max()), float(np.abs([lower, upper]).max())
+    body, given = " x ".join(f"{e:.3g}" for e in extents), _given(mesh)
     if h > MAX_CELL_OVER_BODY * size:
         raise SceneError(
-            f"discretization.mesh ({given}): cells of size {h:.3g} on a body of {width:.3g} x {height:.3g}; "
+            f"discretization.mesh ({given}): cells of size {h:.3g} on a body of {body}; "
             f"give h <= {size:.3g} (the body's larger side) or a larger n; {_FIX}",
             key="discretization.mesh",
         )
-    ratio = MAX_COORDINATE_OVER_CELL.get(family, MAX_COORDINATE_OVER_CELL["other"])
+    ratio = MAX_COORDINATE_OVER_CELL.get(mesh["family"], MAX_COORDINATE_OVER_CELL["other"])
     if size > ratio * h:
         raise SceneError(
             f"discretization.mesh ({given}): about {size / h:.2g} cells of size {h:.3g} across a body of "
-            f"{width:.3g} x {height:.3g}, far beyond any memory; give a larger h or a smaller n (at most "
+            f"{body}, far beyond any memory; give a larger h or a smaller n (at most "
             f"{ratio:.0e} cells across); {_FIX}",
             key="discretization.mesh",
         )
-    structured = domain.is_unit_square and family in ("square", "hanging") and float(1.0 / h).is_integer()
-    finest = h / 2 ** int(mesh.get("levels", 1)) if family == "hanging" else h
     if reach > ratio * finest and not structured:
+        axes = ", ".join(f"|{axis}|" for axis in "xyz"[: extents.size])
         raise SceneError(
-            f"discretization.mesh ({given}): cells of size {finest:.3g} at |x|, |y| up to {reach:.3g}, more "
+            f"discretization.mesh ({given}): cells of size {finest:.3g} at {axes} up to {reach:.3g}, more "
             f"than {ratio:.0e} cells from the origin: too fine for double precision there; move the body "
-            "near the origin (shift domain.polygon and the holes), or use coarser cells (fewer levels)",
+            f"near the origin ({shift}), or use coarser cells (fewer levels)",
             key="discretization.mesh",
         )
+
+
+def check_refined_side(mesh: dict, sides) -> None:
+    """A family that refines towards ``contact_side`` (hanging, octree) needs a side the body has."""
+    side = mesh.get("contact_side", "bottom")
+    if mesh.get("rule", "contact") == "contact" and side not in sides:
+        raise SceneError(
+            f"discretization.mesh.contact_side = {side!r}: the {mesh['family']} family refines towards a side "
+            f"of the body; give one of {', '.join(dict.fromkeys(sides))} (or rule: random)",
+            key="discretization.mesh.contact_side",
+        )
+
+
+def check_mesh_resolution(mesh: dict, domain: Domain, h: float | None = None) -> None:
+    """SceneError if the mesh size of ``discretization.mesh`` cannot mesh ``domain`` (module doc);
+    ``h``: the cell size when another rule than the 2D one gives it (the base of a 3D body)."""
+    if "file" in mesh:
+        return
+    family = mesh["family"]
+    h = cell_size(mesh, domain) if h is None else h
+    x0, y0, x1, y1 = domain.bounds
+    structured = domain.is_unit_square and family in ("square", "hanging") and float(1.0 / h).is_integer()
+    finest = h / 2 ** int(mesh.get("levels", 1)) if family == "hanging" else h
+    check_cells(mesh, h, finest, (x0, y0), (x1, y1), "shift domain.polygon and the holes", structured)
+    size = _extent(domain)[0]
     _check_features(domain, max(h, size / 4096), size)
     if family == "voronoi":
         _check_voronoi_holes(domain, h)
-    if family == "hanging" and mesh.get("rule", "contact") == "contact":
-        side = mesh.get("contact_side", "bottom")
-        if side not in domain.side_names:
+    if family == "hanging":
+        check_refined_side(mesh, domain.side_names)
+
+
+def _bounds3d(body) -> tuple:
+    """(lower, upper) corners of a 3D body's bounding box."""
+    if isinstance(body, Box):
+        return np.asarray(body.lower, dtype=float), np.asarray(body.upper, dtype=float)
+    x0, y0, x1, y1 = body.base.bounds
+    return np.array([x0, y0, 0.0]), np.array([x1, y1, body.depth])
+
+
+def _check_aspect(body, lower, upper) -> None:
+    """A body whose smallest side is below ``MIN_FEATURE`` x its largest: no mesh resolves it in double
+    precision (its rigid motions, its faces' planes are rounding noise)."""
+    extents = upper - lower
+    if extents.min() >= MIN_FEATURE * extents.max():
+        return
+    shape = " x ".join(f"{e:.3g}" for e in extents)
+    if isinstance(body, Box):
+        raise SceneError(
+            f"domain.box: a box of {shape} is {extents.max() / extents.min():.1e} times longer than thick, "
+            f"beyond what a mesh resolves in double precision (at most {1 / MIN_FEATURE:.0e}); give sides "
+            f"within a factor {1 / MIN_FEATURE:.0e} of each other",
+            key="domain.box",
+        )
+    base = float(extents[:2].max())
+    raise SceneError(
+        f"domain.extrude.depth = {body.depth:g}: a body of {shape} is {extents.max() / extents.min():.1e} "
+        f"times longer than thick, beyond what a mesh resolves in double precision (at most "
+        f"{1 / MIN_FEATURE:.0e}); give a depth within a factor {1 / MIN_FEATURE:.0e} of the base's size {base:.3g}",
+        key="domain.extrude.depth",
+    )
+
+
+def check_mesh_resolution3d(mesh: dict, body) -> None:
+    """The rules of :func:`check_mesh_resolution` for a 3D body (a Box or an Extruded): its aspect, the
+    cell size against the body (the octree's halves the finest cells), the octree's refined side and
+    level; on an extruded body the base's own rules at the same h (prisms over its 2D mesh, or tet)."""
+    if "file" in mesh:
+        return
+    family = mesh["family"]
+    lower, upper = _bounds3d(body)
+    _check_aspect(body, lower, upper)
+    per_cube = 6.0 if family == "tet" else 2.0 if family == "triangle" else 1.0
+    sizes = {key: mesh[key] for key in ("n", "h", "cells") if key in mesh}
+    h = 1.0 / float(cells_per_length3d(body, **sizes, cells_per_cube=per_cube))
+    shift = "shift domain.box" if isinstance(body, Box) else "shift domain.polygon and the holes"
+    check_cells(mesh, h, h / 2 if family == "octree" else h, lower, upper, shift)
+    if family == "octree":
+        check_refined_side(mesh, body.sides)
+        if int(mesh.get("levels", 1)) != 1:
             raise SceneError(
-                f"discretization.mesh.contact_side = {side!r}: the hanging family refines towards a side "
-                f"of the body; give one of {', '.join(domain.side_names)} (or rule: random)",
-                key="discretization.mesh.contact_side",
+                f"discretization.mesh.levels = {mesh['levels']}: the octree family refines one level; "
+                "set discretization.mesh.levels=1 (or drop it)",
+                key="discretization.mesh.levels",
             )
+    if isinstance(body, Extruded) and family != "tet":
+        check_mesh_resolution(mesh, body.base, h)
+    elif isinstance(body, Extruded):
+        size = _extent(body.base)[0]
+        _check_features(body.base, max(h, size / 4096), size)
 
 
 def _circle_gaps(domain: Domain):

@@ -11,7 +11,7 @@ import copy
 import re
 
 from vemkit.config.safe_yaml import parse_yaml
-from vemkit.config.scene_schema import key_name, resolve, schema_root, show, suggest
+from vemkit.config.scene_schema import branch_names, key_name, resolve, schema_root, show, suggest
 from vemkit.exceptions import SceneError
 
 #: an override of discretization.mesh.KEY removes these keys: one size (docs/reference/files.md), or a file
@@ -23,12 +23,28 @@ _MESH_SIZE_KEYS = {
 }
 
 
-def _branch_for(node: dict, segment: str) -> dict:
-    """The alternative of a oneOf (``domain``: unit_square or a mapping) that has ``segment``."""
-    for branch in map(resolve, node.get("oneOf", ())):
-        if ("items" in branch) if segment.isdigit() else ("properties" in branch):
-            return branch
-    return node
+def _branch_for(node: dict, segment, container, override: str, path: list) -> dict:
+    """The alternative of a oneOf that ``container[segment]`` lives in: for an index a list branch;
+    for a key the branch the container's own keys fit (``domain``: a polygon, box or extrude
+    mapping), else the first that has the key. A key of another branch than the container's is
+    refused: the whole entry must change."""
+    branches = [resolve(branch) for branch in node.get("oneOf", ())]
+    if not branches:
+        return node
+    if isinstance(segment, int):
+        return next((b for b in branches if "items" in b), node)
+    mappings = [b for b in branches if "properties" in b]
+    having = [b for b in mappings if segment in b["properties"]]
+    keys = set(container) if isinstance(container, dict) else set()
+    fitting = [b for b in mappings if keys and keys <= set(b["properties"])]
+    if fitting and having and not any(b in having for b in fitting):
+        other = branch_names([having[0]])
+        raise SceneError(
+            f"--set {override}: {key_name([*path, segment])} belongs to another form of {key_name(path)} "
+            f"({other}) than the scene's; replace the whole entry, e.g. --set '{key_name(path)}={{{segment}: ...}}'",
+            key=key_name([*path, segment]),
+        )
+    return next((b for b in fitting if b in having), None) or (having or fitting or mappings or [node])[0]
 
 
 _KEY_PATH = re.compile(r"[\w-]+(?:\.[\w-]+|\[\d+\])*")
@@ -56,7 +72,7 @@ def _key_segments(override: str, key_text: str) -> list:
 
 def _schema_step(node: dict, segment, container, override: str, path: list) -> dict:
     """The schema of ``container[segment]`` (``container`` the value at ``path``)."""
-    node = _branch_for(node, str(segment))
+    node = _branch_for(node, segment, container, override, path)
     if isinstance(segment, int):
         if not isinstance(container, list) or "items" not in node:
             raise SceneError(
@@ -95,6 +111,15 @@ def _schema_step(node: dict, segment, container, override: str, path: list) -> d
     raise SceneError(f"--set {override}: {key_name(path)!r} has no key {segment!r}", key=key_name(path))
 
 
+def _default(node: dict, data: dict):
+    """The schema's default of a key not in the scene; a vector's (body_force) has a 3D scene's three
+    components."""
+    value = copy.deepcopy(node.get("default", {}))
+    if data.get("model") == "3d" and value == [0.0, 0.0]:
+        value.append(0.0)
+    return value
+
+
 def apply_override(data: dict, override: str) -> None:
     """Apply ``a.b[0].c=value`` to ``data``; every key must exist in the schema, every index in
     the list it indexes."""
@@ -108,7 +133,7 @@ def apply_override(data: dict, override: str) -> None:
         node = _schema_step(node, segment, container, override, path)
         last = position == len(segments) - 1
         if isinstance(segment, str) and not last:
-            container.setdefault(segment, copy.deepcopy(node.get("default", {})))
+            container.setdefault(segment, _default(node, data))
         path.append(segment)
         if not last:
             container = container[segment]

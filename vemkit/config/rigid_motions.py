@@ -14,10 +14,14 @@ nowhere; otherwise a rotation is free iff S is singular, and then about the poin
 (every u1 point on the line y = ȳ_1, every u2 point on x = x̄_2). Each sum is one pass over the
 points; the points are first shifted by one of their own and scaled by the set's extent, so that an
 exactly degenerate set (all u1 points on one line) gives S = 0 exactly and the test is scale-free.
-S counts as singular when its smallest eigenvalue is below ``RANK_TOL``² · max_i n_i: the singular
-value ratio 1e-9 of the full constraint matrix, as before this module (the matrix itself, N x 3, and
-its SVD, quadratic in N, are never formed), or in 3D below ``EIGEN_ROUNDING`` times its largest one
-(the rounding of the eigenvalue solver; the 2D S is one sum, exactly 0 for a degenerate set).
+S counts as singular when a diagonal entry is below ``RANK_TOL``² · max_i n_i (the singular value
+ratio 1e-9 of the full constraint matrix, as before this module; the matrix itself, N x 3, and its
+SVD, quadratic in N, are never formed), or in 3D when the smallest eigenvalue of S scaled to a unit
+diagonal (D^-1/2 S D^-1/2, D = diag S: singular together with S) is below ``EIGEN_ROUNDING`` times its
+largest (the rounding of the eigenvalue solver). The scaling makes the test relative per axis: the
+rotation about the thin axis of a 1 x 1 x 1e-7 plate clamped on a narrow side has an eigenvalue of S
+near 1e-15 of the others, which an unscaled test takes for rounding; the 2D S is one sum, exactly 0
+for a degenerate set.
 """
 
 from __future__ import annotations
@@ -84,7 +88,11 @@ def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | 
         if not prescribed[:, component].any():
             return f"a translation in {_AXES[component]}"
     S, means, counts = _schur(points, prescribed)
-    values, vectors = np.linalg.eigh(S)
-    if values[0] > max(RANK_TOL**2 * counts.max(), EIGEN_ROUNDING * values[-1]):
+    diagonal = np.diag(S).copy()
+    if diagonal.min() <= RANK_TOL**2 * counts.max():  # no spread at all about one axis
+        return _rotation_words(points, np.eye(S.shape[0])[:, int(np.argmin(diagonal))], means)
+    scale = 1.0 / np.sqrt(diagonal)
+    values, vectors = np.linalg.eigh(S * np.outer(scale, scale))
+    if values[0] > EIGEN_ROUNDING * values[-1]:
         return None
-    return _rotation_words(points, vectors[:, 0], means)
+    return _rotation_words(points, scale * vectors[:, 0], means)

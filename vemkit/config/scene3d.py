@@ -27,6 +27,7 @@ from vemkit.config.boundary_conditions import (
     rigid_motion_error,
 )
 from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
+from vemkit.config.mesh_resolution import check_mesh_resolution3d
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
 
@@ -161,6 +162,7 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
     body = None if from_file else domain3d_from_spec(data["domain"])
     if body is not None:
         _check_family(data["discretization"]["mesh"], body)
+        check_mesh_resolution3d(data["discretization"]["mesh"], body)
     check_sides(data, None if body is None else body.side_names)
     probes = None if body is None else BodyProbes(body)
     compiled = boundary_expressions(data, None, probes, DIMENSION)

@@ -108,7 +108,7 @@ def document_order(data, error) -> tuple:
     return tuple(position)
 
 
-def _branch_names(branches) -> str:
+def branch_names(branches) -> str:
     """What the alternatives of a oneOf accept, in words."""
     names = []
     for branch in map(resolve, branches):
@@ -130,7 +130,16 @@ def _took_branch(value, branch: dict) -> bool:
     return set(branch.get("required", ())) <= set(value) and set(value) <= set(branch["properties"])
 
 
-def schema_error_message(error, fix=scene_fix) -> str:
+def _title(schema: dict, model) -> str:
+    """`` (title)`` of a schema node; a key whose meaning depends on the model (``material.nu``) has
+    one per model (``x-title-by-model``)."""
+    titles = schema.get("x-title-by-model", {})
+    title = titles.get(model, schema.get("title")) if isinstance(model, str) else schema.get("title")
+    return f" ({title})" if title else ""
+
+
+def schema_error_message(error, fix=scene_fix, model: str | None = "plane_stress") -> str:
+    """The one line of a schema ``error`` (``model``: the scene's, for titles that depend on it)."""
     path, keyword, schema = list(error.absolute_path), error.validator, resolve(error.schema)
     key, value = key_name(path), error.instance
     if keyword == "oneOf":  # the value took one branch when the problem lies inside it: report that
@@ -138,9 +147,9 @@ def schema_error_message(error, fix=scene_fix) -> str:
         taken = [e for e in deeper if _took_branch(value, error.validator_value[e.relative_schema_path[0]])]
         deeper = taken or deeper  # a mapping with a branch's required keys took that branch (domain: polygon, box)
         if deeper:
-            return schema_error_message(jsonschema.exceptions.best_match(deeper), fix)
+            return schema_error_message(jsonschema.exceptions.best_match(deeper), fix, model)
         title = f" ({schema['title']})" if "title" in schema else ""
-        return f"{key} = {show(value)}: must be {_branch_names(error.validator_value)}{title}; {fix(key)}"
+        return f"{key} = {show(value)}: must be {branch_names(error.validator_value)}{title}; {fix(key)}"
     if "propertyNames" in error.absolute_schema_path:
         return f"{key}: {show(value)} is not a side name (letters, digits, _ and -); fix the scene"
     if keyword == "minProperties":
@@ -181,8 +190,7 @@ def schema_error_message(error, fix=scene_fix) -> str:
             "minLength": "must not be empty",
             "maxLength": f"must be at most {bound} characters",
         }.get(keyword, error.message)
-    title = f" ({schema['title']})" if "title" in schema else ""
-    return f"{key} = {show(value)}: {need}{title}; {fix(key)}"
+    return f"{key} = {show(value)}: {need}{_title(schema, model)}; {fix(key)}"
 
 
 def first_problem(errors, data):
@@ -197,7 +205,7 @@ def validate(data) -> None:
     check_finite(data, [])
     errors = list(schema_validator().iter_errors(data))
     if errors:
-        raise SceneError(schema_error_message(first_problem(errors, data)))
+        raise SceneError(schema_error_message(first_problem(errors, data), model=data.get("model", "plane_stress")))
 
 
 def normalized(value, node: dict):

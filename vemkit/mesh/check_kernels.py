@@ -7,6 +7,8 @@ numbers, the checks decide and word the errors."""
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -81,15 +83,18 @@ def corner_angle_sums(vertices, offsets, cell_vertices):
 @numba.njit(cache=True)
 def worst_coordinate_over_edge(vertices, offsets, cell_vertices):
     """(half-edge, ratio, length, reach) of the half-edge (a, b) with the largest
-    reach / length, reach = max(|x_a|, |y_a|) and length = hypot(x_b - x_a, y_b - y_a) (ratio 0 for
-    length 0; the first of equal ratios; (-1, 0, 0, 0) for no half-edge)."""
+    reach / length, reach = max_i |x_a,i| and length = |x_b - x_a| (hypot over the 2 or 3 coordinates;
+    ratio 0 for length 0; the first of equal ratios; (-1, 0, 0, 0) for no half-edge). The cells are
+    polygons: a 2D mesh's cells or a 3D mesh's faces."""
     worst, worst_ratio, worst_length, worst_reach = -1, 0.0, 0.0, 0.0
     for k in range(offsets.size - 1):
         s, e = offsets[k], offsets[k + 1]
         for h in range(s, e):
             a, b = cell_vertices[h], cell_vertices[h + 1 if h + 1 < e else s]
-            length = np.hypot(vertices[b, 0] - vertices[a, 0], vertices[b, 1] - vertices[a, 1])
-            reach = max(abs(vertices[a, 0]), abs(vertices[a, 1]))
+            length, reach = 0.0, 0.0
+            for i in range(vertices.shape[1]):
+                length = math.hypot(length, vertices[b, i] - vertices[a, i])
+                reach = max(reach, abs(vertices[a, i]))
             ratio = reach / length if length > 0 else 0.0
             if worst < 0 or ratio > worst_ratio:
                 worst, worst_ratio, worst_length, worst_reach = h, ratio, length, reach

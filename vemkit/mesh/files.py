@@ -257,21 +257,26 @@ def _check_precision(mesh: Mesh, path: Path) -> None:
     """An edge far shorter than its distance from the origin loses its cells' shape in double precision
     (a unit square at x = 1e9: its shoelace area is rounding noise): refused naming the file when the
     ratio passes ``MAX_FILE_COORDINATE_OVER_EDGE`` (a plate at 1e6 still solves to 15 digits)."""
-    v, refs = mesh.vertices, mesh.cell_vertices
-    if (
-        v.size == 0
-        or refs.size == 0
-        or not np.isfinite(v).all()
-        or refs.min() < 0
-        or refs.max() >= v.shape[0]
-        or mesh.cell_sizes.min() < 3
-    ):
-        return  # validate_mesh names the vertex or the cell
-    worst, ratio, length, reach = worst_coordinate_over_edge(v, mesh.cell_offsets, refs)
+    if mesh.cell_vertices.size and mesh.cell_sizes.min() >= 3:  # else validate_mesh names the cell
+        check_coordinate_precision(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, path)
+
+
+def check_coordinate_precision(vertices: np.ndarray, offsets: np.ndarray, polygons: np.ndarray, path: Path) -> None:
+    """The check of :func:`_check_precision` on the edges of ``polygons`` (CSR: a 2D mesh's cells, a
+    3D mesh's faces: a cube at x = 1e9 has faces whose planes are rounding noise); broken arrays
+    pass, the validation names them."""
+    v, n = vertices, polygons.size
+    if v.size == 0 or n == 0 or not np.isfinite(v).all() or polygons.min() < 0 or polygons.max() >= v.shape[0]:
+        return
+    if offsets[0] != 0 or offsets[-1] != n or (np.diff(offsets) < 0).any():
+        return
+    worst, ratio, length, reach = worst_coordinate_over_edge(v, offsets, polygons)
     if ratio > MAX_FILE_COORDINATE_OVER_EDGE:
-        a, b = mesh.half_edges[worst]
+        cell = int(np.searchsorted(offsets, worst, side="right")) - 1
+        a, b = polygons[worst], polygons[worst + 1 if worst + 1 < offsets[cell + 1] else offsets[cell]]
+        axes = ", ".join(f"|{axis}|" for axis in "xyz"[: v.shape[1]])
         raise MeshError(
-            f"{path.name}: edge ({a}, {b}) is {length:.3g} long at |x|, |y| = {reach:.3g}, more "
+            f"{path.name}: edge ({a}, {b}) is {length:.3g} long at {axes} = {reach:.3g}, more "
             f"than {MAX_FILE_COORDINATE_OVER_EDGE:.0e} times shorter than its distance from the origin: too "
             "small for double precision there; shift the mesh near the origin",
             key=str(path),

@@ -38,7 +38,7 @@ from vemkit.config.domain import SIDE_NAME
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
 from vemkit.mesh.file_description import FileDescription
-from vemkit.mesh.files import json_scalar
+from vemkit.mesh.files import check_coordinate_precision, json_scalar
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import csr_rows, from_face_soup
 
@@ -179,6 +179,7 @@ def _mesh_from_dataset(ds, path: Path) -> PolyhedralMesh:
 
 
 def _validated(mesh: PolyhedralMesh, path: Path) -> PolyhedralMesh:
+    check_coordinate_precision(mesh.vertices, mesh.face_offsets, mesh.face_vertices, path)  # as in 2D
     try:
         validate_mesh3d(mesh)
     except MeshError as error:
