@@ -205,6 +205,16 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
             if kind == "profiles" and meshed:
                 raise WorkflowConfigError("the grid changes the mesh, so the contact nodes differ between points; "
                                           "drop the profiles figure", path=("sweeps", name, "figures", kind))
+    cases = config["stability"]["cases"]
+    if cases != "all":
+        from vemkit.studies.robustness import CASES
+
+        names = [case["name"] for case in CASES]
+        for i, name in enumerate(cases):
+            if name not in names:
+                raise WorkflowConfigError(f"{name!r} is not a case of the robustness matrix; use all or names of "
+                                          f"vemkit.studies.robustness.CASES, e.g. {', '.join(names[:4])}",
+                                          path=("stability", "cases", i))
     for method, solver in config["stability"]["solvers"].items():
         steps = [(("stability", "solvers", method), f"solver.method={method}")]
         steps += _solver_steps(("stability", "solvers", method), solver)
@@ -267,6 +277,12 @@ def _check_three_d(config, scenes: _Scenes) -> None:
             own = _solver_steps((study, "solver"), spec.get("solver", {}))
             scenes.check((study, "scene"), spec["scene"], inherited + own)
             scenes.check((study, "scene"), spec["scene"], [((study, "nu"), f"material.nu={spec['nu']}")])
+    shifts = config.get("mindlin", {}).get("shifts", [])
+    for i in range(1, len(shifts)):
+        if shifts[i] <= shifts[i - 1]:
+            raise WorkflowConfigError(f"{shifts[i]} <= the shift before it ({shifts[i - 1]}): the tangential steps "
+                                      "move the platen further each time; list the shifts increasing",
+                                      path=("mindlin", "shifts", i))
 
 
 def check_workflow_config(config: dict) -> None:

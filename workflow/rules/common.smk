@@ -70,10 +70,14 @@ def _validated(data, schema):
         cause = error.__cause__ or error.__context__
         if not isinstance(cause, jsonschema.ValidationError):
             raise
+        from vemkit.config.scene_schema import suggest
+
         path = _schema_path(cause)
-        problem = "unknown key" if cause.validator == "additionalProperties" else cause.message
-        raise WorkflowConfigError(f"{problem} (schema: workflow/schemas/{Path(schema).name}); fix the value",
-                                  path=path) from None
+        if cause.validator == "additionalProperties" and isinstance(cause.instance, dict):
+            problem = f"unknown key{suggest(path[-1], cause.schema.get('properties', {}))}"
+        else:
+            problem = f"{cause.message} (workflow/schemas/{Path(schema).name}); fix the value"
+        raise WorkflowConfigError(problem, path=path) from None
 
 
 def _validate_config():
