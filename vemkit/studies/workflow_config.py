@@ -75,7 +75,7 @@ class _Scenes:
             try:
                 self._loaded[scene_path] = load_scene(scene_path).data
             except SceneError as error:
-                raise WorkflowConfigError(f"the scene {scene_path!r} is refused: {error}", path=path_key) from None
+                raise WorkflowConfigError(f"the scene file is refused: {error}", path=path_key) from None
         return copy.deepcopy(self._loaded[scene_path])
 
     @staticmethod
@@ -101,11 +101,10 @@ class _Scenes:
         overrides = extra + [o for _, o in steps]
         if not steps or self.refusal(copy.deepcopy(base), overrides) is None:
             return
-        for i, (path, override) in enumerate(steps):
+        for i, (path, _) in enumerate(steps):
             problem = self.refusal(copy.deepcopy(base), extra + [o for _, o in steps[: i + 1]])
             if problem:
-                value = override.partition("=")[2]
-                raise WorkflowConfigError(f"{value} is refused by the scene {scene_path}: {problem}", path=path)
+                raise WorkflowConfigError(f"the scene {scene_path} refuses it: {problem}", path=path)
 
 
 def _solver_steps(prefix, solver: dict):
@@ -144,27 +143,38 @@ def _check_paper(config, scenes: _Scenes) -> None:
     used += [(("figures", k, "mesh"), fig[k]["mesh"]) for k in ("deformed", "contact")]
     for path, label in used:
         if label not in meshes:
-            raise WorkflowConfigError(f"{label!r} is not a mesh family label; use one of meshes: {', '.join(meshes)}",
-                                      path=path)
+            raise WorkflowConfigError(
+                f"{label!r} is not a mesh family label; use one of meshes: {', '.join(meshes)}", path=path
+            )
     for label, spec in meshes.items():
         _mesh_options(("meshes", label, "options"), spec["family"], levels[0], spec.get("options"))
     for i, n in enumerate(config["levels"]):
         if n >= ref["n"]:
-            raise WorkflowConfigError(f"{n} >= reference.n = {ref['n']}: errors are measured against the finer "
-                                      "reference; drop the level or refine the reference", path=("levels", i))
+            raise WorkflowConfigError(
+                f"{n} >= reference.n = {ref['n']}: errors are measured against the finer "
+                "reference; drop the level or refine the reference",
+                path=("levels", i),
+            )
     at = [(("figures", "fields", k), v) for k, v in fig["fields"].items()]
     for key, spec_at in at + [(("figures", "deformed"), fig["deformed"]), (("figures", "contact"), fig["contact"])]:
         spec = meshes[spec_at["mesh"]]
         delaunay = spec["family"] == "triangle" and spec.get("options", {}).get("kind", "delaunay") == "delaunay"
         if not float(spec_at["n"]).is_integer() and not delaunay:
-            raise WorkflowConfigError(f"{spec_at['n']}: only the Delaunay triangle family takes a non-integer n; "
-                                      "give an integer", path=(*key, "n"))
+            raise WorkflowConfigError(
+                f"{spec_at['n']}: only the Delaunay triangle family takes a non-integer n; give an integer",
+                path=(*key, "n"),
+            )
     if ref["n"] not in (2**k for k in range(1, 16)):
-        raise WorkflowConfigError(f"{ref['n']}: the error measure needs n a power of 2 (nested with the square "
-                                  "levels); use 256", path=("reference", "n"))
+        raise WorkflowConfigError(
+            f"{ref['n']}: the error measure needs n a power of 2 (nested with the square levels); use 256",
+            path=("reference", "n"),
+        )
     if meshes[ref["mesh"]]["family"] != "square":
-        raise WorkflowConfigError(f"{ref['mesh']!r} is a {meshes[ref['mesh']]['family']} family: the error "
-                                  "measure needs a square reference mesh", path=("reference", "mesh"))
+        raise WorkflowConfigError(
+            f"{ref['mesh']!r} is a {meshes[ref['mesh']]['family']} family: the error "
+            "measure needs a square reference mesh",
+            path=("reference", "mesh"),
+        )
     steps = _override_steps(("overrides",), config["overrides"]) + _solver_steps(("solver",), config["solver"])
     scenes.check(("scene",), config["scene"], steps)
     from vemkit.studies.solution_order import require_order1
@@ -184,8 +194,9 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
     scenes.check(("studies_scene",), scene, base)
     base_overrides = [o for _, o in base]
     defaults = config["sweep_defaults"]
-    scenes.check(("studies_scene",), scene, _solver_steps(("sweep_defaults", "solver"), defaults["solver"]),
-                 base_overrides)
+    scenes.check(
+        ("studies_scene",), scene, _solver_steps(("sweep_defaults", "solver"), defaults["solver"]), base_overrides
+    )
     for name, spec in config["sweeps"].items():
         own = _override_steps(("sweeps", name, "overrides"), spec["overrides"])
         solver = _solver_steps(("sweeps", name, "solver"), spec.get("solver", {}))
@@ -200,11 +211,15 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
             used = [figure[a] for a in ("x", "y", "hue", "across") if a in figure] + list(figure.get("select", {}))
             for dim in used:
                 if dim not in dims:
-                    raise WorkflowConfigError(f"{dim!r} is not a dimension of the grid ({', '.join(dims)})",
-                                              path=("sweeps", name, "figures", kind))
+                    raise WorkflowConfigError(
+                        f"{dim!r} is not a dimension of the grid ({', '.join(dims)})",
+                        path=("sweeps", name, "figures", kind),
+                    )
             if kind == "profiles" and meshed:
-                raise WorkflowConfigError("the grid changes the mesh, so the contact nodes differ between points; "
-                                          "drop the profiles figure", path=("sweeps", name, "figures", kind))
+                raise WorkflowConfigError(
+                    "the grid changes the mesh, so the contact nodes differ between points; drop the profiles figure",
+                    path=("sweeps", name, "figures", kind),
+                )
     cases = config["stability"]["cases"]
     if cases != "all":
         from vemkit.studies.robustness import CASES
@@ -212,9 +227,11 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
         names = [case["name"] for case in CASES]
         for i, name in enumerate(cases):
             if name not in names:
-                raise WorkflowConfigError(f"{name!r} is not a case of the robustness matrix; use all or names of "
-                                          f"vemkit.studies.robustness.CASES, e.g. {', '.join(names[:4])}",
-                                          path=("stability", "cases", i))
+                raise WorkflowConfigError(
+                    f"{name!r} is not a case of the robustness matrix; use all or names of "
+                    f"vemkit.studies.robustness.CASES, e.g. {', '.join(names[:4])}",
+                    path=("stability", "cases", i),
+                )
     for method, solver in config["stability"]["solvers"].items():
         steps = [(("stability", "solvers", method), f"solver.method={method}")]
         steps += _solver_steps(("stability", "solvers", method), solver)
@@ -226,19 +243,25 @@ def _check_tradeoff(config, scenes: _Scenes) -> None:
     for i, gain in enumerate(tradeoff["refinement_gain"]):
         for key in ("uniform", "refined"):
             if gain[key] not in tradeoff["families"]:
-                raise WorkflowConfigError(f"{gain[key]!r} is not a family of tradeoff.families "
-                                          f"({', '.join(tradeoff['families'])})", path=("tradeoff", "refinement_gain", i, key))
+                raise WorkflowConfigError(
+                    f"{gain[key]!r} is not a family of tradeoff.families ({', '.join(tradeoff['families'])})",
+                    path=("tradeoff", "refinement_gain", i, key),
+                )
     for i, n in enumerate(tradeoff["levels"]):
         if n > ref_n:
-            raise WorkflowConfigError(f"{n} > reference.n = {ref_n} (config/config.yaml): errors are measured "
-                                      "against the finer reference", path=("tradeoff", "levels", i))
+            raise WorkflowConfigError(
+                f"{n} > reference.n = {ref_n} (config/config.yaml): errors are measured against the finer reference",
+                path=("tradeoff", "levels", i),
+            )
     for label, spec in tradeoff["families"].items():
-        _mesh_options(("tradeoff", "families", label, "options"), spec["family"], min(tradeoff["levels"]),
-                      spec.get("options"))
+        _mesh_options(
+            ("tradeoff", "families", label, "options"), spec["family"], min(tradeoff["levels"]), spec.get("options")
+        )
     paper = config["overrides"] + [f"solver.{k}={v}" for k, v in config["solver"].items()]
     steps = [(("tradeoff", "tolerances", i), f"solver.tol={tol}") for i, tol in enumerate(tradeoff["tolerances"])]
-    steps += [(("tradeoff", "max_iterations", m), f"solver.max_iterations={v}")
-              for m, v in tradeoff["max_iterations"].items()]
+    steps += [
+        (("tradeoff", "max_iterations", m), f"solver.max_iterations={v}") for m, v in tradeoff["max_iterations"].items()
+    ]
     for step in steps:
         scenes.check(("scene",), config["scene"], [step], paper)
 
@@ -247,8 +270,11 @@ def _check_tradeoff(config, scenes: _Scenes) -> None:
 def _check_adaptivity(config, scenes: _Scenes) -> None:
     for label, case in config["adaptivity_study"]["scenes"].items():
         if Path(case["scene"]).is_file():  # a scene whose file does not exist is skipped (by design)
-            scenes.check(("adaptivity_study", "scenes", label, "scene"), case["scene"],
-                         _override_steps(("adaptivity_study", "scenes", label, "overrides"), case.get("overrides", [])))
+            scenes.check(
+                ("adaptivity_study", "scenes", label, "scene"),
+                case["scene"],
+                _override_steps(("adaptivity_study", "scenes", label, "overrides"), case.get("overrides", [])),
+            )
 
 
 def _check_three_d(config, scenes: _Scenes) -> None:
@@ -267,7 +293,8 @@ def _check_three_d(config, scenes: _Scenes) -> None:
         raise WorkflowConfigError(
             f"{level} is {'above' if level >= 0 else 'below'} the number of levels ({count}) of "
             f"three_d.manufactured.{fewest[0]}; use 0..{count - 1} (or -{count}..-1, counted from the finest)",
-            path=("three_d", "figure_level"))
+            path=("three_d", "figure_level"),
+        )
     for study in ("lame", "plane_strain", "plane_stress"):
         scenes.check(("three_d", study, "scene"), three_d[study]["scene"], solver)
     for study in ("hertz", "mindlin"):
@@ -280,9 +307,11 @@ def _check_three_d(config, scenes: _Scenes) -> None:
     shifts = config.get("mindlin", {}).get("shifts", [])
     for i in range(1, len(shifts)):
         if shifts[i] <= shifts[i - 1]:
-            raise WorkflowConfigError(f"{shifts[i]} <= the shift before it ({shifts[i - 1]}): the tangential steps "
-                                      "move the platen further each time; list the shifts increasing",
-                                      path=("mindlin", "shifts", i))
+            raise WorkflowConfigError(
+                f"{shifts[i]} <= the shift before it ({shifts[i - 1]}): the tangential steps "
+                "move the platen further each time; list the shifts increasing",
+                path=("mindlin", "shifts", i),
+            )
 
 
 def check_workflow_config(config: dict) -> None:
@@ -294,4 +323,3 @@ def check_workflow_config(config: dict) -> None:
     _check_tradeoff(config, scenes)
     _check_adaptivity(config, scenes)
     _check_three_d(config, scenes)
-
