@@ -152,6 +152,18 @@ BROKEN = {
         "stability.cases[1]",
         ["robustness"],
     ),
+    "sweep-figure-select": (
+        {"sweeps": {"exponent-gap": {"figures": {"map": {"select": {"k_nu": 11.0}}}}}},
+        "extras",
+        "sweeps.exponent-gap.figures.map.select.k_nu",
+        ["not a value of the grid's k_nu"],
+    ),
+    "sweep-figure-axis": (
+        {"sweeps": {"exponent-gap": {"figures": {"lines": {"hue": "contact_normal_m"}}}}},
+        "extras",
+        "sweeps.exponent-gap.figures.lines.hue",
+        ["m_nu"],
+    ),
     "mindlin-shifts": ({"mindlin": {"shifts": [0.002, 0.001]}}, "three_d", "mindlin.shifts[1]", ["increasing"]),
     "unknown-key": ({"three_d": {"figure_levle": 1}}, "three_d", "three_d.figure_levle", ["figure_level"]),
 }

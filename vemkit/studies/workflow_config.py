@@ -208,12 +208,20 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
         dims = [dimension_name(k) for k in spec["grid"]]
         meshed = any(k.startswith("discretization.mesh") for k in spec["grid"])
         for kind, figure in spec["figures"].items():
-            used = [figure[a] for a in ("x", "y", "hue", "across") if a in figure] + list(figure.get("select", {}))
-            for dim in used:
+            used = [((a,), figure[a]) for a in ("x", "y", "hue", "across") if a in figure]
+            used += [(("select", dim), dim) for dim in figure.get("select", {})]
+            for where, dim in used:
                 if dim not in dims:
                     raise WorkflowConfigError(
-                        f"{dim!r} is not a dimension of the grid ({', '.join(dims)})",
-                        path=("sweeps", name, "figures", kind),
+                        f"{dim!r} is not a dimension of the grid; use one of {', '.join(dims)}",
+                        path=("sweeps", name, "figures", kind, *where),
+                    )
+            for dim, value in figure.get("select", {}).items():
+                values = next(v for k, v in spec["grid"].items() if dimension_name(k) == dim)
+                if value not in values:
+                    raise WorkflowConfigError(
+                        f"{value!r} is not a value of the grid's {dim} ({', '.join(map(str, values))}); use one of them",
+                        path=("sweeps", name, "figures", kind, "select", dim),
                     )
             if kind == "profiles" and meshed:
                 raise WorkflowConfigError(
