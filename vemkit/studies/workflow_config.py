@@ -21,9 +21,16 @@ from pathlib import Path
 import jsonschema
 
 from vemkit.config.overrides import apply_override
-from vemkit.config.scene import load_scene, scene_from_dict
-from vemkit.config.scene_schema import check_finite, first_problem, schema_error_message, schema_root
-from vemkit.exceptions import SceneError, WorkflowConfigError
+from vemkit.config.safe_yaml import parse_yaml, read_user_file
+from vemkit.config.scene import scene_from_dict
+from vemkit.config.scene_schema import (
+    check_finite,
+    first_problem,
+    schema_error_message,
+    schema_root,
+    schema_validator,
+)
+from vemkit.exceptions import InputError, SceneError, WorkflowConfigError
 from vemkit.studies.sweep_dimensions import dimension_name
 
 __all__ = ["check_workflow_config", "config_source"]
@@ -65,44 +72,59 @@ def config_source(path, layers) -> str:
 
 # -- values forwarded into a scene ----------------------------------------------------------------
 class _Scenes:
-    """Scenes loaded once per file; a refusal of a forwarded value names its config key."""
+    """Scene files read once; a refusal of a forwarded value names its config key. Only ``solver.*``
+    values (no check beyond the schema reads the solver section): the schema alone, else the scene's
+    whole validation (expressions, sides, 3D limits)."""
 
     def __init__(self):
-        self._loaded = {}
+        self._read = {}
+        self._passed = set()  # (scene file, overrides) found valid
 
     def data(self, path_key, scene_path) -> dict:
-        if scene_path not in self._loaded:
+        """The scene file's plain data, as the jobs read it (the overrides go on top)."""
+        if scene_path not in self._read:
             try:
-                self._loaded[scene_path] = load_scene(scene_path).data
-            except SceneError as error:
+                data = parse_yaml(read_user_file(Path(scene_path)), str(scene_path))
+            except InputError as error:
                 raise WorkflowConfigError(f"the scene file is refused: {error}", path=path_key) from None
-        return copy.deepcopy(self._loaded[scene_path])
+            if not isinstance(data, dict):
+                raise WorkflowConfigError(f"{scene_path}: not a scene (a mapping of keys)", path=path_key)
+            self._read[scene_path] = data
+        return copy.deepcopy(self._read[scene_path])
 
     @staticmethod
-    def refusal(data: dict, overrides) -> str | None:
+    def refusal(data: dict, overrides, whole: bool) -> str | None:
         """Why the scene ``data`` with ``overrides`` applied is refused (None: it is not)."""
         try:
             for override in overrides:
                 apply_override(data, override)
             check_finite(data, [], _fix)
-            errors = list(jsonschema.Draft202012Validator(schema_root()).iter_errors(data))
+            errors = list(schema_validator().iter_errors(data))
             if errors:
                 return schema_error_message(first_problem(errors, data), _fix)
-            scene_from_dict(data)  # the checks beyond the schema (expressions, sides, ...)
-        except SceneError as error:
+            if whole:
+                scene_from_dict(data)  # the checks beyond the schema (expressions, sides, ...)
+        except InputError as error:  # SceneError, ExpressionError, MeshError
             return str(error)
         return None
 
     def check(self, scene_key, scene_path, steps, extra=()) -> None:
         """``steps``: [(config path, override)] in the order the job applies them, after ``extra``
-        (overrides already checked); the first one that makes the scene invalid is blamed."""
+        (overrides checked before); the first one that makes the scene invalid is blamed."""
         base = self.data(scene_key, scene_path)
         extra = list(extra)
         overrides = extra + [o for _, o in steps]
-        if not steps or self.refusal(copy.deepcopy(base), overrides) is None:
+        if not steps or (scene_path, tuple(overrides)) in self._passed:
             return
+        whole = not all(o.startswith("solver.") for o in overrides)
+        if self.refusal(copy.deepcopy(base), overrides, whole) is None:
+            self._passed.add((scene_path, tuple(overrides)))
+            return
+        problem = self.refusal(copy.deepcopy(base), extra, whole)
+        if problem:  # the scene itself (with what was checked before)
+            raise WorkflowConfigError(f"the scene file is refused: {scene_path}: {problem}", path=scene_key)
         for i, (path, _) in enumerate(steps):
-            problem = self.refusal(copy.deepcopy(base), extra + [o for _, o in steps[: i + 1]])
+            problem = self.refusal(copy.deepcopy(base), extra + [o for _, o in steps[: i + 1]], whole)
             if problem:
                 raise WorkflowConfigError(f"the scene {scene_path} refuses it: {problem}", path=path)
 
@@ -179,11 +201,12 @@ def _check_paper(config, scenes: _Scenes) -> None:
     scenes.check(("scene",), config["scene"], steps)
     from vemkit.studies.solution_order import require_order1
 
-    data = scenes.data(("scene",), config["scene"])
-    for override in config["overrides"]:
-        apply_override(data, override)
+    try:  # valid after the check above
+        scene = scene_from_dict(scenes.data(("scene",), config["scene"]), config["overrides"])
+    except InputError as error:
+        raise WorkflowConfigError(f"the scene file is refused: {config['scene']}: {error}", path=("scene",)) from None
     try:
-        require_order1(scene_from_dict(data), "the paper workflow (Table 1, convergence)")
+        require_order1(scene, "the paper workflow (Table 1, convergence)")
     except SceneError as error:
         raise WorkflowConfigError(str(error), path=("overrides",)) from None
 
