@@ -61,7 +61,7 @@ BROKEN = {
         {"three_d": {"figure_level": 10}},
         "three_d",
         "three_d.figure_level",
-        ["10 is above the number of levels (4)", "use 0..3"],
+        ["10 is not an index of the 4 levels", "use 0..3"],
     ),
     "voronoi-seed": (
         {"meshes": {"voronoi": {"family": "voronoi", "options": {"seed": -1}}}},
@@ -182,7 +182,7 @@ def test_the_file_named_is_the_last_one_that_set_the_key(tmp_path):
     first.write_text(yaml.safe_dump({"three_d": {"figure_level": 10}}))
     second.write_text(yaml.safe_dump({"three_d": {"figure_level": -9}}))
     run = dry_run("three_d", "--configfile", str(first), str(second))
-    assert_refused(run, str(second), "three_d.figure_level", "-9 is below")
+    assert_refused(run, str(second), "three_d.figure_level", "-9 is not an index")
 
 
 def test_a_value_of_the_command_line_is_named_as_config():

@@ -322,8 +322,8 @@ def _check_three_d(config, scenes: _Scenes) -> None:
     if fewest and not -len(fewest[1]) <= level < len(fewest[1]):
         count = len(fewest[1])
         raise WorkflowConfigError(
-            f"{level} is {'above' if level >= 0 else 'below'} the number of levels ({count}) of "
-            f"three_d.manufactured.{fewest[0]}; use 0..{count - 1} (or -{count}..-1, counted from the finest)",
+            f"{level} is not an index of the {count} levels of three_d.manufactured.{fewest[0]}; "
+            f"use 0..{count - 1} (or -{count}..-1, counted from the finest)",
             path=("three_d", "figure_level"),
         )
     for study in ("lame", "plane_strain", "plane_stress"):
