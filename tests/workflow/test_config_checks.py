@@ -158,6 +158,20 @@ BROKEN = {
         "sweeps.exponent-gap.figures.map.select.k_nu",
         ["not a value of the grid's k_nu"],
     ),
+    "sweep-figure-select-held": (
+        {
+            "sweeps": {
+                "tiny": {
+                    **TINY_SWEEP,
+                    "grid": {"contact.normal.k": [1.0, 10.0], "contact.friction.k": [0.0, 450.0]},
+                    "figures": {"lines": {"x": "k_nu", "quantities": ["normal_force"], "select": {"k_tau": 5.0}}},
+                }
+            }
+        },
+        "results/sweeps/tiny/lines.png",
+        "sweeps.tiny.figures.lines.select.k_tau",
+        ["5.0 is not a value of the grid's k_tau (0.0, 450.0)"],
+    ),
     "sweep-figure-axis": (
         {"sweeps": {"exponent-gap": {"figures": {"lines": {"hue": "contact_normal_m"}}}}},
         "extras",

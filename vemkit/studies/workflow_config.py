@@ -239,9 +239,10 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
                         f"{dim!r} is not a dimension of the grid; use one of {', '.join(dims)}",
                         path=("sweeps", name, "figures", kind, *where),
                     )
+            plotted = {figure[a] for a in ("x", "y", "hue", "across") if a in figure}
             for dim, value in figure.get("select", {}).items():
                 values = next(v for k, v in spec["grid"].items() if dimension_name(k) == dim)
-                if value not in values:
+                if dim not in plotted and value not in values:  # the figure holds dim at value
                     raise WorkflowConfigError(
                         f"{value!r} is not a value of the grid's {dim} ({', '.join(map(str, values))}); use one of them",
                         path=("sweeps", name, "figures", kind, "select", dim),
