@@ -4,7 +4,9 @@
 #   snakemake --report report.html       the HTML report
 # Layout: workflow/rules/*.smk (rules), workflow/scripts/ (thin scripts calling vemkit),
 # config/config.yaml, config/sweeps.yaml, config/adaptivity.yaml, config/three_d.yaml (Snakemake's
-# config; add yours with --configfile), validated against workflow/schemas/*.schema.yaml in common.smk.
+# config; add yours with --configfile), checked in common.smk before any job (also in `snakemake -n`):
+# workflow/schemas/*.schema.yaml, then vemkit.studies.workflow_config; a refusal is one line naming the
+# file and the key (docs/paper.md, "The configuration and its checks").
 from snakemake.utils import min_version
 
 min_version("8.0")

@@ -11,7 +11,8 @@ Imports nothing from vemkit.
     │   ├── MeshError                     a mesh (built or read) the solver must not use
     │   ├── ResultError                   a result that must not be written (NaN, wrong shape)
     │   ├── OutputError                   an output path that must not or cannot be written
-    │   └── ResourceLimitError            a request beyond a documented limit or the machine
+    │   ├── ResourceLimitError            a request beyond a documented limit or the machine
+    │   └── WorkflowConfigError           a value of the Snakemake workflow's configuration
     └── SolveError (RuntimeError)         a solve that did not produce a trustworthy answer
         ├── ConvergenceError              a contact solver did not converge (``reason``)
         ├── LinearSolveError              a linear solve failed
@@ -72,6 +73,20 @@ class ResourceLimitError(InputError):
     def __init__(self, message: str = "", *, key: str | None = None, estimate: dict | None = None):
         super().__init__(message, key=key)
         self.estimate = dict(estimate or {})
+
+
+class WorkflowConfigError(InputError):
+    """A value of the workflow's configuration (config/*.yaml, --configfile, --config) refused before any
+    job. ``path``: the config key as segments (``("sweeps", "mine", "grid", "contact.normal.k", 0)``),
+    ``key`` its text (``sweeps.mine.grid.contact.normal.k[0]``); the message says what is wrong and the fix,
+    the Snakefile prefixes the file that set the key."""
+
+    def __init__(self, message: str = "", *, path=()):
+        self.path = tuple(path)
+        text = ""
+        for part in self.path:
+            text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+        super().__init__(message, key=text or "(top level)")
 
 
 #: why a solve failed (``SolveError.reason``); the robustness study classifies by these

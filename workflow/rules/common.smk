@@ -3,14 +3,15 @@
 #
 # The configuration is Snakemake's own `config`: config/config.yaml (the paper) and
 # config/sweeps.yaml (the studies), merged with any `--configfile` / `--config` of the command line.
-# Each part is validated against its schema; a key that neither schema knows is an error.
+# Each part is validated against its schema (a key that no schema knows is an error), then every check
+# beyond the schemas (vemkit.studies.workflow_config): all before any job, also in `snakemake -n`; a
+# refusal is one line naming the file that set the key, the key and the fix (exit 1, no traceback).
+import sys
 from pathlib import Path
 
 import yaml
-from snakemake.exceptions import WorkflowError
-from snakemake.utils import validate
 
-from vemkit.studies.sweep_dimensions import dimension_name
+from vemkit.exceptions import WorkflowConfigError
 
 #: part of the configuration: (schema, the file that sets its defaults)
 CONFIG_PARTS = {
@@ -21,15 +22,47 @@ CONFIG_PARTS = {
 }
 
 
-def config_error(source, key, problem):
-    """The one-line error of a configuration value, naming the key and the file to fix."""
-    return WorkflowError(f"invalid workflow configuration: {key or 'top level'}: {problem}; fix {source} "
-                         "(or the --configfile / --config that set it)")
+def _config_layers():
+    """[(name, data)] of what set the config, lowest priority first: the Snakefile's files, each
+    --configfile, --config."""
+    def shown(path):
+        path = Path(path)
+        try:
+            return str(path.resolve().relative_to(Path.cwd().resolve()))
+        except ValueError:
+            return str(path)
+
+    layers = []
+    for name in [source for _, source in CONFIG_PARTS.values()] + [shown(p) for p in workflow.overwrite_configfiles]:
+        try:
+            layers.append((name, yaml.safe_load(Path(name).read_text(encoding="utf-8")) or {}))
+        except (OSError, yaml.YAMLError):
+            layers.append((name, {}))
+    return layers + [("--config", dict(workflow.config_settings.config or {}))]
 
 
-def _validated(data, schema, source):
-    """Snakemake's validate (fills the defaults in place), its error cut to one line naming the key."""
+def config_failure(error: WorkflowConfigError):
+    """One line naming the file that set the key, the key, the problem and the fix; exit 1, before any job."""
+    from vemkit.studies.workflow_config import config_source
+
+    print(f"{config_source(error.path, _config_layers())}: {error.key}: {error}", file=sys.stderr)
+    raise SystemExit(1)
+
+
+def _schema_path(error):
+    """The config key of a jsonschema error (an unknown key: that key)."""
+    path = list(error.absolute_path)
+    if error.validator == "additionalProperties" and isinstance(error.instance, dict):
+        known = error.schema.get("properties", {})
+        path += [next((k for k in error.instance if k not in known), "?")]
+    return path
+
+
+def _validated(data, schema):
+    """Snakemake's validate (fills the defaults in place), its error as a WorkflowConfigError."""
     import jsonschema
+    from snakemake.exceptions import WorkflowError
+    from snakemake.utils import validate
 
     try:
         validate(data, schema)
@@ -37,25 +70,40 @@ def _validated(data, schema, source):
         cause = error.__cause__ or error.__context__
         if not isinstance(cause, jsonschema.ValidationError):
             raise
-        key = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in cause.absolute_path).lstrip(".")
-        raise config_error(f"{source} (schema: workflow/schemas/{Path(schema).name})", key, cause.message) from None
+        from vemkit.config.scene_schema import suggest
+
+        path = _schema_path(cause)
+        if cause.validator == "additionalProperties" and isinstance(cause.instance, dict):
+            problem = f"unknown key{suggest(path[-1], cause.schema.get('properties', {}))}"
+        else:
+            problem = f"{cause.message} (workflow/schemas/{Path(schema).name}); fix the value"
+        raise WorkflowConfigError(problem, path=path) from None
 
 
 def _validate_config():
+    """Every part against its schema, then the checks beyond the schemas (vemkit.studies.workflow_config:
+    cross-field constraints, every value forwarded into a scene through the scene's validation)."""
+    from vemkit.studies.workflow_config import check_workflow_config
+
     schema_dir = Path(workflow.current_basedir)
     known = set()
-    for schema, source in CONFIG_PARTS.values():
+    for schema, _ in CONFIG_PARTS.values():
         keys = set(yaml.safe_load((schema_dir / schema).read_text(encoding="utf-8"))["properties"])
         part = {k: v for k, v in config.items() if k in keys}
-        _validated(part, schema, source)
+        _validated(part, schema)
         config.update(part)
         known |= keys
     unknown = sorted(set(config) - known)
     if unknown:
-        raise config_error("config/config.yaml or config/sweeps.yaml", unknown[0], "unknown key")
+        raise WorkflowConfigError("unknown key (the workflow reads the keys of workflow/schemas/*.schema.yaml); "
+                                  "drop it or fix its spelling", path=[unknown[0]])
+    check_workflow_config(config)
 
 
-_validate_config()
+try:
+    _validate_config()
+except WorkflowConfigError as error:
+    config_failure(error)
 
 MESHES = config["meshes"]
 STABS = list(config["stabilizations"])
@@ -64,49 +112,6 @@ BATCH = config["batch_levels"]
 REF = config["reference"]
 FIG = config["figures"]
 FIG_STAB = FIG["stabilization"]
-
-
-def _check_config():
-    """What the schema cannot say: every label is defined, every level is below the reference."""
-    used = [("reference.mesh", REF["mesh"]), ("table1.mesh", config["table1"]["mesh"])]
-    used += [(f"convergence[{i}]", label) for i, label in enumerate(config["convergence"])]
-    used += [(f"figures.fields.{k}.mesh", v["mesh"]) for k, v in FIG["fields"].items()]
-    used += [("figures.deformed.mesh", FIG["deformed"]["mesh"]), ("figures.contact.mesh", FIG["contact"]["mesh"])]
-    for key, label in used:
-        if label not in MESHES:
-            raise WorkflowError(f"config {key} = {label!r}: not a mesh family label; defined in meshes: "
-                                f"{', '.join(MESHES)}")
-    high = [n for n in LEVELS if n >= REF["n"]]
-    if high:
-        raise WorkflowError(f"config levels lists {high[0]} >= reference.n = {REF['n']}: errors are measured "
-                            "against the finer reference; drop the level or refine the reference")
-    fig_meshes = [(f"figures.fields.{k}", v) for k, v in FIG["fields"].items()]
-    fig_meshes += [("figures.deformed", FIG["deformed"]), ("figures.contact", FIG["contact"])]
-    for key, at in fig_meshes:
-        spec = MESHES[at["mesh"]]
-        delaunay = spec["family"] == "triangle" and spec.get("options", {}).get("kind", "delaunay") == "delaunay"
-        if not float(at["n"]).is_integer() and not delaunay:
-            raise WorkflowError(f"config {key}.n = {at['n']}: only the Delaunay triangle family takes a "
-                                "non-integer n; give an integer")
-    if REF["n"] not in (2 ** k for k in range(1, 16)) or MESHES[REF["mesh"]]["family"] != "square":
-        raise WorkflowError(f"config reference = {REF}: the error measure needs a square mesh with n a power "
-                            "of 2 (nested with the square levels, docs/reference/mathematics.md)")
-
-
-def _check_order():
-    """The paper workflow measures errors with Pi_1 of vertex values (docs/reference/mathematics.md): k = 1 only."""
-    from vemkit.config.scene import load_scene
-    from vemkit.exceptions import SceneError
-    from vemkit.studies.solution_order import require_order1
-
-    try:
-        require_order1(load_scene(config["scene"], config["overrides"]), "the paper workflow (Table 1, convergence)")
-    except SceneError as error:
-        raise config_error("config/config.yaml (scene, overrides)", "overrides", str(error)) from None
-
-
-_check_config()
-_check_order()
 
 
 def ntag(n):
@@ -174,7 +179,6 @@ SWEEPS = config["sweeps"]
 SWEEP_DEFAULTS = config["sweep_defaults"]
 STABILITY = config["stability"]
 TRADEOFF = config["tradeoff"]
-STUDIES_SOURCE = "config/sweeps.yaml"
 
 
 def studies_scene():
@@ -217,36 +221,6 @@ def tradeoff_settings():
         **{k: v for k, v in TRADEOFF.items() if k != "families"},
     }
 
-
-def _check_sweeps():
-    for name, spec in SWEEPS.items():
-        dims = [dimension_name(k) for k in spec["grid"]]
-        meshed = any(k.startswith("discretization.mesh") for k in spec["grid"])
-        for kind, figure in spec["figures"].items():
-            used = [figure[a] for a in ("x", "y", "hue", "across") if a in figure] + list(figure.get("select", {}))
-            for dim in used:
-                if dim not in dims:
-                    raise config_error(STUDIES_SOURCE, f"sweeps.{name}.figures.{kind}",
-                                       f"{dim!r} is not a dimension of the grid ({', '.join(dims)})")
-            if kind == "profiles" and meshed:
-                raise config_error(STUDIES_SOURCE, f"sweeps.{name}.figures.profiles", "the grid changes the mesh, "
-                                   "so the contact nodes differ between points; drop the profiles figure")
-
-
-def _check_tradeoff():
-    for i, gain in enumerate(TRADEOFF["refinement_gain"]):
-        for key in ("uniform", "refined"):
-            if gain[key] not in TRADEOFF["families"]:
-                raise config_error(STUDIES_SOURCE, f"tradeoff.refinement_gain[{i}].{key}", f"{gain[key]!r} is not "
-                                   f"a family of tradeoff.families ({', '.join(TRADEOFF['families'])})")
-    too_fine = [n for n in TRADEOFF["levels"] if n > REF["n"]]
-    if too_fine:
-        raise config_error(STUDIES_SOURCE, "tradeoff.levels", f"{too_fine[0]} > reference n = {REF['n']} "
-                           "(config/config.yaml): errors are measured against the finer reference")
-
-
-_check_sweeps()
-_check_tradeoff()
 
 SWEEP_TARGETS = [f"results/sweeps/{name}.nc" for name in SWEEPS] + [
     f"results/sweeps/{name}/{kind}.png" for name, spec in SWEEPS.items() for kind in spec["figures"]]
