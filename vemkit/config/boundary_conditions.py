@@ -18,6 +18,7 @@ import numpy as np
 from vemkit.config.domain import Domain
 from vemkit.config.expression_tree import shorten
 from vemkit.config.expressions import Expression, compile_expression
+from vemkit.config.load_poles import check_integrable_on_edges
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import ExpressionError, SceneError
 
@@ -361,7 +362,7 @@ def check_file_sides(scene, header) -> None:
 def check_expressions_on_mesh(scene, mesh) -> None:
     """Every expression finite at the vertices where it acts (a pole at a vertex that the probes
     before meshing missed, or any point of a mesh file's body): tractions and pressures on their
-    sides, the body force and the exact solution everywhere. The gap and the Dirichlet values are
+    sides, and integrable along their edges (2D: :mod:`vemkit.config.load_poles`), the body force and the exact solution everywhere. The gap and the Dirichlet values are
     evaluated at their vertices when they are used."""
     coordinates = tuple(mesh.vertices.T)  # x, y (and z)
     for side in scene.neumann_sides:
@@ -372,5 +373,7 @@ def check_expressions_on_mesh(scene, mesh) -> None:
         pressure = scene.pressure(side)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))
+            if mesh.vertices.shape[1] == 2:  # and between the vertices: a pole inside an edge
+                check_integrable_on_edges(expression, mesh.vertices[parts[:, 0]], mesh.vertices[parts[:, 1]], side)
     for expression in (*scene.body_force, *(scene.exact_displacement or ())):
         evaluate_checked(expression, coordinates)
