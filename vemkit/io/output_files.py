@@ -211,8 +211,8 @@ def _temporary_next_to(target: Path) -> Path:
         except FileExistsError:
             CREATED.discard(name)
             continue
-        except BaseException:
-            CREATED.discard(name)
+        except BaseException:  # made or not: removed if it is there (_discard), never left unlisted
+            _discard([name])
             raise
         return Path(name)
 
@@ -288,9 +288,9 @@ def _signals_deferred():
     try:
         yield received
     finally:
+        _report("free")  # before the handlers go: a signal the parent forwards until it reads this is kept
         for number, handler in previous.items():
             signal.signal(number, handler)
-        _report("free")
 
 
 @contextmanager
