@@ -31,6 +31,17 @@ class MeshPieces:
     def vertices(self, piece: int) -> np.ndarray:
         return np.flatnonzero(self.vertex_piece == piece)
 
+    def point_in(self, mesh, piece: int) -> np.ndarray:
+        """A point of the piece to name it by: the vertex mean of its cell nearest to the vertex mean
+        of the whole piece (that mean itself may lie outside a piece that is not convex)."""
+        offsets, ids = _cell_vertex_csr(mesh)
+        cells = self.cells(piece)
+        sizes = offsets[cells + 1] - offsets[cells]
+        take = np.repeat(offsets[cells] - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
+        centres = np.add.reduceat(mesh.vertices[ids[take]], np.cumsum(sizes) - sizes, axis=0) / sizes[:, None]
+        middle = mesh.vertices[self.vertices(piece)].mean(axis=0)
+        return centres[np.argmin(((centres - middle) ** 2).sum(axis=1))]
+
 
 def _cell_vertex_csr(mesh) -> tuple[np.ndarray, np.ndarray]:
     if getattr(mesh, "dimension", 2) == 3:
