@@ -185,7 +185,17 @@ def test_sigint_as_the_part_file_appears_never_leaves_it(tmp_path):
     ``.part`` left (issue 33: once 1 in 24, a signal landing while the parent was reading the
     worker's records ``hold`` / ``part NAME`` made it lose them), the earlier file or a complete one."""
     rng = random.Random(33)
-    args = [sys.executable, "-m", "vemkit.cli", "solve", PAPER, "-o", "out.nc", "-q", "--set", "discretization.mesh.n=2"]
+    args = [
+        sys.executable,
+        "-m",
+        "vemkit.cli",
+        "solve",
+        PAPER,
+        "-o",
+        "out.nc",
+        "-q",
+        *("--set", "discretization.mesh.n=2"),
+    ]
     for attempt in range(24):
         (tmp_path / "out.nc").write_bytes(EARLIER)
         process = subprocess.Popen(args, cwd=tmp_path, stderr=subprocess.PIPE, text=True)

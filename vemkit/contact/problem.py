@@ -101,8 +101,8 @@ def check_parts(mesh: Mesh, names) -> None:
 
 
 def _piece_words(mesh, pieces, piece: int) -> str:
-    """"the piece of 3 cells (cells 6, 7, 8) around (5.5, 0.5)": its size, its first cells, a point
-    in it (``MeshPieces.point_in``)."""
+    """The piece in words, "the piece of 3 cells (cells 6, 7, 8) around (5.5, 0.5)": its size, its
+    first cells, a point in it (``MeshPieces.point_in``)."""
     cells = pieces.cells(piece)
     centre = ", ".join(f"{c:.6g}" for c in pieces.point_in(mesh, piece))
     listed = ", ".join(map(str, cells[:3])) + (f" and {cells.shape[0] - 3} more" if cells.shape[0] > 3 else "")
