@@ -49,3 +49,20 @@ def test_a_pole_between_vertices_is_refused(tmp_path, kind, text, growth):
 def test_an_integrable_load_still_solves(tmp_path, text):
     run = _solve(tmp_path, "pressure", text)
     assert run.returncode == 0, run.stderr
+
+
+def test_a_singular_plane_across_3d_faces_is_refused(tmp_path):
+    """3D: the pole plane x = 0.37 crosses the edges of the loaded faces: refused there; 1/sqrt solves."""
+    scene = (
+        "name: p3\nmodel: 3d\ndomain: {box: [[0, 0, 0], [1, 1, 0.5]]}\nmaterial: {E: 1000, nu: 0.3}\n"
+        'boundary:\n  dirichlet: {bottom: [0, 0, 0]}\n  neumann: {top: {pressure: "P"}}\n'
+        "discretization: {mesh: {family: octree, n: 2}}\n"
+    )
+    for text, status in (("1/(x-0.37)", 2), ("1/sqrt(abs(x-0.37))", 0)):
+        (tmp_path / "s.yaml").write_text(scene.replace("P", text))
+        run = vemkit("solve", "s.yaml", "-o", "out.nc", "-q", cwd=tmp_path)
+        assert run.returncode == status, run.stderr
+    (tmp_path / "s.yaml").write_text(scene.replace("P", "1/(x-0.37)"))
+    run = vemkit("solve", "s.yaml", "-o", "again.nc", cwd=tmp_path)
+    assert len(run.stderr.splitlines()) == 1 and "'1/(x-0.37)': not integrable on side 'top'" in run.stderr
+    assert "from (0.37, " in run.stderr and not (tmp_path / "again.nc").exists()
