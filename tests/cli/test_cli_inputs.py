@@ -256,6 +256,7 @@ def test_an_unconverged_result_is_a_failure(tmp_path):
         cwd=tmp_path,
     )
     _one_error_line(run, "independent check")
+    assert "try solver.method=ssn" in run.stderr  # the other method, never the one in use
     assert (tmp_path / "out.nc").read_bytes() == b"an earlier result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.nc"]
 

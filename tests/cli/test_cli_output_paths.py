@@ -125,3 +125,21 @@ def test_an_append_only_target_is_refused_before_any_work(tmp_path):
         assert sorted(os.listdir(tmp_path)) == ["out.nc"] and out.read_bytes() == b"earlier"
     finally:
         subprocess.run(["chattr", "-a", str(out)], check=True)
+
+
+def test_names_up_to_255_bytes_are_written(tmp_path):
+    """Any name Linux takes is an output name (issue 33, item 5: names of 232-255 bytes were refused,
+    the room kept for the temporary file's name): 255 bytes (ASCII, and 2-byte UTF-8 characters) for
+    -o and --vtu, written, no .part left; 256 bytes refused in one line."""
+    out = "o" * 252 + ".nc"
+    vtu = ("\u00e9" * 125 + ".vtu").encode()  # 250 + 4 bytes: the temporary name is made ASCII
+    vtu = vtu[:-4] + b"x.vtu"  # 255 bytes
+    assert len(out.encode()) == 255 and len(vtu) == 255
+    run = vemkit("solve", PAPER, "-o", out, "--vtu", vtu, "-q", *SMALL, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / out).stat().st_size > 1000
+    assert open(os.fsencode(tmp_path) + b"/" + vtu, "rb").read(5) == b"<?xml"
+    assert not _parts(tmp_path)
+    run = vemkit("solve", PAPER, "-o", "o" + out, *SMALL, cwd=tmp_path)
+    message = run.stderr.decode()
+    assert run.returncode == 2 and message.count("\n") == 1 and "a name at most 255 bytes" in message, message

@@ -81,7 +81,14 @@ def _k2_scene(nc):
     nc.setncattr("scene", nc.getncattr("scene").replace("  order: 1\n", "  order: 2\n", 1))  # the attribute says 1
 
 
+def _nan_in_u2(nc):
+    values = nc.variables["u2"]
+    values.set_auto_mask(False)
+    values[3] = float("nan")
+
+
 CASES = {
+    "a NaN in u2": (_nan_in_u2, "variable u2 holds 1 NaN or inf value (the first at node 3: nan)"),
     "a vertex index out of range": (_bad_vertex, "vertex"),
     "a python tag in the scene attribute": (_set_scene("name: !!python/object/apply:os.system [echo]"), "tags"),
     "an alias in the scene attribute": (_set_scene("a: &x [1]\nb: *x"), "aliases"),

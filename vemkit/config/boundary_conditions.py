@@ -18,6 +18,7 @@ import numpy as np
 from vemkit.config.domain import Domain
 from vemkit.config.expression_tree import shorten
 from vemkit.config.expressions import Expression, compile_expression
+from vemkit.config.load_poles import check_integrable_on_edges
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import ExpressionError, SceneError
 
@@ -358,10 +359,24 @@ def check_file_sides(scene, header) -> None:
             )
 
 
+def _loaded_edges(mesh, parts) -> np.ndarray:
+    """(E, 2) the edges of a side: its boundary edges (2D), the edges of its faces (3D)."""
+    if mesh.vertices.shape[1] == 2:
+        return parts
+    faces = np.asarray(parts, dtype=np.int64)
+    sizes = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
+    ids = mesh.face_vertex_ids(faces)
+    start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    following = np.arange(ids.shape[0]) + 1
+    following[np.cumsum(sizes) - 1] = start[np.cumsum(sizes) - 1]  # the last vertex closes the face
+    return np.stack([ids, ids[following]], axis=1)
+
+
 def check_expressions_on_mesh(scene, mesh) -> None:
     """Every expression finite at the vertices where it acts (a pole at a vertex that the probes
     before meshing missed, or any point of a mesh file's body): tractions and pressures on their
-    sides, the body force and the exact solution everywhere. The gap and the Dirichlet values are
+    sides, and integrable along their edges (3D: the edges of their faces;
+    :mod:`vemkit.config.load_poles`), the body force and the exact solution everywhere. The gap and the Dirichlet values are
     evaluated at their vertices when they are used."""
     coordinates = tuple(mesh.vertices.T)  # x, y (and z)
     for side in scene.neumann_sides:
@@ -370,7 +385,11 @@ def check_expressions_on_mesh(scene, mesh) -> None:
         parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
         on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else mesh.face_vertex_ids(parts))
         pressure = scene.pressure(side)
+        edges = _loaded_edges(mesh, parts)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))
+            # and between the vertices: a pole inside an edge (3D: on the faces' edges, where a
+            # singular plane or surface such as 1/(x - 0.37) crosses them)
+            check_integrable_on_edges(expression, mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]], side)
     for expression in (*scene.body_force, *(scene.exact_displacement or ())):
         evaluate_checked(expression, coordinates)

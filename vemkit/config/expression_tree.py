@@ -300,6 +300,10 @@ def parse_tree(text: str, name: str) -> Node:
         reason = error.msg or "invalid syntax"
         column = f" at column {error.offset}" if error.offset else ""
         raise fail(name, text, f"not a valid expression ({reason}{column})") from None
+    except UnicodeEncodeError as error:  # a lone surrogate (the scene loader joins pairs, refuses halves)
+        bad = f"\\u{ord(error.object[error.start]):04x}"
+        where = f"the lone surrogate {bad} at column {error.start + 1}"
+        raise fail(name, text, f"not a valid expression ({where})") from None
     except (RecursionError, MemoryError, ValueError):
         raise fail(name, text, "not a valid expression (too complex)", hint=False) from None
     return _Parser(text, name).value(tree.body)

@@ -83,6 +83,26 @@ class _Composer:
             self._depth -= 1
 
 
+_SURROGATE = re.compile("[\ud800-\udfff]")
+_PAIR = re.compile("([\ud800-\udbff])([\udc00-\udfff])")
+
+
+def _joined_surrogates(text: str, node) -> str:
+    """``text`` with each high-low surrogate pair joined into its character; a ConstructorError at
+    ``node`` for a surrogate left over (a lone half)."""
+    joined = _PAIR.sub(lambda m: chr(0x10000 + ((ord(m[1]) - 0xD800) << 10) + ord(m[2]) - 0xDC00), text)
+    lone = _SURROGATE.search(joined)
+    if lone is not None:
+        raise yaml.constructor.ConstructorError(
+            None,
+            None,
+            f"the string has a lone surrogate \\u{ord(lone[0]):04x} (half of a UTF-16 pair, not a "
+            "character); write the character itself, its \\U00XXXXXX escape, or both halves of the pair",
+            node.start_mark,
+        )
+    return joined
+
+
 class UserLoader(_Composer, yaml.SafeLoader):
     """SafeLoader for user input: YAML 1.2 core scalars, no aliases/tags, no duplicate keys."""
 
@@ -100,6 +120,15 @@ class UserLoader(_Composer, yaml.SafeLoader):
                 raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r}", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
+
+    def construct_scalar(self, node):
+        """The scalar's text; a UTF-16 surrogate pair written as two escapes ("\\ud83d\\ude00", as JSON
+        writes a character beyond U+FFFF) is the one character it encodes; a lone surrogate (half
+        of a pair, no character at all) is refused."""
+        value = super().construct_scalar(node)
+        if isinstance(value, str) and _SURROGATE.search(value):
+            value = _joined_surrogates(value, node)
+        return value
 
     def construct_core_int(self, node):
         text = self.construct_scalar(node)

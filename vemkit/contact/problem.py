@@ -27,6 +27,7 @@ from vemkit.contact.boundary import ContactBoundary, FoundationLine, check_quadr
 from vemkit.contact.laws import ContactLaw
 from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
 from vemkit.exceptions import SceneError
+from vemkit.mesh.components import mesh_pieces
 from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.mesh import Mesh
 from vemkit.vem.condensation import condense_load, interior_load, recover_interior
@@ -99,14 +100,53 @@ def check_parts(mesh: Mesh, names) -> None:
             )
 
 
+def _piece_words(mesh, pieces, piece: int) -> str:
+    """The piece in words, "the piece of 3 cells (cells 6, 7, 8) around (5.5, 0.5)": its size, its
+    first cells, a point in it (``MeshPieces.point_in``)."""
+    cells = pieces.cells(piece)
+    centre = ", ".join(f"{c:.6g}" for c in pieces.point_in(mesh, piece))
+    listed = ", ".join(map(str, cells[:3])) + (f" and {cells.shape[0] - 3} more" if cells.shape[0] > 3 else "")
+    plural = "s" if cells.shape[0] > 1 else ""
+    return f"the piece of {cells.shape[0]} cell{plural} (cell{plural} {listed}) around ({centre})"
+
+
+def check_pieces_held(mesh, prescribed: np.ndarray) -> None:
+    """Every piece of the mesh (:func:`vemkit.mesh.components.mesh_pieces`) held by its own Dirichlet
+    components (``prescribed`` (N, d): u_i prescribed at vertex k), else a SceneError naming the motion
+    and, for a mesh in several pieces, the piece (its cells, a point of it) and the fix.
+
+    Contact sides do not count, for one piece as for many: the normal compliance and friction forces
+    act only where a point penetrates, and the solvers factorize or precondition the stiffness matrix
+    on its own (Uzawa's steps solve with it alone), so it must be regular before any contact term.
+    A piece held by nothing makes it singular; the solvers would then fail with a misleading message."""
+    pieces = mesh_pieces(mesh)
+    for piece in range(pieces.count):
+        on = pieces.vertex_piece == piece if pieces.count > 1 else np.ones(mesh.n_vertices, dtype=bool)
+        held = on & np.any(prescribed, axis=1)
+        motion = free_rigid_motion(mesh.vertices[held], prescribed[held])
+        if motion is None:
+            continue
+        if pieces.count == 1:
+            raise rigid_motion_error(motion)
+        where = _piece_words(mesh, pieces, piece)
+        what = (
+            f"no side of boundary.dirichlet holds {where}: it floats"
+            if not held.any()
+            else f"boundary.dirichlet leaves {motion} of {where} free"
+        )
+        raise SceneError(
+            f"the mesh is in {pieces.count} separate pieces and {what} (the stiffness is singular); "
+            "prescribe a side on that piece in boundary.dirichlet, or remove the piece from the mesh "
+            "(discretization.mesh)",
+            key="boundary.dirichlet",
+        )
+
+
 def constrained(space: VirtualElementSpace, dirichlet) -> DofMap:
-    """The dof map of the Dirichlet data; a rigid motion left free is a SceneError."""
+    """The dof map of the Dirichlet data; a rigid motion of the body or of any of its pieces left free
+    is a SceneError (:func:`check_pieces_held`)."""
     prescribed, values = space.dirichlet_components(dirichlet)
-    nv = space.mesh.n_vertices
-    held = np.any(prescribed[:nv], axis=1)
-    motion = free_rigid_motion(space.mesh.vertices[held], prescribed[:nv][held])
-    if motion is not None:
-        raise rigid_motion_error(motion)
+    check_pieces_held(space.mesh, prescribed[: space.mesh.n_vertices])
     return space.constrain(prescribed, values)
 
 

@@ -91,12 +91,11 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
         raise OutputError(f"{where}: give the path of a file, e.g. {option} out.nc", key=option)
     target = Path(os.path.realpath(text))  # follow links: replace what they point to
     name_max, path_max = _limits(str(target.parent) if target.parent.is_dir() else "/")
-    if len(os.fsencode(str(target))) >= path_max or len(os.fsencode(target.name)) > name_max - 24:
-        raise OutputError(
-            f"{where}: the path is too long (at most {path_max - 1} bytes, a name "
-            f"at most {name_max - 24} bytes here); choose a shorter one",
-            key=option,
-        )
+    # the temporary file beside it has a name of at most TEMPORARY_NAME_MAX bytes (temporary_name):
+    # any name the file system takes is a valid output name; only its path may not get longer
+    longer = max(0, len(temporary_name(target.name, "0" * 12)) - len(os.fsencode(target.name)))
+    if len(os.fsencode(str(target))) >= path_max or len(os.fsencode(target.name)) > name_max:
+        raise _too_long(where, option, path_max - 1 - longer, name_max)
     for source in inputs:
         if source is not None and same_file(source, target):
             raise OutputError(
@@ -111,8 +110,18 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
     if mode is not None and not stat.S_ISREG(mode):
         raise OutputError(f"{where}: exists and is {_kind(mode)}; give the path of a regular file", key=option)
     _check_directory(target.parent, where, option)
+    if len(os.fsencode(str(target))) + longer >= path_max:  # its temporary file's path would be
+        raise _too_long(where, option, path_max - 1 - longer, name_max)
     _check_replaceable(target, mode, where, option)
     return target
+
+
+def _too_long(where: str, option: str, path_bytes: int, name_bytes: int) -> OutputError:
+    return OutputError(
+        f"{where}: the path is too long (at most {path_bytes} bytes, a name at most {name_bytes} bytes "
+        "here); choose a shorter one",
+        key=option,
+    )
 
 
 def _check_directory(directory: Path, where: str, option: str) -> None:
@@ -198,12 +207,23 @@ def _report(record: str) -> None:
         os.write(REPORT_FD, (record + "\n").encode("utf-8", "surrogateescape"))
 
 
+#: the longest name :func:`temporary_name` gives (a stem of 100 characters, the token, the dots):
+#: far below NAME_MAX (255 on Linux), so a target name up to NAME_MAX bytes has its temporary file
+TEMPORARY_STEM = 100
+TEMPORARY_NAME_MAX = 1 + TEMPORARY_STEM + 1 + 12 + len(".part")
+
+
+def temporary_name(name: str, token: str) -> str:
+    """``.NAME.TOKEN.part`` for a target called ``name``: ASCII (the netCDF library encodes names as
+    UTF-8: a target name that is not UTF-8 must not reach it) and at most TEMPORARY_NAME_MAX bytes
+    for a 12-character token, whatever the length of ``name`` (the stem is its first 100 characters)."""
+    return f".{re.sub(r'[^A-Za-z0-9._-]', '_', name[:TEMPORARY_STEM])}.{token}.part"
+
+
 def _temporary_next_to(target: Path) -> Path:
-    """A new empty ``.NAME.XXXX.part`` next to ``target``; its name is ASCII (the netCDF library
-    encodes names as UTF-8: a target name that is not UTF-8 must not reach it)."""
-    safe = re.sub(r"[^A-Za-z0-9._-]", "_", target.name[:100])
+    """A new empty :func:`temporary_name` next to ``target``."""
     while True:
-        name = os.path.join(target.parent, f".{safe}.{secrets.token_hex(6)}.part")
+        name = os.path.join(target.parent, temporary_name(target.name, secrets.token_hex(6)))
         _report(f"part {name}")  # before it exists: a kill in between leaves nothing behind
         CREATED.add(name)
         try:
@@ -211,8 +231,8 @@ def _temporary_next_to(target: Path) -> Path:
         except FileExistsError:
             CREATED.discard(name)
             continue
-        except BaseException:
-            CREATED.discard(name)
+        except BaseException:  # made or not: removed if it is there (_discard), never left unlisted
+            _discard([name])
             raise
         return Path(name)
 
@@ -288,9 +308,9 @@ def _signals_deferred():
     try:
         yield received
     finally:
+        _report("free")  # before the handlers go: a signal the parent forwards until it reads this is kept
         for number, handler in previous.items():
             signal.signal(number, handler)
-        _report("free")
 
 
 @contextmanager

@@ -125,11 +125,27 @@ class _Supervisor:
                 self.holding = kind == "hold"
         return open_end
 
+    def _drain_masked(self) -> bool:
+        """:meth:`drain` with the handled signals blocked: ``on_signal`` (which drains too) never
+        runs in the middle of a drain. Without the mask a signal landing after a drain had taken
+        the records ``hold``, ``part NAME`` off the pipe and before it stored them made
+        ``on_signal`` see neither: it killed the worker as outside the final write and removed
+        the temporary files it knew of, and the worker's fresh, announced ``.part`` stayed (issue
+        33: 1 SIGINT in 24 sent as the ``.part`` appeared). A signal blocked here is delivered
+        when the mask is lifted, the records stored."""
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+        try:
+            return self.drain()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
     def on_signal(self, number, _frame) -> None:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)  # a second signal waits for this one
         self.drain()
         if self.holding:  # the final write: the worker delivers it right after
             self.forwarded = number
             os.kill(self.pid, number)
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
             return
         try:
             os.kill(self.pid, signal.SIGKILL)
@@ -157,7 +173,7 @@ class _Supervisor:
     def wait(self) -> int:
         """The worker's exit status, once it ended by itself (its records read as they come, so
         that it never blocks on a full pipe)."""
-        while self.drain():
+        while self._drain_masked():
             select.select([self.fd], [], [])  # a signal interrupts it: on_signal runs at once
         while True:
             try:
@@ -165,7 +181,7 @@ class _Supervisor:
                 break
             except ChildProcessError:  # pragma: no cover - reaped by the signal handler, which exits
                 return 70
-        self.drain()
+        self._drain_masked()
         if os.WIFSIGNALED(status):  # killed from outside (the out-of-memory killer, kill -9)
             number = os.WTERMSIG(status)
             self._finish(

@@ -12,10 +12,12 @@ Imports: vemkit.config, vemkit.io, vemkit.vem, vemkit.studies.solution_order and
 from __future__ import annotations
 
 import json
+import secrets
 from pathlib import Path
 
 import numpy as np
 
+from vemkit.io.output_files import temporary_name
 from vemkit.io.solution_file import read_solution
 from vemkit.studies.solution_order import projected_solution_file, refuse_order2, require_order1, solution_order
 
@@ -228,7 +230,7 @@ def write_records(records, path) -> Path:
     """Records as JSON (a small intermediate file of the workflow), written atomically."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.part")
+    tmp = path.with_name(temporary_name(path.name, secrets.token_hex(6)))  # fits NAME_MAX for any name
     tmp.write_text(json.dumps(list(records), indent=1) + "\n", encoding="utf-8")
     tmp.replace(path)
     return path

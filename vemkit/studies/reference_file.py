@@ -9,7 +9,7 @@ The file is user input like a scene or a mesh file, so it is read the same caref
 - its mesh read and validated like any mesh file (``vemkit.mesh.files.read_mesh``: a vertex index out
   of range, a broken cell is a one-line refusal, never a kernel indexing outside an array);
 - only the variables it needs (``u1``, ``u2`` on the mesh's nodes) read, after checking their shape:
-  any other variable of the file, however large, is never read;
+  any other variable of the file, however large, is never read; a NaN or inf in them is refused;
 - its ``scene`` attribute parsed by the safe YAML loader (``vemkit.config.safe_yaml``; at most
   ``MAX_FILE_BYTES``, a mapping) and its order checked: the error measure is k = 1, an order-2
   reference is refused.
@@ -76,6 +76,13 @@ def _node_values(path: Path, nc, n_vertices: int) -> dict:
                 f"{variable.dtype} of shape {variable.shape}; {FIX}",
             )
         values[name] = np.asarray(variable[:], dtype=np.float64)
+        bad = np.flatnonzero(~np.isfinite(values[name]))
+        if bad.size:  # refused here: the true errors computed from it would blame the output file
+            raise _refused(
+                path,
+                f"variable {name} holds {bad.size:,} NaN or inf value{'s' if bad.size > 1 else ''} (the first at "
+                f"node {bad[0]}: {values[name][bad[0]]}); a reference must be a finite solution: {FIX}",
+            )
     return values
 
 
