@@ -214,7 +214,8 @@ def _ugrid_header(path: Path, size: int, dimension: int = 2) -> MeshFileHeader:
     try:
         nc = netCDF4.Dataset(path, "r")
     except OSError as error:
-        raise _fail(path, f"cannot be read as UGRID netCDF: not a netCDF file ({error.strerror or error})") from None
+        kind = "UGRID netCDF" if dimension == 2 else "a mesh3d netCDF file"
+        raise _fail(path, f"cannot be read as {kind}: not a netCDF file ({error.strerror or error})") from None
     try:
         nc.set_auto_mask(False)
         return _ugrid_counts(nc, path, size) if dimension == 2 else _mesh3d_counts(nc, path, size)

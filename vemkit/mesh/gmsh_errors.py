@@ -5,6 +5,7 @@ for int() with base 10") or only prints a warning. When it fails, :func:`gmsh_re
 ASCII file itself (formats 2.2 and 4.1: the sections, the node and element lines) for the first
 line that is wrong and returns a MeshError naming the file, that line and what it should hold, with
 the fix; where no line can be named (a binary file) it names the file, meshio's reason and the fix.
+:func:`read_gmsh_data` is meshio's reading with these refusals, for the 2D and the 3D reader.
 """
 
 from __future__ import annotations
@@ -59,6 +60,26 @@ class _Problem(Exception):
     def __init__(self, index: int, text: str):
         super().__init__(text)
         self.line, self.text = index + 1, text
+
+
+def read_gmsh_data(path):
+    """meshio's reading of a gmsh file (2D or 3D; not meshio.read: on a broken file it prints and
+    exits the process), its warnings kept off the terminal; a file it cannot read, or whose section
+    it finds unclosed, is a MeshError naming the file, the line and the fix (``gmsh_read_error``).
+    A MemoryError passes (the caller's memory budget reports it)."""
+    path = Path(path)
+    notes: list = []
+    with meshio_warnings(notes):
+        try:
+            data = meshio.gmsh.read(path)
+        except MemoryError:
+            raise
+        except Exception as error:  # meshio's raw Python text: located and explained instead
+            raise gmsh_read_error(path, " ".join(str(error).split()) or type(error).__name__) from None
+    unclosed = [note for note in notes if "not closed" in note]
+    if unclosed:
+        raise gmsh_read_error(path, unclosed[0])
+    return data
 
 
 def gmsh_read_error(path, reason: str) -> MeshError:
