@@ -264,21 +264,48 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     return MeshFileHeader(vertices, cells, sides, True, size)
 
 
+#: most entries of a mesh3d face or volume table per vertex (8 bytes each): a tetrahedral mesh has
+#: about 13 faces of 3 vertices and 6 cells of 4 faces per vertex; padding to the largest face or
+#: cell leaves a margin of 5 or more
+TABLE_ENTRIES_PER_VERTEX = 256
+
+
 def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
-    """The counts and sides of a ``mesh3d`` file (SPEC §10) from its dimensions and attributes."""
+    """The counts and sides of a ``mesh3d`` file (SPEC §10) from its dimensions and attributes; its
+    tables' declared shapes must be proportional to its nodes (netCDF reads unwritten chunks as fill
+    values: a 40 kB file can declare gigabytes)."""
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
+    if len(topologies) == 1 and str(getattr(topologies[0], "topology_dimension", "2")) == "2":
+        raise _fail(path, "is a 2D mesh (UGRID mesh2d) but the scene is 3D; remove model: 3d, or give a 3D mesh file")
     if len(topologies) != 1 or str(getattr(topologies[0], "topology_dimension", "")) != "3":
         raise _fail(
             path,
             "cannot be read as a mesh3d netCDF file: expected one 3D mesh topology variable (topology_dimension = 3)",
         )
+    topology = topologies[0]
     volumes = _ugrid_variable(
-        nc, getattr(topologies[0], "volume_face_connectivity", None), path, "volume_face_connectivity", 2
+        nc, getattr(topology, "volume_face_connectivity", None), path, "volume_face_connectivity", 2
     )
-    coordinates = str(getattr(topologies[0], "node_coordinates", "")).split()
-    x = _ugrid_variable(nc, coordinates[0] if coordinates else None, path, "node coordinate", 1)
+    faces = _ugrid_variable(nc, getattr(topology, "face_node_connectivity", None), path, "face_node_connectivity", 2)
+    coordinates = str(getattr(topology, "node_coordinates", "")).split()
+    if len(coordinates) != 3:
+        raise _fail(path, "cannot be read as a mesh3d netCDF file: node_coordinates must name three variables (x y z)")
+    x, y, z = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
+    vertices = x.shape[0]
+    if y.shape[0] != vertices or z.shape[0] != vertices:
+        raise _fail(
+            path, f"{vertices:,} x but {y.shape[0]:,} y and {z.shape[0]:,} z node coordinates; the file is broken"
+        )
+    most = TABLE_ENTRIES_PER_VERTEX * vertices + (1 << 20)
+    for table, what in ((faces, "face"), (volumes, "volume")):
+        if table.shape[0] * table.shape[1] > most:
+            raise _fail(
+                path,
+                f"declares a {what} table of {table.shape[0]:,} x {table.shape[1]:,} entries for {vertices:,} "
+                "vertices; the file is broken",
+            )
     try:
-        names = json.loads(getattr(topologies[0], "vemkit_boundary_parts", "[]"))
+        names = json.loads(getattr(topology, "vemkit_boundary_parts", "[]"))
     except ValueError:
         names = None
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
@@ -287,7 +314,15 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
             "cannot be read as a mesh3d netCDF file: the attribute vemkit_boundary_parts must be a "
             "JSON list of side names",
         )
-    return MeshFileHeader(x.shape[0], volumes.shape[0], tuple(names), True, size)
+    for name in names:
+        key = f"mesh3d_boundary_{name}"
+        if key in nc.variables and (nc.variables[key].ndim != 1 or nc.variables[key].shape[0] > faces.shape[0]):
+            raise _fail(
+                path,
+                f"{key[:80]} declares {nc.variables[key].size:,} faces but the mesh has {faces.shape[0]:,}; "
+                "the file is broken",
+            )
+    return MeshFileHeader(vertices, volumes.shape[0], tuple(names), True, size)
 
 
 def _ugrid_sides(nc, text, vertices: int, path: Path) -> tuple:
