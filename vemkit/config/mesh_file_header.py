@@ -33,7 +33,7 @@ from typing import NamedTuple
 from vemkit.config.safe_yaml import file_kind
 from vemkit.exceptions import MeshError
 
-__all__ = ["MESH_SUFFIXES", "MeshFileHeader", "mesh_file_header", "open_regular_file"]
+__all__ = ["MESH_SUFFIXES", "OTHER_DIMENSION", "MeshFileHeader", "mesh_file_header", "open_regular_file"]
 
 MESH_SUFFIXES = {".msh": "gmsh", ".nc": "UGRID netCDF"}
 MIN_NODE_BYTES = 7  # the shortest gmsh node: "1 0 0 0\n" (text) or a tag and three doubles (binary)
@@ -51,6 +51,7 @@ class MeshFileHeader(NamedTuple):
     sides: tuple
     sides_complete: bool
     size: int
+    other_sides: tuple = ()  # gmsh: physical names of the other dimension's sides (3D in 2D, 2D in 3D)
 
 
 def _fail(path: Path, problem: str) -> MeshError:
@@ -165,8 +166,44 @@ def _gmsh_header(fd: int, path: Path, size: int, dimension: int = 2) -> MeshFile
             f"declares {elements:,} elements on {nodes:,} nodes, more than a "
             f"{'plane' if dimension == 2 else '3D'} mesh has; the file is broken",
         )
-    names = _physical_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path, dimension - 1)
-    return MeshFileHeader(nodes, min(elements, CELLS_PER_VERTEX[dimension] * nodes + 2), names, False, size)
+    named = _physical_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path)
+    shown = _gmsh_dimension(fd, named, version, binary, word, at_nodes)
+    if shown is not None and shown != dimension:
+        raise _fail(path, OTHER_DIMENSION[shown])
+    names = tuple(name for dim, name in named if dim == dimension - 1)
+    others = tuple(name for dim, name in named if dim == (2 if dimension == 2 else 1))
+    return MeshFileHeader(nodes, min(elements, CELLS_PER_VERTEX[dimension] * nodes + 2), names, False, size, others)
+
+
+#: the refusal of a mesh file of the other dimension, by the dimension the file shows (the header's
+#: and the gmsh readers' words, after "<file>: ")
+OTHER_DIMENSION = {
+    3: "is a 3D mesh (it has volumes) but the scene is 2D; set model: 3d",
+    2: "is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; remove model: 3d, or give a 3D mesh file",
+}
+
+
+def _gmsh_dimension(fd, named, version, binary, word, at_nodes) -> int | None:
+    """The dimension a gmsh file shows before its elements are read, or None: 3 with a physical
+    volume named, or volume entities (format 4); 2 with surface but no volume entities (format 4)."""
+    if any(dim == 3 for dim, _ in named):
+        return 3
+    if version != 4:
+        return None
+    at = _find_section(fd, "Entities", 0, at_nodes)
+    if at is None:
+        return None
+    head = _read_at(fd, at, 256)
+    try:
+        if binary:
+            counts = struct.unpack(f"<4{'Q' if word == 8 else 'I'}", head[: 4 * word])
+        else:
+            counts = tuple(int(v) for v in head.split(b"\n", 1)[0].split()[:4])
+    except (ValueError, struct.error):
+        return None
+    if len(counts) != 4:
+        return None
+    return 3 if counts[3] > 0 else 2 if counts[2] > 0 else None
 
 
 def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
@@ -185,8 +222,8 @@ def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
     return count
 
 
-def _physical_names(fd, offset, path, dimension: int = 1) -> tuple:
-    """The names of the physical groups of ``dimension`` (the sides: lines in 2D, surfaces in 3D)."""
+def _physical_names(fd, offset, path) -> tuple:
+    """(dimension, name) of every named physical group (the sides: lines in 2D, surfaces in 3D)."""
     if offset is None:
         return ()
     text = _read_at(fd, offset, 1 << 20).decode("utf-8", errors="replace").split("\n")
@@ -197,8 +234,8 @@ def _physical_names(fd, offset, path, dimension: int = 1) -> tuple:
     names = []
     for line in text[1 : 1 + count]:
         parts = line.split(None, 2)
-        if len(parts) == 3 and parts[0] == str(dimension):
-            names.append(parts[2].strip().strip('"'))
+        if len(parts) == 3 and parts[0] in ("0", "1", "2", "3"):
+            names.append((int(parts[0]), parts[2].strip().strip('"')))
     return tuple(names)
 
 

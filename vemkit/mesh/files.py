@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from vemkit.config.domain import SIDE_NAME
+from vemkit.config.mesh_file_header import OTHER_DIMENSION
 from vemkit.exceptions import MeshError
 from vemkit.mesh.check_kernels import worst_coordinate_over_edge
 from vemkit.mesh.checks import validate_mesh
@@ -261,6 +262,8 @@ def read_gmsh(path) -> Mesh:
     from vemkit.mesh.gmsh_errors import read_gmsh_data  # meshio: lazily, not in the core's import
 
     data = read_gmsh_data(path)
+    if any(block.dim == 3 for block in data.cells):
+        raise MeshError(f"{path.name}: {OTHER_DIMENSION[3]}", key=str(path))
     if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
         v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
         raise MeshError(

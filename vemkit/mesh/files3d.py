@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from vemkit.config.domain import SIDE_NAME
+from vemkit.config.mesh_file_header import OTHER_DIMENSION
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
 from vemkit.mesh.file_description import FileDescription
@@ -318,6 +319,8 @@ def gmsh3d_mesh(data, path: Path) -> PolyhedralMesh:
                 "hexahedra, prisms (wedge) or pyramids, with triangles or quadrilaterals as surfaces",
                 key=str(path),
             )
+    if not soups and surfaces:
+        raise MeshError(f"{path.name}: {OTHER_DIMENSION[2]}", key=str(path))
     if not soups:
         raise MeshError(
             f"{path.name}: no tetrahedra, hexahedra, prisms or pyramids in the file; give a 3D mesh", key=str(path)
