@@ -308,7 +308,7 @@ TABLE_ENTRIES_PER_VERTEX = 256
 
 
 def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
-    """The counts and sides of a ``mesh3d`` file (SPEC §10) from its dimensions and attributes; its
+    """The counts and sides of a ``mesh3d`` file from its dimensions and attributes; its
     tables' declared shapes must be proportional to its nodes (netCDF reads unwritten chunks as fill
     values: a 40 kB file can declare gigabytes)."""
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
