@@ -93,6 +93,14 @@ def _files(folder: Path) -> None:
     (folder / "badnode.msh").write_text(good.replace(lines[first + 3], lines[first + 3].rsplit(" ", 1)[0] + " 999"))
     (folder / "badtype.msh").write_text(good.replace(lines[-3], lines[-3].replace(" 5 2 ", " 99 2 ", 1)))
     good4 = (folder / "good4.msh").read_text()
+    lines4 = good4.split("\n")
+    at = lines4.index("$Nodes")
+    lines4[at + 1], lines4[at + 3] = "1 18 1 1500000000", "1500000000"  # node 1 renamed, as in tag.msh
+    for k in range(lines4.index("$Elements") + 2, len(lines4)):
+        fields = lines4[k].split()
+        if len(fields) > 4:
+            lines4[k] = " ".join(fields[:1] + ["1500000000" if x == "1" else x for x in fields[1:]])
+    (folder / "tag4.msh").write_text("\n".join(lines4))
     (folder / "trunc4.msh").write_text(good4[: good4.index("$EndElements") - 10])
     (folder / "nameless.msh").write_text(re.sub(r"\$PhysicalNames.*?\$EndPhysicalNames\n", "", good, flags=re.S))
     plane = gmsh_v2({"quad": QUADS})
@@ -125,7 +133,12 @@ def _line_of(path: Path, needle: str) -> int:
 
 # name: (scene, text the error line must contain)
 CASES = {
-    "gmsh node number 1.5e9": (scene3d("tag.msh"), "tag.msh: cannot be read as gmsh: reading it needs far more memory"),
+    "gmsh node number 1.5e9": (
+        scene3d("tag.msh"),
+        "tag.msh, line 16: node number 1,500,000,000 in a file of 18 nodes: reading it needs a table of "
+        "1,500,000,000 entries, far more memory than the mesh; number the nodes from 1",
+    ),
+    "gmsh 4 node number 1.5e9": (scene3d("tag4.msh"), "tag4.msh, line 27: node number 1,500,000,000"),
     "mesh3d face table of 1e8 rows": (scene3d("face_rows.nc"), "declares a face table of 100,000,000 x 4 entries"),
     "mesh3d faces of 1e7 nodes": (scene3d("face_columns.nc"), "declares a face table of 36 x 10,000,000 entries"),
     "mesh3d cells of 1e8 faces": (scene3d("volume_columns.nc"), "declares a volume table of 8 x 100,000,000"),

@@ -53,6 +53,15 @@ def parse_within_budget(path, dimension: int, parse: Callable[[Path], T]) -> tup
     except MeshError:
         raise
     except MemoryError:
+        found = _largest_node_tag(path)
+        if found is not None and found[1] > 2 * header.vertices:
+            line, tag = found
+            raise MeshError(
+                f"{path.name}, line {line}: node number {tag:,} in a file of {header.vertices:,} nodes: reading "
+                f"it needs a table of {tag:,} entries, far more memory than the mesh; number the nodes from 1 "
+                "(gmsh: Mesh.Renumber, or export the mesh again)",
+                key=str(path),
+            ) from None
         raise MeshError(
             f"{path.name}: cannot be read as {kind}: reading it needs far more memory than a mesh of "
             f"{header.vertices:,} nodes (a node number or count beyond what the file holds); fix the "
@@ -64,3 +73,12 @@ def parse_within_budget(path, dimension: int, parse: Callable[[Path], T]) -> tup
         raise MeshError(
             f"{path.name}: cannot be read as {kind}: {reason[:200] or type(error).__name__}", key=str(path)
         ) from None
+
+
+def _largest_node_tag(path: Path):
+    """(line, number) of a gmsh file's largest node number (``vemkit.mesh.gmsh_errors``), or None."""
+    if path.suffix != ".msh":
+        return None
+    from vemkit.mesh.gmsh_errors import largest_node_tag  # meshio: lazily, as the readers
+
+    return largest_node_tag(path)

@@ -98,6 +98,37 @@ def gmsh_read_error(path, reason: str) -> MeshError:
     return MeshError(f"{path.name}, line {found.line}: {found.text}; {FIX}", key=str(path))
 
 
+#: files larger than this are not scanned for their largest node number (the message then names the file)
+SCAN_BYTES = 64 << 20
+
+
+def largest_node_tag(path) -> tuple[int, int] | None:
+    """(line, number) of the largest node number of an ASCII gmsh file (2.2 or 4.1), or None: what
+    makes meshio allocate a table of that many entries."""
+    path = Path(path)
+    try:
+        if path.stat().st_size > SCAN_BYTES:
+            return None
+        lines = path.read_bytes().decode("utf-8", "replace").splitlines()
+        sections = {name: (start, end) for name, start, end in _sections(lines)}
+        version = _format(lines, *sections["MeshFormat"])
+        start, end = sections["Nodes"]
+        if version is None:
+            return None
+        if version < 4:
+            rows = range(start + 1, end)
+        else:
+            rows, i = [], start + 1
+            while i < end:
+                n = int(lines[i].split()[3])
+                rows += range(i + 1, i + 1 + n)
+                i += 1 + 2 * n
+        line = max(rows, key=lambda k: int(lines[k].split()[0]))
+        return line + 1, int(lines[line].split()[0])
+    except (_Problem, KeyError, IndexError, ValueError, OSError):
+        return None
+
+
 def _first_problem(lines: list) -> _Problem | None:
     version = None
     tags: set = set()
