@@ -331,7 +331,9 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
     vertices = x.shape[0]
     if y.shape[0] != vertices or z.shape[0] != vertices:
         raise _fail(
-            path, f"{vertices:,} x but {y.shape[0]:,} y and {z.shape[0]:,} z node coordinates; the file is broken"
+            path,
+            f"{vertices:,} x but {y.shape[0]:,} y and {z.shape[0]:,} z node coordinates; the file is broken: "
+            "write it again (vemkit mesh --scene)",
         )
     most = TABLE_ENTRIES_PER_VERTEX * vertices + (1 << 20)
     for table, what in ((faces, "face"), (volumes, "volume")):
@@ -339,7 +341,7 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
             raise _fail(
                 path,
                 f"declares a {what} table of {table.shape[0]:,} x {table.shape[1]:,} entries for {vertices:,} "
-                "vertices; the file is broken",
+                "vertices; the file is broken: write it again (vemkit mesh --scene)",
             )
     try:
         names = json.loads(getattr(topology, "vemkit_boundary_parts", "[]"))
@@ -357,7 +359,7 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
             raise _fail(
                 path,
                 f"{key[:80]} declares {nc.variables[key].size:,} faces but the mesh has {faces.shape[0]:,}; "
-                "the file is broken",
+                "the file is broken: write it again (vemkit mesh --scene)",
             )
     return MeshFileHeader(vertices, volumes.shape[0], tuple(names), True, size)
 
