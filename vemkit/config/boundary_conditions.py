@@ -350,6 +350,14 @@ def check_file_sides(scene, header) -> None:
         for side in boundary[part]:
             if side in header.sides or (not header.sides_complete and (side.isdigit() or side == "untagged")):
                 continue
+            if side in getattr(header, "other_sides", ()):
+                three_d = scene.dimension == 3
+                raise SceneError(
+                    f"boundary.{part}: side {side!r} is a physical {'line' if three_d else 'surface'} in the mesh "
+                    f"file {scene.mesh_options['file']}: the file is a {'2D' if three_d else '3D'} mesh but the "
+                    f"scene is {'3D' if three_d else '2D'}; {'remove model: 3d' if three_d else 'set model: 3d'}",
+                    key=f"boundary.{part}",
+                )
             listed = ", ".join(header.sides) or "none"
             raise SceneError(
                 f"boundary.{part}: side {side!r} is not in the mesh file {scene.mesh_options['file']} "

@@ -33,7 +33,7 @@ from typing import NamedTuple
 from vemkit.config.safe_yaml import file_kind
 from vemkit.exceptions import MeshError
 
-__all__ = ["MESH_SUFFIXES", "MeshFileHeader", "mesh_file_header", "open_regular_file"]
+__all__ = ["MESH_SUFFIXES", "OTHER_DIMENSION", "MeshFileHeader", "mesh_file_header", "open_regular_file"]
 
 MESH_SUFFIXES = {".msh": "gmsh", ".nc": "UGRID netCDF"}
 MIN_NODE_BYTES = 7  # the shortest gmsh node: "1 0 0 0\n" (text) or a tag and three doubles (binary)
@@ -51,6 +51,7 @@ class MeshFileHeader(NamedTuple):
     sides: tuple
     sides_complete: bool
     size: int
+    other_sides: tuple = ()  # gmsh: physical names of the other dimension's sides (3D in 2D, 2D in 3D)
 
 
 def _fail(path: Path, problem: str) -> MeshError:
@@ -165,8 +166,44 @@ def _gmsh_header(fd: int, path: Path, size: int, dimension: int = 2) -> MeshFile
             f"declares {elements:,} elements on {nodes:,} nodes, more than a "
             f"{'plane' if dimension == 2 else '3D'} mesh has; the file is broken",
         )
-    names = _physical_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path, dimension - 1)
-    return MeshFileHeader(nodes, min(elements, CELLS_PER_VERTEX[dimension] * nodes + 2), names, False, size)
+    named = _physical_names(fd, _find_section(fd, "PhysicalNames", 0, at_nodes), path)
+    shown = _gmsh_dimension(fd, named, version, binary, word, at_nodes)
+    if shown is not None and shown != dimension:
+        raise _fail(path, OTHER_DIMENSION[shown])
+    names = tuple(name for dim, name in named if dim == dimension - 1)
+    others = tuple(name for dim, name in named if dim == (2 if dimension == 2 else 1))
+    return MeshFileHeader(nodes, min(elements, CELLS_PER_VERTEX[dimension] * nodes + 2), names, False, size, others)
+
+
+#: the refusal of a mesh file of the other dimension, by the dimension the file shows (the header's
+#: and the gmsh readers' words, after "<file>: ")
+OTHER_DIMENSION = {
+    3: "is a 3D mesh (it has volumes) but the scene is 2D; set model: 3d",
+    2: "is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; remove model: 3d, or give a 3D mesh file",
+}
+
+
+def _gmsh_dimension(fd, named, version, binary, word, at_nodes) -> int | None:
+    """The dimension a gmsh file shows before its elements are read, or None: 3 with a physical
+    volume named, or volume entities (format 4); 2 with surface but no volume entities (format 4)."""
+    if any(dim == 3 for dim, _ in named):
+        return 3
+    if version != 4:
+        return None
+    at = _find_section(fd, "Entities", 0, at_nodes)
+    if at is None:
+        return None
+    head = _read_at(fd, at, 256)
+    try:
+        if binary:
+            counts = struct.unpack(f"<4{'Q' if word == 8 else 'I'}", head[: 4 * word])
+        else:
+            counts = tuple(int(v) for v in head.split(b"\n", 1)[0].split()[:4])
+    except (ValueError, struct.error):
+        return None
+    if len(counts) != 4:
+        return None
+    return 3 if counts[3] > 0 else 2 if counts[2] > 0 else None
 
 
 def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
@@ -185,8 +222,8 @@ def _gmsh_count(fd, offset, version, binary, word, path, section) -> int:
     return count
 
 
-def _physical_names(fd, offset, path, dimension: int = 1) -> tuple:
-    """The names of the physical groups of ``dimension`` (the sides: lines in 2D, surfaces in 3D)."""
+def _physical_names(fd, offset, path) -> tuple:
+    """(dimension, name) of every named physical group (the sides: lines in 2D, surfaces in 3D)."""
     if offset is None:
         return ()
     text = _read_at(fd, offset, 1 << 20).decode("utf-8", errors="replace").split("\n")
@@ -197,8 +234,8 @@ def _physical_names(fd, offset, path, dimension: int = 1) -> tuple:
     names = []
     for line in text[1 : 1 + count]:
         parts = line.split(None, 2)
-        if len(parts) == 3 and parts[0] == str(dimension):
-            names.append(parts[2].strip().strip('"'))
+        if len(parts) == 3 and parts[0] in ("0", "1", "2", "3"):
+            names.append((int(parts[0]), parts[2].strip().strip('"')))
     return tuple(names)
 
 
@@ -214,7 +251,8 @@ def _ugrid_header(path: Path, size: int, dimension: int = 2) -> MeshFileHeader:
     try:
         nc = netCDF4.Dataset(path, "r")
     except OSError as error:
-        raise _fail(path, f"cannot be read as UGRID netCDF: not a netCDF file ({error.strerror or error})") from None
+        kind = "UGRID netCDF" if dimension == 2 else "a mesh3d netCDF file"
+        raise _fail(path, f"cannot be read as {kind}: not a netCDF file ({error.strerror or error})") from None
     try:
         nc.set_auto_mask(False)
         return _ugrid_counts(nc, path, size) if dimension == 2 else _mesh3d_counts(nc, path, size)
@@ -263,21 +301,50 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     return MeshFileHeader(vertices, cells, sides, True, size)
 
 
+#: most entries of a mesh3d face or volume table per vertex (8 bytes each): a tetrahedral mesh has
+#: about 13 faces of 3 vertices and 6 cells of 4 faces per vertex; padding to the largest face or
+#: cell leaves a margin of 5 or more
+TABLE_ENTRIES_PER_VERTEX = 256
+
+
 def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
-    """The counts and sides of a ``mesh3d`` file (docs/reference/files.md) from its dimensions and attributes."""
+    """The counts and sides of a ``mesh3d`` file from its dimensions and attributes; its
+    tables' declared shapes must be proportional to its nodes (netCDF reads unwritten chunks as fill
+    values: a 40 kB file can declare gigabytes)."""
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
+    if len(topologies) == 1 and str(getattr(topologies[0], "topology_dimension", "2")) == "2":
+        raise _fail(path, "is a 2D mesh (UGRID mesh2d) but the scene is 3D; remove model: 3d, or give a 3D mesh file")
     if len(topologies) != 1 or str(getattr(topologies[0], "topology_dimension", "")) != "3":
         raise _fail(
             path,
             "cannot be read as a mesh3d netCDF file: expected one 3D mesh topology variable (topology_dimension = 3)",
         )
+    topology = topologies[0]
     volumes = _ugrid_variable(
-        nc, getattr(topologies[0], "volume_face_connectivity", None), path, "volume_face_connectivity", 2
+        nc, getattr(topology, "volume_face_connectivity", None), path, "volume_face_connectivity", 2
     )
-    coordinates = str(getattr(topologies[0], "node_coordinates", "")).split()
-    x = _ugrid_variable(nc, coordinates[0] if coordinates else None, path, "node coordinate", 1)
+    faces = _ugrid_variable(nc, getattr(topology, "face_node_connectivity", None), path, "face_node_connectivity", 2)
+    coordinates = str(getattr(topology, "node_coordinates", "")).split()
+    if len(coordinates) != 3:
+        raise _fail(path, "cannot be read as a mesh3d netCDF file: node_coordinates must name three variables (x y z)")
+    x, y, z = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
+    vertices = x.shape[0]
+    if y.shape[0] != vertices or z.shape[0] != vertices:
+        raise _fail(
+            path,
+            f"{vertices:,} x but {y.shape[0]:,} y and {z.shape[0]:,} z node coordinates; the file is broken: "
+            "write it again (vemkit mesh --scene)",
+        )
+    most = TABLE_ENTRIES_PER_VERTEX * vertices + (1 << 20)
+    for table, what in ((faces, "face"), (volumes, "volume")):
+        if table.shape[0] * table.shape[1] > most:
+            raise _fail(
+                path,
+                f"declares a {what} table of {table.shape[0]:,} x {table.shape[1]:,} entries for {vertices:,} "
+                "vertices; the file is broken: write it again (vemkit mesh --scene)",
+            )
     try:
-        names = json.loads(getattr(topologies[0], "vemkit_boundary_parts", "[]"))
+        names = json.loads(getattr(topology, "vemkit_boundary_parts", "[]"))
     except ValueError:
         names = None
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
@@ -286,7 +353,15 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
             "cannot be read as a mesh3d netCDF file: the attribute vemkit_boundary_parts must be a "
             "JSON list of side names",
         )
-    return MeshFileHeader(x.shape[0], volumes.shape[0], tuple(names), True, size)
+    for name in names:
+        key = f"mesh3d_boundary_{name}"
+        if key in nc.variables and (nc.variables[key].ndim != 1 or nc.variables[key].shape[0] > faces.shape[0]):
+            raise _fail(
+                path,
+                f"{key[:80]} declares {nc.variables[key].size:,} faces but the mesh has {faces.shape[0]:,}; "
+                "the file is broken: write it again (vemkit mesh --scene)",
+            )
+    return MeshFileHeader(vertices, volumes.shape[0], tuple(names), True, size)
 
 
 def _ugrid_sides(nc, text, vertices: int, path: Path) -> tuple:

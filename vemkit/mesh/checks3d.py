@@ -15,11 +15,11 @@ offending cell, face or vertex and the defect, for the first problem found. In o
 5. cells point outward: the divergence-theorem volume is positive, and not degenerate (> ``DEGENERATE_TOL``
    x diameter³); a negative volume means the faces point in;
 6. vertices: none unused, no two at the same place (within ``tol`` x the mesh extent);
-7. boundary parts: names are identifiers, faces exist and are boundary faces, no face in two parts,
+7. no two cells overlap: the boundary's winding number is 0 just outside every boundary face
+   (``vemkit.mesh.cover3d``: the volume identity of the divergence theorem cannot see an overlap);
+8. boundary parts: names are identifiers, faces exist and are boundary faces, no face in two parts,
    and (``require_named``) every boundary face in one part (``unnamed_boundary_faces`` lists them).
 
-What is not checked: that two cells do not overlap in space (a mesh whose cells are each closed
-and outward, every face shared consistently, is a valid covering in all families vemkit makes).
 Everything is vectorized (numpy), so a mesh of 10^6 cells is checked in seconds; Numba screens
 (``vemkit.mesh.check_kernels3d``) pass a valid mesh's repeats, faces and closed cells in one pass
 each, the numpy checks deciding whenever a screen does not pass.
@@ -32,6 +32,7 @@ import numpy as np
 from vemkit.exceptions import MeshError
 from vemkit.mesh.check_kernels3d import cells_closed, faces_flat_and_planar, no_repeats
 from vemkit.mesh.close_points import close_pairs, has_close_pair
+from vemkit.mesh.cover3d import check_cover3d
 from vemkit.mesh.geometry import extents
 from vemkit.mesh.polyhedral import PolyhedralMesh
 
@@ -51,6 +52,7 @@ def validate_mesh3d(
     _check_closed(mesh)
     _check_volumes(mesh)
     _check_vertices(mesh, tol)
+    check_cover3d(mesh)
     _check_boundary(mesh, require_named)
 
 

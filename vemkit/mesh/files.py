@@ -4,7 +4,7 @@
 validates the mesh like a family's: a broken mesh is refused with a one-line ``MeshError`` naming
 the file and the cell or vertex (docs/reference/files.md). Before parsing, the file must be a regular file whose
 declared counts fit its size, a plane mesh and the machine (``vemkit.config.mesh_file_header``);
-the parser runs within a memory budget (``vemkit.config.limits.memory_budget``).
+the parser runs within a memory budget (``vemkit.mesh.file_budget``, shared with the 3D reader).
 
 gmsh: the 2D elements (linear triangles and quadrilaterals, mixed freely) are the cells, turned
 counter-clockwise if needed; nodes used by no cell (geometry points) are dropped; z must be 0.
@@ -34,11 +34,11 @@ from pathlib import Path
 import numpy as np
 
 from vemkit.config.domain import SIDE_NAME
-from vemkit.config.limits import check_resources, estimate_resources, memory_budget
-from vemkit.config.mesh_file_header import MESH_SUFFIXES, mesh_file_header
+from vemkit.config.mesh_file_header import OTHER_DIMENSION
 from vemkit.exceptions import MeshError
 from vemkit.mesh.check_kernels import worst_coordinate_over_edge
 from vemkit.mesh.checks import validate_mesh
+from vemkit.mesh.file_budget import parse_within_budget
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
@@ -211,8 +211,6 @@ def json_scalar(value):
 
 # -- any mesh file ------------------------------------------------------------------------------
 _GMSH_CELLS = ("triangle", "quad")
-READ_BASE_BYTES = 512 << 20  # what meshio / xarray may map beyond the file's own size ...
-READ_BYTES_PER_FILE_BYTE = 16  # ... and per byte of the file (measured: gmsh text, 5 x its size)
 MAX_FILE_COORDINATE_OVER_EDGE = 1e7  # a unit square at 1e9 has a shoelace area of rounding noise
 
 
@@ -220,31 +218,11 @@ def read_mesh(path) -> Mesh:
     """The validated mesh in ``path`` (``.msh``: gmsh 2 or 4; ``.nc``: UGRID); MeshError otherwise.
 
     Before the file is parsed: it must be a regular file whose declared counts fit its size, a plane
-    mesh and this machine (``vemkit.config.mesh_file_header``, ``vemkit.config.limits``); the parser
-    then runs within a memory budget of ``READ_BASE_BYTES + READ_BYTES_PER_FILE_BYTE`` x the file
-    size (a node tag of 10^10 in a small file would otherwise make meshio allocate gigabytes)."""
+    mesh and this machine; the parser then runs within a memory budget (a node tag of 10^10 in a
+    small file would otherwise make meshio allocate gigabytes): ``vemkit.mesh.file_budget``, the
+    path the 3D reader takes too."""
     path = Path(path)
-    header = mesh_file_header(path)
-    check_resources(
-        estimate_resources(header.cells, header.vertices), None, what=f"the mesh file {path.name}", fix="a coarser mesh"
-    )
-    kind = MESH_SUFFIXES[path.suffix]
-    try:
-        with memory_budget(READ_BASE_BYTES + READ_BYTES_PER_FILE_BYTE * header.size):
-            mesh = read_gmsh(path) if path.suffix == ".msh" else read_ugrid(path)
-    except MeshError:
-        raise
-    except MemoryError:
-        raise MeshError(
-            f"{path.name}: cannot be read as {kind}: reading it needs far more memory than a mesh of "
-            f"{header.vertices:,} nodes (a node number or count beyond what the file holds)",
-            key=str(path),
-        ) from None
-    except Exception as error:  # a file the reader cannot parse: say which and why, in one line
-        reason = " ".join(str(error).split())
-        raise MeshError(
-            f"{path.name}: cannot be read as {kind}: {reason[:200] or type(error).__name__}", key=str(path)
-        ) from None
+    mesh, _ = parse_within_budget(path, 2, read_gmsh if path.suffix == ".msh" else read_ugrid)
     _check_precision(mesh, path)
     try:
         validate_mesh(mesh)
@@ -286,7 +264,11 @@ def check_coordinate_precision(vertices: np.ndarray, offsets: np.ndarray, polygo
 def read_gmsh(path) -> Mesh:
     """The mesh of a gmsh file (not validated; see ``read_mesh``), sides from physical line groups."""
     path = Path(path)
-    data = _meshio_gmsh(path)
+    from vemkit.mesh.gmsh_errors import read_gmsh_data  # meshio: lazily, not in the core's import
+
+    data = read_gmsh_data(path)
+    if any(block.dim == 3 for block in data.cells):
+        raise MeshError(f"{path.name}: {OTHER_DIMENSION[3]}", key=str(path))
     if data.points.shape[1] == 3 and np.abs(data.points[:, 2]).max(initial=0.0) > 0.0:
         v = int(np.flatnonzero(data.points[:, 2] != 0)[0])
         raise MeshError(
@@ -340,28 +322,6 @@ def read_gmsh(path) -> Mesh:
             )
         return mesh.with_boundary(**_gmsh_sides(mesh, renumber[lines], np.concatenate(line_tags), names, path))
     return mesh.with_boundary(untagged=mesh.boundary_edges)
-
-
-def _meshio_gmsh(path: Path):
-    """meshio's gmsh reader (not meshio.read: on a broken file it prints and exits the process), its
-    warnings kept off the terminal; a file it cannot read, or whose section it finds unclosed, is a
-    MeshError naming the file, the line and the fix (``vemkit.mesh.gmsh_errors``)."""
-    import meshio.gmsh
-
-    from vemkit.mesh.gmsh_errors import gmsh_read_error, meshio_warnings
-
-    notes: list = []
-    with meshio_warnings(notes):
-        try:
-            data = meshio.gmsh.read(path)
-        except MemoryError:
-            raise
-        except Exception as error:  # meshio's raw Python text: located and explained instead
-            raise gmsh_read_error(path, " ".join(str(error).split()) or type(error).__name__) from None
-    unclosed = [note for note in notes if "not closed" in note]
-    if unclosed:
-        raise gmsh_read_error(path, unclosed[0])
-    return data
 
 
 def _gmsh_sides(mesh: Mesh, lines: np.ndarray, tags: np.ndarray, names: dict, path: Path) -> dict:

@@ -22,8 +22,8 @@ binary (base64, UInt64 headers).
 gmsh: linear ``tetra``, ``hexahedron``, ``wedge`` and ``pyramid`` elements are the cells (an
 element given with mirrored node order is turned outward); physical SURFACE groups (triangles,
 quadrilaterals) name the sides, by physical name or else number; boundary faces in no group form
-the part ``untagged``. Every file read is validated (``validate_mesh3d``); a broken one is refused
-with a one-line ``MeshError`` naming the file.
+the part ``untagged``. ``read_mesh3d`` parses within the 2D reader's memory budget
+(``vemkit.mesh.file_budget``) and validates (``validate_mesh3d``): a broken file is one line naming it.
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from vemkit.config.domain import SIDE_NAME
+from vemkit.config.mesh_file_header import OTHER_DIMENSION
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
 from vemkit.mesh.file_description import FileDescription
@@ -95,9 +96,14 @@ def write_ugrid3d(mesh: PolyhedralMesh, path) -> None:
 
 
 def read_ugrid3d(path) -> PolyhedralMesh:
-    """The validated mesh of a ``mesh3d`` netCDF file; MeshError naming the file otherwise. Read
-    through netCDF4 (the stored values, as xarray's ``mask_and_scale=False``), not xarray: its
-    import is 0.7 s of a 3D command."""
+    """The validated mesh of a ``mesh3d`` netCDF file; MeshError naming the file otherwise."""
+    return _validated(parse_ugrid3d(Path(path)), Path(path))
+
+
+def parse_ugrid3d(path: Path) -> PolyhedralMesh:
+    """The mesh of a ``mesh3d`` netCDF file, not validated; MeshError naming the file (a MemoryError
+    passes: see ``read_mesh3d``). Read through netCDF4 (the stored values, as xarray's
+    ``mask_and_scale=False``), not xarray: its import is 0.7 s of a 3D command."""
     path = Path(path)
     t = TOPOLOGY
     import netCDF4
@@ -109,13 +115,12 @@ def read_ugrid3d(path) -> PolyhedralMesh:
                 raise MeshError(
                     f"{path.name}: no variable {t!r}; give a file written by vemkit (a mesh3d topology)", key=str(path)
                 )
-            mesh = _mesh_from_dataset(_StoredVariables(nc), path)
-    except MeshError:
+            return _mesh_from_dataset(_StoredVariables(nc), path)
+    except (MeshError, MemoryError):
         raise
     except Exception as error:
         reason = " ".join(str(error).split())[:200] or type(error).__name__
         raise MeshError(f"{path.name}: cannot be read as a mesh3d netCDF file: {reason}", key=str(path)) from None
-    return _validated(mesh, path)
 
 
 class _StoredVariable:
@@ -289,14 +294,13 @@ def _element_soup(points: np.ndarray, kind: str, nodes: np.ndarray):
 
 def read_gmsh3d(path) -> PolyhedralMesh:
     """The validated mesh of a 3D gmsh file (module doc); MeshError naming the file otherwise."""
-    import meshio.gmsh  # lazily: the core's import time does not pay for meshio's readers
+    from vemkit.mesh.gmsh_errors import read_gmsh_data  # meshio: lazily, not in the core's import
 
-    path = Path(path)
-    try:
-        data = meshio.gmsh.read(path)
-    except Exception as error:
-        reason = " ".join(str(error).split())[:200] or type(error).__name__
-        raise MeshError(f"{path.name}: cannot be read as gmsh: {reason}", key=str(path)) from None
+    return _validated(gmsh3d_mesh(read_gmsh_data(path), Path(path)), Path(path))
+
+
+def gmsh3d_mesh(data, path: Path) -> PolyhedralMesh:
+    """The mesh (not validated) of what meshio read from the 3D gmsh file ``path``."""
     points = np.asarray(data.points, dtype=float)
     if points.shape[1] != 3:
         points = np.column_stack([points, np.zeros((points.shape[0], 3 - points.shape[1]))])
@@ -316,6 +320,8 @@ def read_gmsh3d(path) -> PolyhedralMesh:
                 "hexahedra, prisms (wedge) or pyramids, with triangles or quadrilaterals as surfaces",
                 key=str(path),
             )
+    if not soups and surfaces:
+        raise MeshError(f"{path.name}: {OTHER_DIMENSION[2]}", key=str(path))
     if not soups:
         raise MeshError(
             f"{path.name}: no tetrahedra, hexahedra, prisms or pyramids in the file; give a 3D mesh", key=str(path)
@@ -384,14 +390,16 @@ def _gmsh_sides3d(mesh, surfaces, tags, renumber, names, path) -> dict:
 
 
 def read_mesh3d(path) -> PolyhedralMesh:
-    """A validated 3D mesh file: ``.msh`` (gmsh 2 or 4) or ``.nc`` (mesh3d netCDF)."""
+    """A validated 3D mesh file: ``.msh`` (gmsh 2 or 4) or ``.nc`` (mesh3d netCDF). Read as the 2D
+    reader reads (``vemkit.mesh.file_budget``): the header checked first, the parser within a memory
+    budget, then the mesh built and validated."""
+    from vemkit.mesh.file_budget import parse_within_budget
+    from vemkit.mesh.gmsh_errors import read_gmsh_data
+
     path = Path(path)
-    if not path.is_file():
-        raise MeshError(f"{path}: no such mesh file; give the path of a .msh or .nc file", key=str(path))
     if path.suffix == ".msh":
-        return read_gmsh3d(path)
-    if path.suffix == ".nc":
-        return read_ugrid3d(path)
-    raise MeshError(
-        f"{path.name}: unknown mesh file type {path.suffix!r}; give a .msh (gmsh) or .nc (mesh3d) file", key=str(path)
-    )
+        data, _ = parse_within_budget(path, 3, read_gmsh_data)
+        mesh = gmsh3d_mesh(data, path)
+    else:
+        mesh, _ = parse_within_budget(path, 3, parse_ugrid3d)
+    return _validated(mesh, path)

@@ -5,6 +5,7 @@ for int() with base 10") or only prints a warning. When it fails, :func:`gmsh_re
 ASCII file itself (formats 2.2 and 4.1: the sections, the node and element lines) for the first
 line that is wrong and returns a MeshError naming the file, that line and what it should hold, with
 the fix; where no line can be named (a binary file) it names the file, meshio's reason and the fix.
+:func:`read_gmsh_data` is meshio's reading with these refusals, for the 2D and the 3D reader.
 """
 
 from __future__ import annotations
@@ -61,6 +62,26 @@ class _Problem(Exception):
         self.line, self.text = index + 1, text
 
 
+def read_gmsh_data(path):
+    """meshio's reading of a gmsh file (2D or 3D; not meshio.read: on a broken file it prints and
+    exits the process), its warnings kept off the terminal; a file it cannot read, or whose section
+    it finds unclosed, is a MeshError naming the file, the line and the fix (``gmsh_read_error``).
+    A MemoryError passes (the caller's memory budget reports it)."""
+    path = Path(path)
+    notes: list = []
+    with meshio_warnings(notes):
+        try:
+            data = meshio.gmsh.read(path)
+        except MemoryError:
+            raise
+        except Exception as error:  # meshio's raw Python text: located and explained instead
+            raise gmsh_read_error(path, " ".join(str(error).split()) or type(error).__name__) from None
+    unclosed = [note for note in notes if "not closed" in note]
+    if unclosed:
+        raise gmsh_read_error(path, unclosed[0])
+    return data
+
+
 def gmsh_read_error(path, reason: str) -> MeshError:
     """The MeshError for a gmsh file meshio could not read (``reason``: meshio's own words)."""
     path = Path(path)
@@ -75,6 +96,37 @@ def gmsh_read_error(path, reason: str) -> MeshError:
             key=str(path),
         )
     return MeshError(f"{path.name}, line {found.line}: {found.text}; {FIX}", key=str(path))
+
+
+#: files larger than this are not scanned for their largest node number (the message then names the file)
+SCAN_BYTES = 64 << 20
+
+
+def largest_node_tag(path) -> tuple[int, int] | None:
+    """(line, number) of the largest node number of an ASCII gmsh file (2.2 or 4.1), or None: what
+    makes meshio allocate a table of that many entries."""
+    path = Path(path)
+    try:
+        if path.stat().st_size > SCAN_BYTES:
+            return None
+        lines = path.read_bytes().decode("utf-8", "replace").splitlines()
+        sections = {name: (start, end) for name, start, end in _sections(lines)}
+        version = _format(lines, *sections["MeshFormat"])
+        start, end = sections["Nodes"]
+        if version is None:
+            return None
+        if version < 4:
+            rows = range(start + 1, end)
+        else:
+            rows, i = [], start + 1
+            while i < end:
+                n = int(lines[i].split()[3])
+                rows += range(i + 1, i + 1 + n)
+                i += 1 + 2 * n
+        line = max(rows, key=lambda k: int(lines[k].split()[0]))
+        return line + 1, int(lines[line].split()[0])
+    except (_Problem, KeyError, IndexError, ValueError, OSError):
+        return None
 
 
 def _first_problem(lines: list) -> _Problem | None:
