@@ -78,7 +78,7 @@ import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
-from vemkit.solvers.linear import linear_solver
+from vemkit.solvers.linear import ReducedSolver, linear_solver
 from vemkit.solvers.solution import (
     ContactSolution,
     contact_residual,
@@ -87,8 +87,8 @@ from vemkit.solvers.solution import (
     residual_scale,
     young_modulus,
 )
-from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
-from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis, tangential_diagonal
+from vemkit.solvers.sparse_ops import abs_matvec
+from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 # gamma = GAMMA_FACTOR[d] kd / (L_C h^(d-2) b_ref), see the module docstring; in 3D 0.1 keeps the
@@ -241,7 +241,7 @@ def _plain_start(problem, linear, tol, x0=None):
 def _plain_solution(newton, u):
     """No contact force at the plain linear solution: it is the solution (finished to tol with AMG)."""
     base, tol = newton.base, newton.tol
-    if base.method == "amg" and INITIAL_TOL > tol:
+    if base.iterative and INITIAL_TOL > tol:
         u = base.solve(newton.problem.load, x0=u, tol=tol)
         newton.linear_total += base.iterations
     cb = newton.problem.contact
@@ -286,8 +286,8 @@ def _prepare(newton, t):
     newton.stiffness_cap = cap
     newton.contrast = float(np.max(cb.weight * np.minimum(law.normal_stiffness(np.abs(t)), cap) / kd_nu))
     newton.info["contact_stiffness_contrast"] = newton.contrast
-    if newton.reduced.method == "amg" and newton.contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
-        newton.reduced.method = newton.info["fallback"] = "direct"
+    if newton.contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
+        _fall_back(newton)
     b_lin = law.friction_bound(t)
     b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
@@ -298,6 +298,14 @@ def _prepare(newton, t):
     else:
         newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
+
+
+def _fall_back(newton):
+    """Newton solves on the backend's fallback (AMG: direct), recorded in info["fallback"]; nothing
+    when the backend has none."""
+    fallback = newton.reduced.fall_back()
+    if fallback is not None:
+        newton.info["fallback"] = fallback
 
 
 def _gamma_length(cb) -> float:
@@ -398,9 +406,9 @@ def _newton_iteration(newton, point, k) -> _Point:
     alpha, new = line_search(point, trial, lambda p: _slope(newton, p, du_tau, du), d0, newton.energy_merit)
     newton.theta_previous = point.theta
     newton.short_steps = newton.short_steps + 1 if alpha < SHORT_STEP else 0
-    if newton.reduced.method == "amg" and newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
+    if newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
         # inexact CG steps of a badly conditioned K + J (k_nu w >> K) stall the line search
-        newton.reduced.method = newton.info["fallback"] = "direct"
+        _fall_back(newton)
     record = {
         "residual": np.sqrt(new.theta) / new.scale,
         "du": float(alpha * np.linalg.norm(du) / max(np.linalg.norm(new.u), np.finfo(float).tiny)),
@@ -409,7 +417,7 @@ def _newton_iteration(newton, point, k) -> _Point:
         "active_changes": changes,
         "linear_iterations": its,
     }
-    if newton.base.method == "amg":
+    if newton.base.iterative:
         record["eta"] = newton.eta
     newton.records.append(record)
     return new
@@ -455,11 +463,8 @@ def _newton_direction(newton, point, k):
         lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
         slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    if newton.reduced.method == "direct":  # formed as it always was: the same numbers to the last bit
-        A = K + J if slope_blocks is None else K + J + slope_blocks
-        A = A.tocsr()
-    else:  # K x + J x: no copy of K's values (formed, on K's index arrays, only for a rebuilt hierarchy)
-        A = SumOperator(K, J if slope_blocks is None else J + slope_blocks)
+    # direct: K + J (+ slope) formed as it always was; AMG: K x + J x, no copy of K's values
+    A = newton.reduced.operator(K, J) if slope_blocks is None else newton.reduced.operator(K, J, slope_blocks)
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction
@@ -474,7 +479,7 @@ def _newton_direction(newton, point, k):
 def _solve_newton_system(newton, point, k, A, Z, rhs, penalty):
     """Z y with Z^T A Z y = Z^T rhs; inexact (Eisenstat-Walker) with AMG, never looser than tol needs."""
     tol = newton.tol
-    if newton.base.method == "amg" and k > 1:
+    if newton.base.iterative and k > 1:
         newton.eta = min(ETA_MAX, 0.9 * point.theta / newton.theta_previous)  # Eisenstat-Walker, choice 2
     floor = 0.1 * tol * point.scale / max(np.linalg.norm(rhs), np.finfo(float).tiny)
     newton.eta = min(max(newton.eta, floor, 1e-14), ETA_MAX)

@@ -28,7 +28,6 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
-from vemkit.solvers.sparse_ops import SumOperator
 from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis, stick_multiplier, stick_shift
 
 STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
@@ -80,7 +79,7 @@ def disk_direction(newton, point, k, sets, solve):
         along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
         J = J + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
     # direct: K + J formed as it always was; AMG: K x + J x, no copy of K's values
-    A = (K + J).tocsr() if newton.reduced.method == "direct" else SumOperator(K, J)
+    A = newton.reduced.operator(K, J)
     rhs = -(point.R - friction_now) - A @ shift - slip_force
     correction, its = solve(newton, point, k, A, Z, rhs, penalty)
     du = shift + correction

@@ -176,7 +176,7 @@ class _Uzawa:
 
     @property
     def inexact(self) -> bool:
-        return self.solver.method == "amg"
+        return self.solver.iterative
 
 
 def solve_uzawa(
