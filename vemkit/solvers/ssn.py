@@ -282,14 +282,15 @@ def _prepare(newton, t):
     kd_nu = direction_diagonal(K, cb, cb.normal)
     newton.reduced = ReducedSolver(problem, newton.base, newton.baseline)
     # p_nu' is unbounded at 0 only for m_nu < 1: cap it there (a modified Newton step)
-    cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if 0.0 < law.m_normal < 1.0 else np.inf
+    cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if law.normal_stiffness_unbounded else np.inf
     newton.stiffness_cap = cap
     newton.contrast = float(np.max(cb.weight * np.minimum(law.normal_stiffness(np.abs(t)), cap) / kd_nu))
     newton.info["contact_stiffness_contrast"] = newton.contrast
     if newton.contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
         _fall_back(newton)
     b_lin = law.friction_bound(t)
-    b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
+    k_tau = law.friction_coefficient
+    b_ref = k_tau if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else k_tau)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
         from vemkit.solvers.ssn_disk import coupled_gamma
@@ -331,7 +332,7 @@ def _evaluate(newton, u, lam) -> _Point:
     scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
     point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
     if newton.energy_merit:
-        friction = law.k_friction * (cb.weight @ cb.magnitude(slip))
+        friction = law.friction_coefficient * (cb.weight @ cb.magnitude(slip))
         point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
     return point
 
@@ -377,7 +378,7 @@ def _slope(newton, point, du_tau, du) -> float:
     """Directional derivative of the energy at ``point`` along du (one-sided for |u_tau|)."""
     cb, law = newton.problem.contact, newton.problem.law
     friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau), cb.magnitude(du_tau))
-    return float(point.gradient @ du + law.k_friction * (cb.weight @ friction))
+    return float(point.gradient @ du + law.friction_coefficient * (cb.weight @ friction))
 
 
 def _newton_iteration(newton, point, k) -> _Point:
@@ -502,22 +503,22 @@ def _fail(problem, k, what, records, contrast=0.0, *, reason):
     head = f"ssn did not converge after {k} iterations ({what})"
     if contrast > CONTRAST_WARNING:
         culprit = (
-            f"contact.normal.k = {law.k_normal:g} makes the contact {contrast:.0e} times stiffer than the body "
-            f"(E = {E:g}), beyond what double precision resolves; lower contact.normal.k or rescale E"
+            f"{law.normal_stiffness_text} makes the contact {contrast:.0e} times stiffer than the body "
+            f"(E = {E:g}), beyond what double precision resolves; lower {law.normal_stiffness_key} or rescale E"
         )
     elif not law.reduced:
         culprit = (
-            f"the friction bound of contact.friction.m = {law.m_friction:g} (k = {law.k_friction:g} against "
-            f"contact.normal.k = {law.k_normal:g}) couples too strongly to the penetration; try a smaller friction.k"
+            f"the friction bound of {law.friction_text} couples too strongly to the penetration "
+            f"({law.normal_stiffness_text}); try a smaller contact.friction.k"
         )
     elif any(r["active_changes"] > 0 for r in records[-5:]):
         culprit = (
-            f"the stick/slip/contact sets keep changing (contact.friction.k = {law.k_friction:g}, "
-            f"contact.normal.k = {law.k_normal:g}, E = {E:g}); try a larger solver.max_iterations or solver.linear=direct"
+            f"the stick/slip/contact sets keep changing (contact.friction.k = {law.friction_coefficient:g}, "
+            f"{law.normal_stiffness_text}, E = {E:g}); try a larger solver.max_iterations or solver.linear=direct"
         )
     else:
         culprit = (
-            f"the normal compliance contact.normal.m = {law.m_normal:g} (k = {law.k_normal:g}, E = {E:g}) "
-            f"converges slowly; try a larger solver.max_iterations"
+            f"the normal compliance {law.normal_text} converges slowly against E = {E:g}; "
+            f"try a larger solver.max_iterations"
         )
     raise ConvergenceError(f"{head}: {culprit}", solver="ssn", reason=reason, iterations=k)
