@@ -62,7 +62,8 @@ backtracking on theta. Convergence: theta^1/2 <= tol * ||f||, or at the rounding
 residual evaluation (ROUNDING_FLOOR eps || |K||u| + |f| + |J||u| ||, reached only when the contact is
 ~1e9 times stiffer than the body); otherwise a one-line ConvergenceError naming the likely culprit.
 
-The linear algebra of the steps and the line search are in vemkit.solvers.ssn_steps.
+The linear algebra of the steps and the line search are in vemkit.solvers.ssn_steps, an iterate and its
+merit in vemkit.solvers.ssn_point, the failure messages in vemkit.solvers.ssn_failures.
 
 Cheap path: if the contact forces vanish at the plain linear solution (no vertex penetrates and the
 friction bound is zero there: frictionless, or m_tau > 0, with a never-closing gap) that solution
@@ -79,15 +80,9 @@ import numpy as np
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import ReducedSolver, linear_solver
-from vemkit.solvers.solution import (
-    ContactSolution,
-    contact_residual,
-    history_arrays,
-    relative_slip,
-    residual_scale,
-    young_modulus,
-)
-from vemkit.solvers.sparse_ops import abs_matvec
+from vemkit.solvers.solution import ContactSolution, contact_residual, history_arrays, relative_slip
+from vemkit.solvers.ssn_failures import CONTRAST_WARNING, fail
+from vemkit.solvers.ssn_point import Point, converged, energy_slope, evaluate
 from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
@@ -95,13 +90,11 @@ NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness 
 # coarse meshes' gamma where 0.5 without h had it (4x less at n_c = 16) -- 0.2 lost 1e-10 agreement of
 # uzawa and ssn on a 3 x 3 x 3 Voronoi box with m_tau = 1, 0.5 stalled a load step at 9e-12 > 1e-12
 GAMMA_FACTOR = {2: 0.5, 3: 0.1}
-ROUNDING_FLOOR = 100.0  # accept a residual this many times eps * || |K| |u| + |f| + |J| |u| || (see _converged)
 ETA_MAX = 1e-3  # loosest relative CG tolerance of an inexact Newton step
 INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that starts the iteration
 SHORT_STEP = 1e-2  # two accepted steps shorter than this with AMG: switch the Newton solves to direct
 DIRECT_FALLBACK_LIMIT = 500_000  # ... if there are at most this many dofs
 AMG_CONTRAST_LIMIT = 1e6  # w p_nu' / (stiffness diagonal) above which the Newton solves are direct
-CONTRAST_WARNING = 1e8  # failures with w p_nu' / kd above this are blamed on the conditioning
 STICK_PENALTY = 1e3  # penalty (times the stiffness diagonal) on stick tangents in a rebuilt hierarchy
 
 
@@ -140,23 +133,6 @@ class _Newton:
         return self.problem.contact.zero_multiplier()
 
 
-@dataclass
-class _Point:
-    """An iterate (u, lambda) and everything the step and the line search need there."""
-
-    u: np.ndarray
-    lam: np.ndarray
-    t: np.ndarray  # u_nu - g
-    slip: np.ndarray  # u_tau
-    gradient: np.ndarray  # gradient of the energy without the friction term
-    R: np.ndarray  # the equilibrium residual
-    q: np.ndarray  # lambda + gamma u_tau
-    theta: float  # the residual merit ||R||^2 + ||w b_ref C||^2
-    scale: float  # residual_scale
-    energy: float = 0.0
-    floor: float = 0.0
-
-
 def solve_ssn(
     problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None, initial=None, slip_reference=None
 ) -> ContactSolution:
@@ -182,30 +158,30 @@ def solve_ssn(
         trial = newton.kd_tau * relative_slip(cb, u, slip_reference) / (cb.weight * newton.b_ref)
     else:
         trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), relative_slip(cb, u, slip_reference))
-    point = _evaluate(newton, u, cb.project(trial))
+    point = evaluate(newton, u, cb.project(trial))
     if initial is not None:
-        warm = _evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
+        warm = evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
         newton.info["warm_start"] = bool(warm.theta < point.theta)
         point = warm if warm.theta < point.theta else point
     newton.theta_previous = point.theta
     for k in range(1, max_iterations + 1):
-        if _converged(newton, point):
+        if converged(newton, point):
             lam, move = _returned_multiplier(newton, point)
             if move <= newton.tol:
                 return _finish(newton, point.u, lam, k - 1)
-            point = _evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
+            point = evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
         point = _newton_iteration(newton, point, k)
-        if cb.dimension == 3 and not _converged(newton, point):
+        if cb.dimension == 3 and not converged(newton, point):
             from vemkit.solvers.ssn_disk import aligned_multiplier
 
             lam = aligned_multiplier(newton, point)  # the slip direction, when only it is left
-            point = point if lam is None else _evaluate(newton, point.u, lam)
+            point = point if lam is None else evaluate(newton, point.u, lam)
         if progress is not None:
             progress(k, newton.records[-1])
     lam, move = _returned_multiplier(newton, point)
-    if _converged(newton, point) and move <= newton.tol:
+    if converged(newton, point) and move <= newton.tol:
         return _finish(newton, point.u, lam, max_iterations)
-    _fail(
+    fail(
         problem,
         max_iterations,
         f"residual {np.sqrt(point.theta) / point.scale:.1e} > tol {tol:.0e}",
@@ -315,79 +291,13 @@ def _gamma_length(cb) -> float:
     return area if cb.dimension == 2 else float(np.sqrt(area * area / cb.size))
 
 
-def _evaluate(newton, u, lam) -> _Point:
-    """Everything the step and the line search need at (u, lambda)."""
-    problem = newton.problem
-    K, f, cb, law, n = problem.stiffness, problem.load, problem.contact, problem.law, problem.n_dofs
-    zero = newton.zero
-    t = cb.normal_displacement(u) - cb.gap
-    slip = relative_slip(cb, u, newton.slip_reference)
-    Ku = K @ u
-    normal_force = cb.normal_force(u, law)
-    friction_force = cb.scatter(zero, cb.times(cb.weight * law.friction_bound(t), lam), n)
-    gradient = Ku + normal_force - f
-    R = gradient + friction_force
-    q = lam + cb.times(newton.gamma, slip)
-    C = cb.times(complementarity_weight(newton, t), lam - cb.project(q))
-    scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
-    point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
-    if newton.energy_merit:
-        friction = law.friction_coefficient * (cb.weight @ cb.magnitude(slip))
-        point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
-    return point
-
-
-def complementarity_weight(newton, t):
-    """The weight of C in the merit: w b_ref for the reduced law; w p_tau(t) for m_tau > 0, so that
-    C counts as the friction force it misplaces and a vertex without friction force (p_tau = 0, where
-    lambda only follows the slip direction) does not count: with w b_ref there, its lambda moved
-    by the step made the Newton direction no descent direction of theta (measured on the Hertz half
-    sphere, a stall at a step length ~0)."""
-    cb, law = newton.problem.contact, newton.problem.law
-    return cb.weight * (newton.b_ref if law.reduced else law.friction_bound(t))
-
-
-def _converged(newton, point) -> bool:
-    """Relative residual <= tol, or at the rounding floor of its own evaluation (ill-conditioned cases)."""
-    residual = np.sqrt(point.theta) / point.scale
-    if newton.problem.contact.dimension == 3:  # and the slip direction resolved (vemkit.solvers.ssn_disk)
-        from vemkit.solvers.ssn_disk import disk_alignment
-
-        residual = max(residual, disk_alignment(newton, point))
-        # and lambda in the unit disk to tol, as the independent check asks: neither the weighted C nor
-        # the rounding floor below sees |lambda| > 1 where w b is small against the body's forces
-        # (E = 2e9, k_tau = 3: |lambda| = 1 + 2.8e-4 was accepted after one step)
-        excess = float(np.max(newton.problem.contact.magnitude(point.lam) - 1.0, initial=0.0))
-        if excess > newton.tol:
-            return False
-    if residual <= newton.tol:
-        return True
-    problem = newton.problem
-    cb, law = problem.contact, problem.law
-    stiff = cb.weight * np.minimum(law.normal_stiffness(point.t), newton.stiffness_cap) * np.abs(point.t + cb.gap)
-    size = (
-        abs_matvec(problem.stiffness, np.abs(point.u))
-        + np.abs(problem.load)
-        + cb.scatter(stiff, newton.zero_tangential, problem.n_dofs)
-    )
-    point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
-    return residual <= point.floor
-
-
-def _slope(newton, point, du_tau, du) -> float:
-    """Directional derivative of the energy at ``point`` along du (one-sided for |u_tau|)."""
-    cb, law = newton.problem.contact, newton.problem.law
-    friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau), cb.magnitude(du_tau))
-    return float(point.gradient @ du + law.friction_coefficient * (cb.weight @ friction))
-
-
-def _newton_iteration(newton, point, k) -> _Point:
+def _newton_iteration(newton, point, k) -> Point:
     """One Newton step from ``point`` with its line search; appends the history record."""
     problem = newton.problem
     cb, n = problem.contact, problem.n_dofs
     du, lam_new, its, changes = _newton_direction(newton, point, k)
     if not (np.all(np.isfinite(du)) and np.all(np.isfinite(lam_new))):
-        _fail(
+        fail(
             problem,
             k,
             "non-finite Newton step",
@@ -397,14 +307,14 @@ def _newton_iteration(newton, point, k) -> _Point:
         )
     u, lam = point.u, point.lam
     dlam = lam_new - lam
-    full = _evaluate(newton, u + du, lam_new)
+    full = evaluate(newton, u + du, lam_new)
     du_tau = cb.tangential_displacement(du)
 
     def trial(alpha):
-        return full if alpha == 1.0 else _evaluate(newton, u + alpha * du, lam + alpha * dlam)
+        return full if alpha == 1.0 else evaluate(newton, u + alpha * du, lam + alpha * dlam)
 
-    d0 = _slope(newton, point, du_tau, du) if newton.energy_merit else 0.0
-    alpha, new = line_search(point, trial, lambda p: _slope(newton, p, du_tau, du), d0, newton.energy_merit)
+    d0 = energy_slope(newton, point, du_tau, du) if newton.energy_merit else 0.0
+    alpha, new = line_search(point, trial, lambda p: energy_slope(newton, p, du_tau, du), d0, newton.energy_merit)
     newton.theta_previous = point.theta
     newton.short_steps = newton.short_steps + 1 if alpha < SHORT_STEP else 0
     if newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
@@ -495,30 +405,3 @@ def _solve_newton_system(newton, point, k, A, Z, rhs, penalty):
         raise ConvergenceError(f"ssn: {exc}", solver="ssn", reason="linear_solver_failed", iterations=k) from exc
     newton.linear_total += its
     return correction, its
-
-
-def _fail(problem, k, what, records, contrast=0.0, *, reason):
-    """Raise a one-line ConvergenceError (``reason``, see vemkit.exceptions) naming the likely culprit."""
-    law, E = problem.law, young_modulus(problem)
-    head = f"ssn did not converge after {k} iterations ({what})"
-    if contrast > CONTRAST_WARNING:
-        culprit = (
-            f"{law.normal_stiffness_text} makes the contact {contrast:.0e} times stiffer than the body "
-            f"(E = {E:g}), beyond what double precision resolves; lower {law.normal_stiffness_key} or rescale E"
-        )
-    elif not law.reduced:
-        culprit = (
-            f"the friction bound of {law.friction_text} couples too strongly to the penetration "
-            f"({law.normal_stiffness_text}); try a smaller contact.friction.k"
-        )
-    elif any(r["active_changes"] > 0 for r in records[-5:]):
-        culprit = (
-            f"the stick/slip/contact sets keep changing (contact.friction.k = {law.friction_coefficient:g}, "
-            f"{law.normal_stiffness_text}, E = {E:g}); try a larger solver.max_iterations or solver.linear=direct"
-        )
-    else:
-        culprit = (
-            f"the normal compliance {law.normal_text} converges slowly against E = {E:g}; "
-            f"try a larger solver.max_iterations"
-        )
-    raise ConvergenceError(f"{head}: {culprit}", solver="ssn", reason=reason, iterations=k)
