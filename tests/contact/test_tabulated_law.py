@@ -134,3 +134,19 @@ def test_the_command_refuses_a_bad_table_with_one_line(tmp_path):
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and "contact.normal.penetration" in lines[0] and "increase" in lines[0]
     assert not out.exists()
+
+
+def test_uzawa_on_a_stiff_table_names_the_table_and_its_slope():
+    """Uzawa's contraction estimate asks the law (its largest slope), not a k it does not have."""
+    from dataclasses import replace
+
+    from vemkit.exceptions import ConvergenceError
+    from vemkit.solvers.uzawa import solve_uzawa
+
+    scene = vemkit.load_scene(PAPER, ["discretization.mesh.n=16"])
+    problem = vemkit.scene_problem(scene)
+    stiff = replace(problem, law=TabulatedContactLaw((0.0, 0.01, 1.0), (0.0, 10.0, 1e6), 450.0, 0.0))
+    with pytest.raises(ConvergenceError) as failure:
+        solve_uzawa(stiff, linear="direct")
+    message = str(failure.value)
+    assert "\n" not in message and "unstable for the table contact.normal (largest slope 1.01009e+06)" in message
