@@ -106,3 +106,45 @@ def test_the_public_api_resolves():
 
     for name in vemkit.__all__:
         assert getattr(vemkit, name) is not None
+
+
+LINEAR_LAYER = PACKAGE / "solvers" / "linear"
+
+
+def _linear_backend_names() -> set:
+    """The values of solver.linear that name a backend (the schema's enum without auto)."""
+    schema = json.loads((PACKAGE / "config" / "schemas" / "scene.schema.json").read_text(encoding="utf-8"))
+    return set(schema["properties"]["solver"]["properties"]["linear"]["enum"]) - {"auto"}
+
+
+def test_only_the_linear_solver_layer_names_a_linear_solver():
+    """ssn, uzawa and everything else use the backends' interface (vemkit/solvers/linear/base.py): no
+    string constant outside vemkit/solvers/linear/ is a backend's name (no ``.method == "amg"``)."""
+    names = _linear_backend_names()
+    found = [
+        f"{module}:{node.lineno} {node.value!r}"
+        for module, path in _modules()
+        if LINEAR_LAYER not in path.parents
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in names
+    ]
+    assert not found, f"linear-solver names outside vemkit/solvers/linear/: {found}"
+
+
+def test_every_linear_solver_of_the_schema_has_its_backend():
+    from vemkit.solvers.linear import backends
+
+    assert set(backends()) == _linear_backend_names()
+
+
+def test_the_solvers_never_read_a_contact_laws_parameters():
+    """The solvers ask the law (vemkit.contact.laws.FoundationLaw) for p_nu, p_nu', the friction bound
+    and its derivative; they never read a law's k_ or m_ (a power law's parameters)."""
+    found = [
+        f"{module}:{node.lineno} .{node.attr}"
+        for module, path in _modules()
+        if module.startswith("vemkit.solvers")
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Attribute) and node.attr.startswith(("k_", "m_"))
+    ]
+    assert not found, f"the solvers read a law's parameters: {found}"

@@ -281,7 +281,7 @@ def check_sides(data: dict, sides) -> None:
 
 def check_contact(data: dict, given_contact: dict, domain, compiled: dict) -> None:
     contact, sides = data["contact"], data["boundary"]["contact"]
-    if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
+    if "k" in contact["normal"] and contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
         raise SceneError(
             f"contact.normal.k = {contact['normal']['k']:g}: must be at most "
             f"{MAX_NORMAL_K_OVER_E:g} material.E = {MAX_NORMAL_K_OVER_E * data['material']['E']:g} "

@@ -12,11 +12,11 @@ from __future__ import annotations
 import copy
 from functools import partial
 from pathlib import Path
-from typing import NamedTuple
 
 import yaml
 
 from vemkit.config.boundary_conditions import (
+    MAX_NORMAL_K_OVER_E,
     boundary_expressions,
     check_contact,
     check_mesh_size,
@@ -26,6 +26,7 @@ from vemkit.config.boundary_conditions import (
     evaluate_checked,
     inside_points,
 )
+from vemkit.config.contact_laws import PowerLaw, TabulatedLaw, check_normal_compliance, normal_compliance
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
 from vemkit.config.domain3d import domain3d_from_spec
 from vemkit.config.expressions import Expression
@@ -40,13 +41,6 @@ from vemkit.config.scene_schema import normalized, scene_schema, schema_root, sh
 from vemkit.exceptions import SceneError
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml", "scene_schema"]
-
-
-class PowerLaw(NamedTuple):
-    """``p(t) = k (t)_+^m`` (5.1)."""
-
-    k: float
-    m: float
 
 
 def _check_order_options(discretization: dict) -> None:
@@ -66,6 +60,8 @@ def _semantic_checks(data: dict, given: dict) -> dict:
     """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
     written (before the defaults were filled in)."""
     check_model_domain(data)
+    if "contact" in data:  # the law contact.normal names (2D and 3D), its keys and its table
+        check_normal_compliance(data["contact"]["normal"], max_slope=MAX_NORMAL_K_OVER_E * data["material"]["E"])
     if data["model"] == "3d":
         return semantic_checks_3d(data, given)
     check_mesh_size(data["discretization"]["mesh"])
@@ -237,16 +233,19 @@ class Scene:
         return folder / name
 
     normal_compliance = property(
-        lambda self: self._contact_law("normal"), doc="PowerLaw p_nu(t) = k (t)_+^m; None without contact section"
+        lambda self: self._contact_law("normal"),
+        doc="PowerLaw p_nu(t) = k (t)_+^m, or TabulatedLaw (contact.normal.law: table); None without contact section",
     )
     friction_bound = property(
         lambda self: self._contact_law("friction"),
         doc="PowerLaw p_tau(t) = k (t)_+^m (m = 0: the paper's reduced law); None without contact section",
     )
 
-    def _contact_law(self, kind: str) -> PowerLaw | None:
+    def _contact_law(self, kind: str) -> PowerLaw | TabulatedLaw | None:
         contact = self._data.get("contact")
-        return PowerLaw(**contact[kind]) if contact else None
+        if not contact:
+            return None
+        return normal_compliance(contact["normal"]) if kind == "normal" else PowerLaw(**contact[kind])
 
     def to_yaml(self) -> str:
         """The full, defaults-filled scene as YAML; loads back to an equal scene."""

@@ -185,7 +185,7 @@ def semantic_checks_3d(data: dict, given: dict) -> dict:
 def check_contact_3d(data: dict, given_contact: dict, probes: BodyProbes | None, compiled: dict) -> None:
     """The contact section of a 3D scene (module docstring); ``probes`` None: a mesh file's body."""
     contact, sides = data["contact"], data["boundary"]["contact"]
-    if contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
+    if "k" in contact["normal"] and contact["normal"]["k"] > MAX_NORMAL_K_OVER_E * data["material"]["E"]:
         raise SceneError(
             f"contact.normal.k = {contact['normal']['k']:g}: must be at most {MAX_NORMAL_K_OVER_E:g} "
             "material.E (stiffer is rigid contact, beyond double precision); fix the scene",

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from vemkit.config.boundary_conditions import check_expressions_on_mesh, free_rigid_motion, rigid_motion_error
 from vemkit.config.expressions import vector_field
 from vemkit.contact.boundary import ContactBoundary, FoundationLine, check_quadrature, contact_boundary
-from vemkit.contact.laws import ContactLaw
+from vemkit.contact.laws import ContactLaw, FoundationLaw, contact_law
 from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
 from vemkit.exceptions import SceneError
 from vemkit.mesh.components import mesh_pieces
@@ -43,7 +43,7 @@ class DiscreteProblem:
     stiffness: sp.csr_matrix
     load: np.ndarray
     contact: ContactBoundary
-    law: ContactLaw
+    law: FoundationLaw
     lam: float
     mu: float
     stabilization: str
@@ -175,7 +175,7 @@ def discrete_problem(
     pressure=None,
     contact=(),
     gap=lambda x, *_: np.zeros_like(x),
-    law: ContactLaw | None = None,
+    law: FoundationLaw | None = None,
     body_force=None,
     stabilization: str = "dofi-2mu",
     contact_quadrature: str = "nodal",
@@ -233,7 +233,7 @@ def scene_problem_data(scene) -> dict:
     if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
         body = vector_field(scene.body_force)
     normal, friction = scene.normal_compliance, scene.friction_bound
-    law = ContactLaw(normal.k, normal.m, friction.k, friction.m) if normal is not None else None
+    law = contact_law(normal, friction) if normal is not None else None
     pressures = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
     return dict(
         order=scene.order,

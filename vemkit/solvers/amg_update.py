@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from vemkit.solvers.linear import transfers_in_precision, v_cycle
+from vemkit.solvers.linear.cycle import transfers_in_precision, v_cycle
 from vemkit.solvers.nodal_smoother import NodalBlocks, nodal_smoothers
 
 

@@ -62,7 +62,8 @@ backtracking on theta. Convergence: theta^1/2 <= tol * ||f||, or at the rounding
 residual evaluation (ROUNDING_FLOOR eps || |K||u| + |f| + |J||u| ||, reached only when the contact is
 ~1e9 times stiffer than the body); otherwise a one-line ConvergenceError naming the likely culprit.
 
-The linear algebra of the steps and the line search are in vemkit.solvers.ssn_steps.
+The linear algebra of the steps and the line search are in vemkit.solvers.ssn_steps, an iterate and its
+merit in vemkit.solvers.ssn_point, the failure messages in vemkit.solvers.ssn_failures.
 
 Cheap path: if the contact forces vanish at the plain linear solution (no vertex penetrates and the
 friction bound is zero there: frictionless, or m_tau > 0, with a never-closing gap) that solution
@@ -78,30 +79,22 @@ import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
-from vemkit.solvers.linear import linear_solver
-from vemkit.solvers.solution import (
-    ContactSolution,
-    contact_residual,
-    history_arrays,
-    relative_slip,
-    residual_scale,
-    young_modulus,
-)
-from vemkit.solvers.sparse_ops import SumOperator, abs_matvec
-from vemkit.solvers.ssn_steps import ReducedSolver, direction_diagonal, line_search, stick_basis, tangential_diagonal
+from vemkit.solvers.linear import ReducedSolver, linear_solver
+from vemkit.solvers.solution import ContactSolution, contact_residual, history_arrays, relative_slip
+from vemkit.solvers.ssn_failures import CONTRAST_WARNING, fail
+from vemkit.solvers.ssn_point import Point, converged, energy_slope, evaluate
+from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 # gamma = GAMMA_FACTOR[d] kd / (L_C h^(d-2) b_ref), see the module docstring; in 3D 0.1 keeps the
 # coarse meshes' gamma where 0.5 without h had it (4x less at n_c = 16) -- 0.2 lost 1e-10 agreement of
 # uzawa and ssn on a 3 x 3 x 3 Voronoi box with m_tau = 1, 0.5 stalled a load step at 9e-12 > 1e-12
 GAMMA_FACTOR = {2: 0.5, 3: 0.1}
-ROUNDING_FLOOR = 100.0  # accept a residual this many times eps * || |K| |u| + |f| + |J| |u| || (see _converged)
 ETA_MAX = 1e-3  # loosest relative CG tolerance of an inexact Newton step
 INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that starts the iteration
 SHORT_STEP = 1e-2  # two accepted steps shorter than this with AMG: switch the Newton solves to direct
 DIRECT_FALLBACK_LIMIT = 500_000  # ... if there are at most this many dofs
 AMG_CONTRAST_LIMIT = 1e6  # w p_nu' / (stiffness diagonal) above which the Newton solves are direct
-CONTRAST_WARNING = 1e8  # failures with w p_nu' / kd above this are blamed on the conditioning
 STICK_PENALTY = 1e3  # penalty (times the stiffness diagonal) on stick tangents in a rebuilt hierarchy
 
 
@@ -140,23 +133,6 @@ class _Newton:
         return self.problem.contact.zero_multiplier()
 
 
-@dataclass
-class _Point:
-    """An iterate (u, lambda) and everything the step and the line search need there."""
-
-    u: np.ndarray
-    lam: np.ndarray
-    t: np.ndarray  # u_nu - g
-    slip: np.ndarray  # u_tau
-    gradient: np.ndarray  # gradient of the energy without the friction term
-    R: np.ndarray  # the equilibrium residual
-    q: np.ndarray  # lambda + gamma u_tau
-    theta: float  # the residual merit ||R||^2 + ||w b_ref C||^2
-    scale: float  # residual_scale
-    energy: float = 0.0
-    floor: float = 0.0
-
-
 def solve_ssn(
     problem, *, linear="auto", tol=1e-10, max_iterations=50, progress=None, initial=None, slip_reference=None
 ) -> ContactSolution:
@@ -182,30 +158,30 @@ def solve_ssn(
         trial = newton.kd_tau * relative_slip(cb, u, slip_reference) / (cb.weight * newton.b_ref)
     else:
         trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), relative_slip(cb, u, slip_reference))
-    point = _evaluate(newton, u, cb.project(trial))
+    point = evaluate(newton, u, cb.project(trial))
     if initial is not None:
-        warm = _evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
+        warm = evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
         newton.info["warm_start"] = bool(warm.theta < point.theta)
         point = warm if warm.theta < point.theta else point
     newton.theta_previous = point.theta
     for k in range(1, max_iterations + 1):
-        if _converged(newton, point):
+        if converged(newton, point):
             lam, move = _returned_multiplier(newton, point)
             if move <= newton.tol:
                 return _finish(newton, point.u, lam, k - 1)
-            point = _evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
+            point = evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
         point = _newton_iteration(newton, point, k)
-        if cb.dimension == 3 and not _converged(newton, point):
+        if cb.dimension == 3 and not converged(newton, point):
             from vemkit.solvers.ssn_disk import aligned_multiplier
 
             lam = aligned_multiplier(newton, point)  # the slip direction, when only it is left
-            point = point if lam is None else _evaluate(newton, point.u, lam)
+            point = point if lam is None else evaluate(newton, point.u, lam)
         if progress is not None:
             progress(k, newton.records[-1])
     lam, move = _returned_multiplier(newton, point)
-    if _converged(newton, point) and move <= newton.tol:
+    if converged(newton, point) and move <= newton.tol:
         return _finish(newton, point.u, lam, max_iterations)
-    _fail(
+    fail(
         problem,
         max_iterations,
         f"residual {np.sqrt(point.theta) / point.scale:.1e} > tol {tol:.0e}",
@@ -241,7 +217,7 @@ def _plain_start(problem, linear, tol, x0=None):
 def _plain_solution(newton, u):
     """No contact force at the plain linear solution: it is the solution (finished to tol with AMG)."""
     base, tol = newton.base, newton.tol
-    if base.method == "amg" and INITIAL_TOL > tol:
+    if base.iterative and INITIAL_TOL > tol:
         u = base.solve(newton.problem.load, x0=u, tol=tol)
         newton.linear_total += base.iterations
     cb = newton.problem.contact
@@ -282,14 +258,15 @@ def _prepare(newton, t):
     kd_nu = direction_diagonal(K, cb, cb.normal)
     newton.reduced = ReducedSolver(problem, newton.base, newton.baseline)
     # p_nu' is unbounded at 0 only for m_nu < 1: cap it there (a modified Newton step)
-    cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if 0.0 < law.m_normal < 1.0 else np.inf
+    cap = NORMAL_STIFFNESS_CAP * kd_nu / cb.weight if law.normal_stiffness_unbounded else np.inf
     newton.stiffness_cap = cap
     newton.contrast = float(np.max(cb.weight * np.minimum(law.normal_stiffness(np.abs(t)), cap) / kd_nu))
     newton.info["contact_stiffness_contrast"] = newton.contrast
-    if newton.reduced.method == "amg" and newton.contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
-        newton.reduced.method = newton.info["fallback"] = "direct"
+    if newton.contrast > AMG_CONTRAST_LIMIT and n <= DIRECT_FALLBACK_LIMIT:
+        _fall_back(newton)
     b_lin = law.friction_bound(t)
-    b_ref = law.k_friction if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else law.k_friction)
+    k_tau = law.friction_coefficient
+    b_ref = k_tau if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else k_tau)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
         from vemkit.solvers.ssn_disk import coupled_gamma
@@ -300,85 +277,27 @@ def _prepare(newton, t):
     newton.energy_merit = law.reduced  # m_tau = 0 or k_tau = 0: the problem minimizes a convex energy
 
 
+def _fall_back(newton):
+    """Newton solves on the backend's fallback (AMG: direct), recorded in info["fallback"]; nothing
+    when the backend has none."""
+    fallback = newton.reduced.fall_back()
+    if fallback is not None:
+        newton.info["fallback"] = fallback
+
+
 def _gamma_length(cb) -> float:
     """L_C h^(d-2) of the module docstring: |Gamma_C| in 2D, sqrt(|Gamma_C| |Gamma_C| / n_c) in 3D."""
     area = float(np.sum(cb.weight))
     return area if cb.dimension == 2 else float(np.sqrt(area * area / cb.size))
 
 
-def _evaluate(newton, u, lam) -> _Point:
-    """Everything the step and the line search need at (u, lambda)."""
-    problem = newton.problem
-    K, f, cb, law, n = problem.stiffness, problem.load, problem.contact, problem.law, problem.n_dofs
-    zero = newton.zero
-    t = cb.normal_displacement(u) - cb.gap
-    slip = relative_slip(cb, u, newton.slip_reference)
-    Ku = K @ u
-    normal_force = cb.normal_force(u, law)
-    friction_force = cb.scatter(zero, cb.times(cb.weight * law.friction_bound(t), lam), n)
-    gradient = Ku + normal_force - f
-    R = gradient + friction_force
-    q = lam + cb.times(newton.gamma, slip)
-    C = cb.times(complementarity_weight(newton, t), lam - cb.project(q))
-    scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
-    point = _Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
-    if newton.energy_merit:
-        friction = law.k_friction * (cb.weight @ cb.magnitude(slip))
-        point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)
-    return point
-
-
-def complementarity_weight(newton, t):
-    """The weight of C in the merit: w b_ref for the reduced law; w p_tau(t) for m_tau > 0, so that
-    C counts as the friction force it misplaces and a vertex without friction force (p_tau = 0, where
-    lambda only follows the slip direction) does not count: with w b_ref there, its lambda moved
-    by the step made the Newton direction no descent direction of theta (measured on the Hertz half
-    sphere, a stall at a step length ~0)."""
-    cb, law = newton.problem.contact, newton.problem.law
-    return cb.weight * (newton.b_ref if law.reduced else law.friction_bound(t))
-
-
-def _converged(newton, point) -> bool:
-    """Relative residual <= tol, or at the rounding floor of its own evaluation (ill-conditioned cases)."""
-    residual = np.sqrt(point.theta) / point.scale
-    if newton.problem.contact.dimension == 3:  # and the slip direction resolved (vemkit.solvers.ssn_disk)
-        from vemkit.solvers.ssn_disk import disk_alignment
-
-        residual = max(residual, disk_alignment(newton, point))
-        # and lambda in the unit disk to tol, as the independent check asks: neither the weighted C nor
-        # the rounding floor below sees |lambda| > 1 where w b is small against the body's forces
-        # (E = 2e9, k_tau = 3: |lambda| = 1 + 2.8e-4 was accepted after one step)
-        excess = float(np.max(newton.problem.contact.magnitude(point.lam) - 1.0, initial=0.0))
-        if excess > newton.tol:
-            return False
-    if residual <= newton.tol:
-        return True
-    problem = newton.problem
-    cb, law = problem.contact, problem.law
-    stiff = cb.weight * np.minimum(law.normal_stiffness(point.t), newton.stiffness_cap) * np.abs(point.t + cb.gap)
-    size = (
-        abs_matvec(problem.stiffness, np.abs(point.u))
-        + np.abs(problem.load)
-        + cb.scatter(stiff, newton.zero_tangential, problem.n_dofs)
-    )
-    point.floor = ROUNDING_FLOOR * np.finfo(float).eps * float(np.linalg.norm(size)) / point.scale
-    return residual <= point.floor
-
-
-def _slope(newton, point, du_tau, du) -> float:
-    """Directional derivative of the energy at ``point`` along du (one-sided for |u_tau|)."""
-    cb, law = newton.problem.contact, newton.problem.law
-    friction = np.where(cb.magnitude(point.slip) != 0.0, cb.dot(cb.direction(point.slip), du_tau), cb.magnitude(du_tau))
-    return float(point.gradient @ du + law.k_friction * (cb.weight @ friction))
-
-
-def _newton_iteration(newton, point, k) -> _Point:
+def _newton_iteration(newton, point, k) -> Point:
     """One Newton step from ``point`` with its line search; appends the history record."""
     problem = newton.problem
     cb, n = problem.contact, problem.n_dofs
     du, lam_new, its, changes = _newton_direction(newton, point, k)
     if not (np.all(np.isfinite(du)) and np.all(np.isfinite(lam_new))):
-        _fail(
+        fail(
             problem,
             k,
             "non-finite Newton step",
@@ -388,19 +307,19 @@ def _newton_iteration(newton, point, k) -> _Point:
         )
     u, lam = point.u, point.lam
     dlam = lam_new - lam
-    full = _evaluate(newton, u + du, lam_new)
+    full = evaluate(newton, u + du, lam_new)
     du_tau = cb.tangential_displacement(du)
 
     def trial(alpha):
-        return full if alpha == 1.0 else _evaluate(newton, u + alpha * du, lam + alpha * dlam)
+        return full if alpha == 1.0 else evaluate(newton, u + alpha * du, lam + alpha * dlam)
 
-    d0 = _slope(newton, point, du_tau, du) if newton.energy_merit else 0.0
-    alpha, new = line_search(point, trial, lambda p: _slope(newton, p, du_tau, du), d0, newton.energy_merit)
+    d0 = energy_slope(newton, point, du_tau, du) if newton.energy_merit else 0.0
+    alpha, new = line_search(point, trial, lambda p: energy_slope(newton, p, du_tau, du), d0, newton.energy_merit)
     newton.theta_previous = point.theta
     newton.short_steps = newton.short_steps + 1 if alpha < SHORT_STEP else 0
-    if newton.reduced.method == "amg" and newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
+    if newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
         # inexact CG steps of a badly conditioned K + J (k_nu w >> K) stall the line search
-        newton.reduced.method = newton.info["fallback"] = "direct"
+        _fall_back(newton)
     record = {
         "residual": np.sqrt(new.theta) / new.scale,
         "du": float(alpha * np.linalg.norm(du) / max(np.linalg.norm(new.u), np.finfo(float).tiny)),
@@ -409,7 +328,7 @@ def _newton_iteration(newton, point, k) -> _Point:
         "active_changes": changes,
         "linear_iterations": its,
     }
-    if newton.base.method == "amg":
+    if newton.base.iterative:
         record["eta"] = newton.eta
     newton.records.append(record)
     return new
@@ -455,11 +374,8 @@ def _newton_direction(newton, point, k):
         lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
         slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    if newton.reduced.method == "direct":  # formed as it always was: the same numbers to the last bit
-        A = K + J if slope_blocks is None else K + J + slope_blocks
-        A = A.tocsr()
-    else:  # K x + J x: no copy of K's values (formed, on K's index arrays, only for a rebuilt hierarchy)
-        A = SumOperator(K, J if slope_blocks is None else J + slope_blocks)
+    # direct: K + J (+ slope) formed as it always was; AMG: K x + J x, no copy of K's values
+    A = newton.reduced.operator(K, J) if slope_blocks is None else newton.reduced.operator(K, J, slope_blocks)
     rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
     du = stick_shift + correction
@@ -474,7 +390,7 @@ def _newton_direction(newton, point, k):
 def _solve_newton_system(newton, point, k, A, Z, rhs, penalty):
     """Z y with Z^T A Z y = Z^T rhs; inexact (Eisenstat-Walker) with AMG, never looser than tol needs."""
     tol = newton.tol
-    if newton.base.method == "amg" and k > 1:
+    if newton.base.iterative and k > 1:
         newton.eta = min(ETA_MAX, 0.9 * point.theta / newton.theta_previous)  # Eisenstat-Walker, choice 2
     floor = 0.1 * tol * point.scale / max(np.linalg.norm(rhs), np.finfo(float).tiny)
     newton.eta = min(max(newton.eta, floor, 1e-14), ETA_MAX)
@@ -489,30 +405,3 @@ def _solve_newton_system(newton, point, k, A, Z, rhs, penalty):
         raise ConvergenceError(f"ssn: {exc}", solver="ssn", reason="linear_solver_failed", iterations=k) from exc
     newton.linear_total += its
     return correction, its
-
-
-def _fail(problem, k, what, records, contrast=0.0, *, reason):
-    """Raise a one-line ConvergenceError (``reason``, see vemkit.exceptions) naming the likely culprit."""
-    law, E = problem.law, young_modulus(problem)
-    head = f"ssn did not converge after {k} iterations ({what})"
-    if contrast > CONTRAST_WARNING:
-        culprit = (
-            f"contact.normal.k = {law.k_normal:g} makes the contact {contrast:.0e} times stiffer than the body "
-            f"(E = {E:g}), beyond what double precision resolves; lower contact.normal.k or rescale E"
-        )
-    elif not law.reduced:
-        culprit = (
-            f"the friction bound of contact.friction.m = {law.m_friction:g} (k = {law.k_friction:g} against "
-            f"contact.normal.k = {law.k_normal:g}) couples too strongly to the penetration; try a smaller friction.k"
-        )
-    elif any(r["active_changes"] > 0 for r in records[-5:]):
-        culprit = (
-            f"the stick/slip/contact sets keep changing (contact.friction.k = {law.k_friction:g}, "
-            f"contact.normal.k = {law.k_normal:g}, E = {E:g}); try a larger solver.max_iterations or solver.linear=direct"
-        )
-    else:
-        culprit = (
-            f"the normal compliance contact.normal.m = {law.m_normal:g} (k = {law.k_normal:g}, E = {E:g}) "
-            f"converges slowly; try a larger solver.max_iterations"
-        )
-    raise ConvergenceError(f"{head}: {culprit}", solver="ssn", reason=reason, iterations=k)

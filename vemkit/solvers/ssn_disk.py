@@ -28,7 +28,6 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
-from vemkit.solvers.sparse_ops import SumOperator
 from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis, stick_multiplier, stick_shift
 
 STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
@@ -80,7 +79,7 @@ def disk_direction(newton, point, k, sets, solve):
         along = cb.tangent * lam_hat[:, :1] + cb.tangent2 * lam_hat[:, 1:]
         J = J + rank_one_blocks(cb, cb.weight * law.friction_bound_derivative(point.t), along, n, cb.normal)
     # direct: K + J formed as it always was; AMG: K x + J x, no copy of K's values
-    A = (K + J).tocsr() if newton.reduced.method == "direct" else SumOperator(K, J)
+    A = newton.reduced.operator(K, J)
     rhs = -(point.R - friction_now) - A @ shift - slip_force
     correction, its = solve(newton, point, k, A, Z, rhs, penalty)
     du = shift + correction
@@ -107,7 +106,7 @@ def disk_alignment(newton, point) -> float:
     moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
     sliding = (cb.magnitude(point.q) > 1.0) & moving
     miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
-    from vemkit.solvers.ssn import complementarity_weight
+    from vemkit.solvers.ssn_point import complementarity_weight
 
     return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale
 
@@ -144,13 +143,13 @@ def final_multiplier(newton, point):
     lambda . u_tau = |u_tau| (2.8) hold to rounding; ssn returns it if the move is <= tol, else goes on
     from it.
 
-    The merit weighs C = lambda - P(q) by w p_tau(t) (ssn.complementarity_weight), so at a vertex barely
+    The merit weighs C = lambda - P(q) by w p_tau(t) (ssn_point.complementarity_weight), so at a vertex barely
     in contact |lambda| may end above 1 (measured on the Mindlin sphere: 1.0096) or point away from a
     slip of 6e-6 max|u| (lambda . u_tau - |u_tau| = 1.2e-5 max|u|) while the merit is below tol.
     P(lambda) is no farther from lambda than P(q) is, and the sliding vertices' change is
     disk_alignment's miss (a vertex of the stick set that moves by more than tol max|u| -- its state
     changed in the last step -- may move more, hence the measure)."""
-    from vemkit.solvers.ssn import complementarity_weight
+    from vemkit.solvers.ssn_point import complementarity_weight
 
     cb = newton.problem.contact
     lam = _slip_directions(newton, point, cb.project(point.lam), every=True)

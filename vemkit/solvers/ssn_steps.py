@@ -1,25 +1,15 @@
 """The pieces of one semismooth Newton step (vemkit.solvers.ssn, whose docstring has the maths).
 
 Linear algebra: stiffness diagonals in a direction, rank-one contact blocks, the basis Z that
-eliminates the stick constraints, and the solver of the reduced systems Z^T A Z y = Z^T r (direct,
-or CG/GMRES preconditioned by the projected AMG V-cycle of K, rebuilt for A when CG needs
-REBUILD_FACTOR times the iterations per decade of the first solve). Globalisation: the line search.
+eliminates the stick constraints (the reduced systems Z^T A Z y = Z^T r are solved by the linear
+solver's backend, vemkit.solvers.linear.ReducedSolver). Globalisation: the line search.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from vemkit.contact.boundary import rank_one_blocks
-from vemkit.exceptions import LinearSolveError
-from vemkit.solvers.linear import CYCLE_PRECISION, linear_solver
-from vemkit.solvers.sparse_ops import as_matrix, reduced_operator
-
-REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
-MIN_REBUILD_ITERATIONS = 20
-MAX_REBUILDS = 10
 ARMIJO = 1e-4
 MIN_STEP = 2.0**-30
 MAX_EXPANSION = 64.0  # largest step length tried when the energy still falls steeply after a full step
@@ -159,86 +149,6 @@ def disk_slip_step(q, lam, gamma):
     excess = size - 1.0
     base = unit - (np.sum(e * lam, axis=1) / excess)[:, None] * e
     return base, gamma / excess, e
-
-
-class ReducedSolver:
-    """Solves Z^T A Z y = Z^T r for the Newton steps (direct, or CG with the projected AMG V-cycle)."""
-
-    def __init__(self, problem, base, baseline):
-        self.problem = problem
-        self.method = base.method
-        self.preconditioner = getattr(base, "preconditioner", None)
-        self.rebuilds = 0
-        self.baseline = baseline  # CG iterations per decade of residual reduction with K
-        # 3D: the hierarchy of K follows every step's K + J + stick penalty (vemkit.solvers.amg_update)
-        self.updated = None
-        if self.method == "amg" and problem.contact.dimension == 3:
-            from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy
-
-            cb, ones = problem.contact, np.ones(problem.contact.normal.shape)
-            support = rank_one_blocks(cb, np.ones(cb.size), ones, problem.n_dofs)  # every contact block
-            self.updated = BoundaryUpdatedHierarchy(base.hierarchy, support, nodal=True, precision=CYCLE_PRECISION)
-
-    def solve(self, A, Z, rhs, eta, penalty, symmetric=True, atol=0.0):
-        """Z y with Z^T A Z y = Z^T rhs (Z None: no stick constraint, y solves A y = rhs). A: a
-        sparse matrix or a ``vemkit.solvers.sparse_ops.SumOperator`` (K + J, formed only here for
-        a direct solve or a rebuilt hierarchy). Krylov: relative residual eta, or absolute ``atol``."""
-        b = rhs if Z is None else Z.T @ rhs
-        lift = (lambda y: y) if Z is None else (lambda y: Z @ y)
-        if self.method == "direct":
-            A = as_matrix(A)
-            A_red = A if Z is None else (Z.T @ A @ Z).tocsr()
-            if symmetric:
-                return lift(linear_solver(A_red, "direct").solve(b)), 1
-            y = spla.splu(A_red.tocsc()).solve(b)
-            if not np.all(np.isfinite(y)):
-                raise LinearSolveError(
-                    "the direct solve of the Newton step produced non-finite values", solver="direct", iterations=1
-                )
-            return lift(y), 1
-        if np.linalg.norm(b) == 0.0:
-            return np.zeros(A.shape[0]), 0
-        krylov = spla.cg if symmetric else _gmres
-        A_red = A if Z is None else reduced_operator(A, Z)  # Z^T A Z never formed (a matrix the size of K)
-        if self.updated is not None:  # the V-cycle of K + J + penalty, no rebuild criterion
-            self.preconditioner = self.updated.preconditioner(A.J + penalty())
-            y, its = self._krylov(krylov, A_red, Z, b, eta, atol)
-            return lift(y), its
-        y, its = self._krylov(krylov, A_red, Z, b, eta, atol)
-        decades = max(np.log10(1.0 / eta), 1.0)
-        if its > max(REBUILD_FACTOR * self.baseline * decades, MIN_REBUILD_ITERATIONS) and self.rebuilds < MAX_REBUILDS:
-            hierarchy = linear_solver(as_matrix(A) + penalty(), "amg", near_nullspace=self.problem.near_nullspace)
-            self.preconditioner = hierarchy.preconditioner
-            self.rebuilds += 1
-            y, more = self._krylov(krylov, A_red, Z, b, eta, atol, x0=y)
-            its += more
-        return lift(y), its
-
-    def _krylov(self, krylov, A_red, Z, b, eta, atol, x0=None):
-        full, M = self.preconditioner, self.preconditioner
-        if Z is not None:
-            M = spla.LinearOperator(A_red.shape, matvec=lambda v: Z.T @ (full @ (Z @ v)), dtype=float)
-        count = [0]
-
-        def callback(_):
-            count[0] += 1
-
-        y, info = krylov(A_red, b, x0=x0, rtol=eta, atol=atol, maxiter=5000, M=M, callback=callback)
-        if info != 0 or not np.all(np.isfinite(y)):
-            raise LinearSolveError(
-                f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
-                f"try solver.linear=direct",
-                solver="amg",
-                iterations=count[0],
-            )
-        return y, count[0]
-
-
-def _gmres(A, b, x0, rtol, atol, maxiter, M, callback):
-    """GMRES (restart 50) with the cg call signature; callback once per inner iteration."""
-    return spla.gmres(
-        A, b, x0=x0, rtol=rtol, atol=atol, restart=50, maxiter=maxiter, M=M, callback=callback, callback_type="pr_norm"
-    )
 
 
 def line_search(point, trial, slope, d0, energy_merit):

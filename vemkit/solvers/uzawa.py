@@ -176,7 +176,7 @@ class _Uzawa:
 
     @property
     def inexact(self) -> bool:
-        return self.solver.method == "amg"
+        return self.solver.iterative
 
 
 def solve_uzawa(
@@ -288,8 +288,9 @@ def _step_length(state, bound) -> float:
     law, rho = state.problem.law, state.options["rho"]
     if rho is not None:
         return float(rho)
-    b_scale = float(np.max(bound)) if np.max(bound) > 0.0 else law.k_friction
-    return RHO_FACTOR / (law.k_friction * b_scale * state.mu_tau) if law.k_friction * state.mu_tau > 0.0 else 0.0
+    k_tau = law.friction_coefficient
+    b_scale = float(np.max(bound)) if np.max(bound) > 0.0 else k_tau
+    return RHO_FACTOR / (k_tau * b_scale * state.mu_tau) if k_tau * state.mu_tau > 0.0 else 0.0
 
 
 def _iterate(state, progress):
@@ -327,7 +328,7 @@ def _uzawa_iteration(state):
         u_new, lin_its = _solve_step(state, rhs, x0, lin_tol)
     while True:
         lam_new = cb.project(
-            lam + state.rho * law.k_friction * relative_slip(cb, u_new, options["slip_reference"])
+            lam + state.rho * law.friction_coefficient * relative_slip(cb, u_new, options["slip_reference"])
         )  # (5.5)
         if not (np.all(np.isfinite(u_new)) and np.all(np.isfinite(lam_new))):
             fail(state, "non-finite values", "diverged")

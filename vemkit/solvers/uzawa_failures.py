@@ -69,34 +69,30 @@ def fail(state, what, reason):
     E = young_modulus(problem)
     mu_nu, _ = boundary_compliance(solver, problem, "normal", iterations=10)
     t = cb.normal_displacement(u) - cb.gap if np.all(np.isfinite(u)) else np.full(cb.size, np.inf)
-    slope = law.normal_stiffness(np.where(np.isfinite(t), np.abs(t), 1.0))
-    k_eff = float(np.max(slope)) if slope.size else 0.0
-    if law.m_normal == 1.0 or not np.isfinite(k_eff):
-        k_eff = law.k_normal
-    normal_factor = k_eff * mu_nu
+    normal_factor = law.lagged_stiffness(t) * mu_nu
     if mu_tau == 0.0 and not law.frictionless:
         mu_tau, _ = boundary_compliance(solver, problem, "tangent", iterations=10)
-    friction_factor = rho_n * law.k_friction * law.k_friction * mu_tau
+    k_tau = law.friction_coefficient
+    friction_factor = rho_n * k_tau * k_tau * mu_tau
     verb = "diverged" if reason == "diverged" else "did not converge"
     head = f"uzawa {verb} after {n} iterations ({what})"
     typed = dict(solver="uzawa", reason=reason, iterations=n)
     if normal_factor >= 0.5:
         raise ConvergenceError(
-            f"{head}: the lagged normal compliance is unstable for contact.normal.k = {law.k_normal:g} "
-            f"(m = {law.m_normal:g}) against E = {E:g} (contraction estimate {normal_factor:.1e} >= 1); "
+            f"{head}: the lagged normal compliance is unstable for {law.normal_text} "
+            f"against E = {E:g} (contraction estimate {normal_factor:.1e} >= 1); "
             f"try --set solver.method=ssn",
             **typed,
         )
     if friction_factor >= 1.9:
         raise ConvergenceError(
-            f"{head}: solver.rho = {rho_n:.3g} is too large for contact.friction.k = {law.k_friction:g} "
-            f"(stable below {2.0 / (law.k_friction**2 * mu_tau):.3g}); try a smaller solver.rho or solver.method=ssn",
+            f"{head}: solver.rho = {rho_n:.3g} is too large for contact.friction.k = {k_tau:g} "
+            f"(stable below {2.0 / (k_tau**2 * mu_tau):.3g}); try a smaller solver.rho or solver.method=ssn",
             **typed,
         )
     if not law.reduced:
         raise ConvergenceError(
-            f"{head}: the lagged friction bound of contact.friction.m = {law.m_friction:g} "
-            f"(k = {law.k_friction:g}) does not settle; try --set solver.method=ssn",
+            f"{head}: the lagged friction bound of {law.friction_text} does not settle; try --set solver.method=ssn",
             **typed,
         )
     raise ConvergenceError(

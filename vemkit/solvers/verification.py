@@ -181,7 +181,7 @@ def prebuilt_linear_supported() -> bool:
     from vemkit.solvers.linear import linear_solver
 
     A = sp.identity(2, format="csr")
-    built = linear_solver(A, "direct")
+    built = linear_solver(A)
     try:
         return linear_solver(A, built) is built
     except (ValueError, TypeError):

@@ -23,7 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vemkit.contact.laws import ContactLaw
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.solution import contact_state
 from vemkit.solvers.verification import verify_solution
@@ -43,8 +42,7 @@ def loading_in_steps(problem_at, shifts, solver: dict, *, frictionless_normal_st
     problem = problem_at(0.0)
     first = problem
     if frictionless_normal_step:
-        law = problem.law
-        first = dataclasses.replace(problem, law=ContactLaw(law.k_normal, law.m_normal, 0.0, 0.0))
+        first = dataclasses.replace(problem, law=problem.law.without_friction())
     solution = solve(first, dict(solver))
     steps.append((0.0, first, solution, None, verify_solution(first, solution.u, solution.multiplier, solver["tol"])))
     for shift in shifts:

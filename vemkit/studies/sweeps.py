@@ -160,11 +160,11 @@ def point_quantities(problem, outcome: Outcome):
 
 def _contact_problem(problem, scene):
     """``problem`` with the contact law and gap of ``scene`` (K, load and mesh unchanged)."""
-    from vemkit.contact.laws import ContactLaw
+    from vemkit.contact.laws import contact_law
     from vemkit.contact.problem import scene_gap
 
     normal, friction = scene.normal_compliance, scene.friction_bound
-    law = ContactLaw(normal.k, normal.m, friction.k, friction.m)
+    law = contact_law(normal, friction)
     contact = problem.contact.with_gap(scene_gap(scene))  # a foundation or an expression, 2D or 3D
     return replace(problem, law=law, contact=contact, info=dict(problem.info))
 
