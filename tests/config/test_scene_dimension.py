@@ -3,12 +3,14 @@
 mesh file's dimension read from its header (vemkit.config.mesh_file_header.mesh_file_dimension)."""
 
 import os
+from pathlib import Path
 
 import pytest
+import yaml
 
 from vemkit.config.dimension import MODELS_BY_DIMENSION, default_model
 from vemkit.config.mesh_file_header import mesh_file_dimension
-from vemkit.config.scene import SceneError, scene_from_dict
+from vemkit.config.scene import SceneError, load_scene, scene_from_dict
 
 BOX = {"box": [[0, 0, 0], [1, 1, 0.5]]}
 EXTRUDE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["s", "e", "n", "w"], "extrude": {"depth": 0.5}}
@@ -132,3 +134,26 @@ def test_mesh_file_dimension_of_gmsh_files(tmp_path, dimension, version, binary,
 def test_a_binary_gmsh_2_file_without_a_physical_volume_does_not_say(tmp_path):
     _gmsh(tmp_path / "m.msh", 2.2, 3, binary=True)
     assert mesh_file_dimension(tmp_path / "m.msh") is None
+
+
+ROOT = Path(__file__).resolve().parents[2]
+SHIPPED = sorted(
+    p
+    for folder in ("config/scenes", "benchmarks")
+    for p in (ROOT / folder).rglob("*.yaml")
+    if "material:" in p.read_text()
+)
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_shipped_scene_keeps_its_dimension_and_model_and_reads_the_same_without_model(path):
+    data = yaml.safe_load(path.read_text())
+    if "file" in data["discretization"]["mesh"]:  # the mesh file is made by a benchmark
+        pytest.skip("a mesh file made by its benchmark")
+    s = load_scene(path)
+    assert s.dimension == (3 if data.get("model") == "3d" else 2)
+    assert s.model == data.get("model", "plane_stress")
+    data.pop("model", None)
+    assert scene_from_dict(data, source=str(path)) == (
+        s if s.dimension == 3 else s.with_overrides(["model=plane_stress"])
+    )
