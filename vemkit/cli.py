@@ -193,9 +193,9 @@ def _adapt_inputs(args):
     scene = load_scene(args.scene, args.set or ())
     if scene.dimension == 3:
         raise InputError(
-            f"vemkit adapt: {args.scene} is a 3D scene (model: 3d); adaptivity is for 2D bodies "
+            f"vemkit adapt: {args.scene} is a 3D scene (its body is 3D); adaptivity is for 2D bodies "
             "(see docs/reference/files.md); solve it with vemkit solve",
-            key="model",
+            key="domain",
         )
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]

@@ -109,7 +109,8 @@ def _range(node: dict) -> str:
 
 
 def scene_key_rows(schema: dict | None = None) -> list[dict]:
-    """Every key of the scene schema, depth first: ``path``, ``type``, ``range``, ``default``,
+    """Every key of the scene schema, depth first: ``path``, ``type``, ``range``, ``default``
+    (``default_by_dimension``: the schema's ``x-default-by-dimension``, a default per body dimension),
     ``title``, ``description``, ``required``. A path's ``[]`` is a list entry, ``<side>`` a side
     name chosen by the scene."""
     schema = schema or json.loads(SCHEMA.read_text())
@@ -134,6 +135,7 @@ def scene_key_rows(schema: dict | None = None) -> list[dict]:
                         "range": _range(child_resolved),
                         "default": child_resolved.get("default"),
                         "has_default": "default" in child_resolved,
+                        "default_by_dimension": child_resolved.get("x-default-by-dimension"),
                         "title": child.get("title") or child_resolved.get("title", ""),
                         "description": child.get("description") or child_resolved.get("description", ""),
                         "required": key in required,
@@ -176,6 +178,10 @@ def scene_keys_markdown(schema: dict | None = None) -> str:
                 if r["has_default"]
                 else ("required" if r["required"] else "–")
             )
+            if r.get("default_by_dimension"):  # a default that depends on the body (model)
+                default = ", ".join(
+                    f"`{json.dumps(v, ensure_ascii=False)}` ({d}D body)" for d, v in r["default_by_dimension"].items()
+                )
             meaning = r["title"] + (f". {r['description']}" if r["description"] else "")
             lines.append(
                 f"| `{_cell(r['path'])}` | {_cell(r['type'])} | {_cell(r['range']) or '–'} | "

@@ -97,7 +97,7 @@ def test_vemkit_mesh_writes_the_3d_mesh_of_a_scene(tmp_path):
 
 
 BAD = {
-    "model=plane_stress": "domain.box is a 3D body",
+    "model=plane_stress": "model = 'plane_stress' does not fit the body: domain.box is 3D",
     "discretization.mesh.family=square": "does not mesh a box",
     "discretization.order=2": "k = 1 element only",
     "body_force=[0, 1]": "body_force has 2 components",
@@ -139,7 +139,9 @@ def test_a_2d_domain_with_model_3d_and_adapt_on_3d_are_refused(tmp_path):
         text.replace(scene_text("hex", 2).split("dirichlet:\n")[1].split("discr")[0], "    bottom: [0, 0, 0]\n")
     )
     run = vemkit("solve", tmp_path / "flat.yaml", "-o", tmp_path / "s.nc")
-    assert run.returncode == 2 and "model = '3d' needs a 3D body" in run.stderr, run.stderr
+    assert run.returncode == 2 and "model = '3d' does not fit the body: domain unit_square is 2D" in run.stderr, (
+        run.stderr
+    )
     (tmp_path / "s.yaml").write_text(scene_text("hex", 2))
     run = vemkit("adapt", tmp_path / "s.yaml", "-o", tmp_path / "a.nc")
     assert run.returncode == 2 and "adaptivity is for 2D bodies" in run.stderr
@@ -167,7 +169,7 @@ def test_a_3d_scene_solves_on_its_mesh_file_and_a_2d_scene_refuses_it(tmp_path):
         "--set",
         "boundary.dirichlet=[bottom]",
     )
-    assert run.returncode == 2 and "is a 3D mesh" in run.stderr and not (tmp_path / "g.nc").exists()
+    assert run.returncode == 2 and "the mesh file m.nc is 3D" in run.stderr and not (tmp_path / "g.nc").exists()
 
 
 def _gmsh_box(path):

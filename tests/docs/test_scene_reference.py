@@ -51,6 +51,10 @@ def test_the_reference_shows_type_range_and_default():
     rows = {row["path"]: row for row in vemkit_docs.scene_key_rows(SCHEMA)}
     assert rows["material.nu"]["range"] == "≥ -0.999, < 0.5"
     assert rows["solver.method"]["type"] == 'one of `"ssn"`, `"uzawa"`'
-    assert rows["model"]["default"] == "plane_stress"
+    assert rows["model"]["default_by_dimension"] == {"2": "plane_stress", "3": "3d"}  # the body says the default
+    assert (
+        '| `model` | one of `"plane_stress"`, `"plane_strain"`, `"3d"` | – | `"plane_stress"` (2D body), `"3d"` (3D body) |'
+        in (vemkit_docs.scene_keys_markdown(SCHEMA))
+    )
     assert rows["discretization.mesh.n"]["type"] == "integer"
     assert rows["material"]["required"]

@@ -17,6 +17,12 @@ vertices has fewer faces). The prediction of :mod:`vemkit.config.limits` then us
   (netCDF declares them truthfully: a compressed file cannot hide a larger array), the JSON list
   ``vemkit_boundary_parts``.
 
+:func:`mesh_file_dimension` tells a scene whether its mesh file is a plane or a 3D body (the
+scene's dimension comes from its body, docs/reference/files.md): a UGRID file's
+``topology_dimension``, a gmsh 4 file's ``$Entities`` (volumes or none), a gmsh 2 file's physical
+volumes or, in text, its elements; None when the file does not say (it is then checked as the
+scene's model says, as before).
+
 Only this module's cheap imports (netCDF4 for ``.nc``) are needed: a refusal takes well under a second.
 """
 
@@ -33,7 +39,14 @@ from typing import NamedTuple
 from vemkit.config.safe_yaml import file_kind
 from vemkit.exceptions import MeshError
 
-__all__ = ["MESH_SUFFIXES", "OTHER_DIMENSION", "MeshFileHeader", "mesh_file_header", "open_regular_file"]
+__all__ = [
+    "MESH_SUFFIXES",
+    "OTHER_DIMENSION",
+    "MeshFileHeader",
+    "mesh_file_dimension",
+    "mesh_file_header",
+    "open_regular_file",
+]
 
 MESH_SUFFIXES = {".msh": "gmsh", ".nc": "UGRID netCDF"}
 MIN_NODE_BYTES = 7  # the shortest gmsh node: "1 0 0 0\n" (text) or a tag and three doubles (binary)
@@ -111,6 +124,80 @@ def mesh_file_header(path, dimension: int = 2) -> MeshFileHeader:
 
 
 # -- gmsh ---------------------------------------------------------------------------------------
+#: gmsh element types of dimension 3 (tetrahedra, hexahedra, prisms, pyramids of every order)
+_GMSH_3D_TYPES = (4, 5, 6, 7, 11, 12, 13, 14, 17, 18, 19, 29, 30, 31, 92, 93)
+_GMSH_3D_ELEMENT = re.compile(rb"(?m)^[ \t]*\d+[ \t]+(?:" + b"|".join(b"%d" % t for t in _GMSH_3D_TYPES) + rb")[ \t]")
+
+
+def mesh_file_dimension(path) -> int | None:
+    """2 or 3: the dimension of the body in the mesh file ``path`` (module docstring), read from its
+    header; None when the file cannot be opened or does not say. Never raises: the file's problems
+    are reported by :func:`mesh_file_header` when the scene is solved."""
+    path = Path(path)
+    if path.suffix not in MESH_SUFFIXES:
+        return None
+    try:
+        fd = open_regular_file(path)
+    except MeshError:
+        return None
+    try:
+        size = os.fstat(fd).st_size
+        return _gmsh_dimension(fd, size) if path.suffix == ".msh" else _ugrid_dimension(path)
+    except (MeshError, OSError, ValueError, IndexError, struct.error, UnicodeError):
+        return None
+    finally:
+        os.close(fd)
+
+
+def _ugrid_dimension(path: Path) -> int | None:
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r") as nc:
+        topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
+        if len(topologies) != 1:
+            return None
+        value = str(getattr(topologies[0], "topology_dimension", "2")).strip()
+        return int(value) if value in ("2", "3") else None
+
+
+def _gmsh_dimension(fd: int, size: int) -> int | None:
+    start = _read_at(fd, 0, 4096)
+    match = re.search(rb"(?m)^\$MeshFormat\r?\n([^\n]*)\n", start)
+    if match is None:
+        return None
+    fields = match.group(1).split()
+    version, binary, word = int(fields[0][:1]), fields[1] == b"1", int(fields[2])
+    at_nodes = _find_section(fd, "Nodes", 0, min(size, _MAX_BEFORE_NODES))
+    if at_nodes is None:
+        return None
+    at_entities = _find_section(fd, "Entities", 0, at_nodes) if version == 4 else None
+    if at_entities is not None:  # numPoints numCurves numSurfaces numVolumes
+        head = _read_at(fd, at_entities, 256)
+        counts = struct.unpack(f"<4{'Q' if word == 8 else 'I'}", head[: 4 * word]) if binary else head.split()[:4]
+        return 3 if int(counts[3]) > 0 else 2
+    at_names = _find_section(fd, "PhysicalNames", 0, at_nodes)
+    if at_names is not None:
+        lines = _read_at(fd, at_names, 1 << 20).split(b"\n")
+        if any(line.split()[:1] == [b"3"] for line in lines[1 : 1 + int(lines[0])]):
+            return 3  # a physical volume
+    if version != 2 or binary:
+        return None
+    at_elements = _find_section(fd, "Elements", at_nodes, size)
+    if at_elements is None:
+        return None
+    offset, tail = at_elements, b""
+    while offset < size:  # the element lines "tag type ..." of a text gmsh 2 file: one of a 3D type?
+        chunk = tail + _read_at(fd, offset, min(_SCAN_CHUNK, size - offset))
+        end = chunk.find(b"$EndElements")
+        if _GMSH_3D_ELEMENT.search(chunk if end < 0 else chunk[:end]):
+            return 3
+        if end >= 0:
+            return 2
+        offset += _SCAN_CHUNK
+        tail = chunk[chunk.rfind(b"\n") + 1 :] if b"\n" in chunk else b""
+    return None
+
+
 def _read_at(fd: int, offset: int, count: int) -> bytes:
     return os.pread(fd, count, offset)
 
@@ -282,7 +369,7 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
     if str(getattr(topology, "topology_dimension", "2")) == "3":
-        raise _fail(path, "is a 3D mesh (mesh3d) but the scene is 2D; set model: 3d")
+        raise _fail(path, "is a 3D mesh (mesh3d) but the scene is 2D; drop model or set model: 3d")
     if len(coordinates) != 2:
         raise _fail(path, "cannot be read as UGRID netCDF: node_coordinates must name two variables (x y)")
     x, y = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import copy
 import re
 
+from vemkit.config.domain3d import is_3d_domain
 from vemkit.config.safe_yaml import parse_yaml
 from vemkit.config.scene_schema import branch_names, key_name, resolve, schema_root, show, suggest
 from vemkit.exceptions import SceneError
@@ -113,9 +114,9 @@ def _schema_step(node: dict, segment, container, override: str, path: list) -> d
 
 def _default(node: dict, data: dict):
     """The schema's default of a key not in the scene; a vector's (body_force) has a 3D scene's three
-    components."""
+    components (a 3D domain, or model 3d with a mesh file)."""
     value = copy.deepcopy(node.get("default", {}))
-    if data.get("model") == "3d" and value == [0.0, 0.0]:
+    if (data.get("model") == "3d" or is_3d_domain(data.get("domain"))) and value == [0.0, 0.0]:
         value.append(0.0)
     return value
 

@@ -27,8 +27,9 @@ from vemkit.config.boundary_conditions import (
     inside_points,
 )
 from vemkit.config.contact_laws import PowerLaw, TabulatedLaw, check_normal_compliance, normal_compliance
+from vemkit.config.dimension import fill_model, mesh_file_path
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
-from vemkit.config.domain3d import domain3d_from_spec
+from vemkit.config.domain3d import domain3d_from_spec, is_3d_domain
 from vemkit.config.expressions import Expression
 from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.config.material import lame_parameters
@@ -36,7 +37,7 @@ from vemkit.config.mesh_resolution import check_mesh_resolution
 from vemkit.config.overrides import apply_override
 from vemkit.config.safe_yaml import SceneDumper, read_user_file
 from vemkit.config.safe_yaml import parse_yaml as _parse_yaml
-from vemkit.config.scene3d import check_model_domain, semantic_checks_3d
+from vemkit.config.scene3d import semantic_checks_3d
 from vemkit.config.scene_schema import normalized, scene_schema, schema_root, show, validate
 from vemkit.exceptions import SceneError
 
@@ -56,13 +57,13 @@ def _check_order_options(discretization: dict) -> None:
         )
 
 
-def _semantic_checks(data: dict, given: dict) -> dict:
+def _semantic_checks(data: dict, given: dict, dimension: int) -> dict:
     """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
-    written (before the defaults were filled in)."""
-    check_model_domain(data)
+    written (before the defaults were filled in); ``dimension``: the body's
+    (:mod:`vemkit.config.dimension`)."""
     if "contact" in data:  # the law contact.normal names (2D and 3D), its keys and its table
         check_normal_compliance(data["contact"]["normal"], max_slope=MAX_NORMAL_K_OVER_E * data["material"]["E"])
-    if data["model"] == "3d":
+    if dimension == 3:
         return semantic_checks_3d(data, given)
     check_mesh_size(data["discretization"]["mesh"])
     _check_order_options(data["discretization"])
@@ -100,15 +101,18 @@ class Scene:
     Build it with :func:`load_scene`, :func:`scene_from_yaml` or :func:`scene_from_dict`.
     """
 
-    __slots__ = ("_data", "_expressions", "source")
+    __slots__ = ("_data", "_dimension", "_expressions", "source")
     _data: dict
+    _dimension: int
     _expressions: dict
     source: str | None
 
-    def __init__(self, data: dict, expressions: dict, source: str | None = None):
+    def __init__(self, data: dict, expressions: dict, source: str | None = None, dimension: int | None = None):
         object.__setattr__(self, "_data", data)
         object.__setattr__(self, "_expressions", expressions)
         object.__setattr__(self, "source", source)
+        # the body's dimension (vemkit.config.dimension); a validated scene's model fits it
+        object.__setattr__(self, "_dimension", dimension or (3 if data["model"] == "3d" else 2))
 
     def __setattr__(self, name, value):
         raise AttributeError("a Scene is immutable; use scene.with_overrides([...])")
@@ -131,7 +135,11 @@ class Scene:
 
     name = _field("name")
     domain = _field("domain")
-    model = _field("model", doc="the mechanical model: plane_stress (the paper's), plane_strain or 3d")
+    model = _field(
+        "model",
+        doc="the mechanical model, the constitution C: plane_stress (the paper's) or plane_strain on a 2D "
+        "body, 3d on a 3D body (the default: plane_stress in 2D, 3d in 3D)",
+    )
     E = _field("material", "E", doc="Young's modulus")
     nu = _field("material", "nu", doc="Poisson ratio (the paper's kappa)")
     dirichlet_sides = _field("boundary", "dirichlet", convert=tuple)
@@ -175,8 +183,9 @@ class Scene:
 
     @property
     def dimension(self) -> int:
-        """3 for a ``model: 3d`` scene (docs/reference/files.md), 2 otherwise."""
-        return 3 if self.model == "3d" else 2
+        """The dimension of the body (docs/reference/files.md): 3 for a ``box`` or ``extrude`` domain or a
+        3D mesh file, 2 otherwise; the model (:attr:`model`) fits it."""
+        return self._dimension
 
     @property
     def sides(self) -> tuple:
@@ -227,10 +236,7 @@ class Scene:
     def mesh_file(self) -> Path | None:
         """discretization.mesh.file resolved against the scene file's folder (docs/reference/files.md), or None."""
         name = self._data["discretization"]["mesh"].get("file")
-        if name is None:
-            return None
-        folder = Path(self.source).parent if self.source and not self.source.startswith("<") else Path(".")
-        return folder / name
+        return None if name is None else mesh_file_path(name, self.source)
 
     normal_compliance = property(
         lambda self: self._contact_law("normal"),
@@ -265,13 +271,14 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
     data = copy.deepcopy(data)
     for override in overrides:
         apply_override(data, override)
-    validate(data)
+    validate(data, model=data.get("model") or ("3d" if is_3d_domain(data.get("domain")) else None))
+    dimension = fill_model(data, source)  # the body's dimension; model checked against it, or its default
     filled = normalized(data, schema_root())
     contact = filled.get("contact")
     if contact and "foundation" in contact and "gap" not in data.get("contact", {}):
         del contact["gap"]  # the foundation defines the gap: no default beside it (the scene reads back)
-    expressions = _semantic_checks(filled, data)
-    return Scene(filled, expressions, source)
+    expressions = _semantic_checks(filled, data, dimension)
+    return Scene(filled, expressions, source, dimension)
 
 
 def scene_from_yaml(text: str, overrides=(), *, source: str = "<string>") -> Scene:

@@ -1,6 +1,7 @@
-"""The checks of a 3D scene (docs/reference/files.md, ``model: 3d``) beyond the schema, and where its expressions are probed.
+"""The checks of a 3D scene (docs/reference/files.md, a 3D body) beyond the schema, and where its expressions are probed.
 
-A 3D scene is a box, an ``extrude`` domain or a 3D mesh file with ``model: 3d``; its vectors have
+A 3D scene is one whose body is a box, an ``extrude`` domain or a 3D mesh file (its model is ``3d``,
+:mod:`vemkit.config.dimension`); its vectors have
 three components and its expressions take x, y and z. Before any mesh is built every expression is
 test-evaluated on its side (:class:`BodyProbes`: a grid on each face of a box; on an extruded body the
 2D probes of a lateral side at several heights, the base's boundary on the end faces), the Dirichlet
@@ -26,12 +27,12 @@ from vemkit.config.boundary_conditions import (
     evaluate_checked,
     rigid_motion_error,
 )
-from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec, is_3d_domain
+from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec
 from vemkit.config.mesh_resolution import check_mesh_resolution3d
 from vemkit.config.rigid_motions import free_rigid_motion
 from vemkit.exceptions import SceneError
 
-__all__ = ["BodyProbes", "check_contact_3d", "check_model_domain", "semantic_checks_3d"]
+__all__ = ["BodyProbes", "check_contact_3d", "semantic_checks_3d"]
 
 DIMENSION = 3
 
@@ -87,23 +88,6 @@ class BodyProbes:
         s = (np.arange(PROBES) + 0.5) / PROBES
         grid = np.meshgrid(*(lower[i] + s * (upper[i] - lower[i]) for i in range(3)), indexing="ij")
         return tuple(g.ravel() for g in grid)
-
-
-def check_model_domain(data: dict) -> None:
-    """A box or extrude domain needs ``model: 3d``; ``model: 3d`` needs one (or a mesh file)."""
-    three_d = is_3d_domain(data["domain"])
-    if three_d and data["model"] != "3d":
-        kind = "box" if "box" in data["domain"] else "extrude"
-        raise SceneError(
-            f"domain.{kind} is a 3D body but model = {data['model']!r}; set model: 3d (or give a 2D domain)",
-            key="model",
-        )
-    if data["model"] == "3d" and not three_d and "file" not in data["discretization"]["mesh"]:
-        raise SceneError(
-            "model = '3d' needs a 3D body: domain {box: [[x0, y0, z0], [x1, y1, z1]]}, a polygon "
-            "with extrude: {depth: ...}, or a 3D mesh file; fix domain or the model",
-            key="domain",
-        )
 
 
 def _refuse_2d_only(data: dict, given: dict) -> None:

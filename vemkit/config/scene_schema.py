@@ -198,14 +198,17 @@ def first_problem(errors, data):
     return min(errors, key=lambda e: (document_order(data, e), e.validator != "type"))
 
 
-def validate(data) -> None:
-    """A one-line SceneError for the first problem of ``data`` (the scene as plain data)."""
+def validate(data, model: str | None = None) -> None:
+    """A one-line SceneError for the first problem of ``data`` (the scene as plain data); ``model``:
+    the scene's model for the titles that depend on it, when ``data`` omits it (its body's default)."""
     if not isinstance(data, dict):
         raise SceneError(f"the scene must be a mapping of keys (name, material, boundary, ...), got {show(data)}")
     check_finite(data, [])
     errors = list(schema_validator().iter_errors(data))
     if errors:
-        raise SceneError(schema_error_message(first_problem(errors, data), model=data.get("model", "plane_stress")))
+        raise SceneError(
+            schema_error_message(first_problem(errors, data), model=data.get("model") or model or "plane_stress")
+        )
 
 
 def normalized(value, node: dict):

@@ -1,0 +1,91 @@
+"""The dimension of a scene's body, and the models that fit it (docs/reference/files.md).
+
+The body says the dimension: a ``domain`` with ``box`` or ``extrude``, or a mesh file whose header
+says 3D (:func:`vemkit.config.mesh_file_header.mesh_file_dimension`), is 3D; ``unit_square``, a
+polygon and a plane mesh file are 2D. The ``model`` key says the constitution only (the elasticity
+tensor's lambda and mu, :mod:`vemkit.config.material`): ``plane_stress`` or ``plane_strain`` on a 2D
+body, ``3d`` on a 3D body; omitted, it is the body's default (``x-default-by-dimension`` of the
+schema: plane_stress in 2D, 3d in 3D). A model that does not fit the body is a one-line
+:class:`SceneError` naming ``model``, the body's dimension and the models that fit.
+
+A mesh file that does not say its dimension (a binary gmsh 2 file without a physical volume, a
+file that cannot be opened) keeps the rule of before: 3D with ``model: 3d`` or a 3D ``domain``,
+2D otherwise; the file's own problems are reported when the scene is solved.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from vemkit.config.domain3d import is_3d_domain
+from vemkit.config.mesh_file_header import mesh_file_dimension
+from vemkit.config.scene_schema import schema_root
+from vemkit.exceptions import SceneError
+
+__all__ = ["MODELS_BY_DIMENSION", "body_dimension", "default_model", "fill_model", "mesh_file_path"]
+
+#: the models (the constitution) that fit a body of each dimension, the default first
+MODELS_BY_DIMENSION = {2: ("plane_stress", "plane_strain"), 3: ("3d",)}
+
+
+def default_model(dimension: int) -> str:
+    """The model of a scene that names none: the schema's ``x-default-by-dimension``."""
+    return schema_root()["properties"]["model"]["x-default-by-dimension"][str(dimension)]
+
+
+def mesh_file_path(name: str, source: str | None) -> Path:
+    """``discretization.mesh.file`` resolved against the scene file's folder (a scene that is not
+    a file, ``source`` None or ``<...>``: against the working directory)."""
+    folder = Path(source).parent if source and not source.startswith("<") else Path(".")
+    return folder / name
+
+
+def _domain_words(domain) -> str:
+    if isinstance(domain, dict):
+        kind = next((k for k in ("box", "extrude", "polygon") if k in domain), "")
+        return f"domain.{kind}" if kind else "the domain"
+    return f"domain {domain}"
+
+
+def body_dimension(data: dict, source: str | None = None) -> tuple[int, str]:
+    """``(dimension, body)`` of a scene given as plain data (schema-valid, before the defaults):
+    the dimension of its body and the words naming that body in a message."""
+    domain = data.get("domain", "unit_square")
+    domain_3d = is_3d_domain(domain)
+    name = data.get("discretization", {}).get("mesh", {}).get("file")
+    if name is None:
+        return (3 if domain_3d else 2), _domain_words(domain)
+    dimension = mesh_file_dimension(mesh_file_path(name, source))
+    if dimension is None:  # the file does not say: the rule of before (module docstring)
+        dimension = 3 if domain_3d or data.get("model") == "3d" else 2
+        return dimension, f"the mesh file {name}"
+    if domain_3d and dimension == 2:
+        raise SceneError(
+            f"{_domain_words(domain)} is a 3D body but the mesh file {name} is a plane (2D) mesh; "
+            "with a mesh file the file is the body: drop domain or give a 3D mesh file",
+            key="domain",
+        )
+    return dimension, f"the mesh file {name}"
+
+
+def fill_model(data: dict, source: str | None = None) -> int:
+    """Check ``model`` against the body of ``data`` (module docstring) and fill in the body's
+    default when it is omitted; returns the body's dimension."""
+    dimension, body = body_dimension(data, source)
+    valid = MODELS_BY_DIMENSION[dimension]
+    model = data.get("model")
+    if model is None:
+        data["model"] = default_model(dimension)
+    elif model not in valid:
+        names = ", ".join(f"{m} (the default)" if m == default_model(dimension) else m for m in valid)
+        fix = (
+            "drop model or set model: 3d"
+            if dimension == 3
+            else "drop model, or give a 3D body (domain box, a polygon with extrude, or a 3D mesh file)"
+        )
+        raise SceneError(
+            f"model = {model!r} does not fit the body: {body} is {dimension}D; the models of a "
+            f"{dimension}D body: {names}; {fix}",
+            key="model",
+        )
+    return dimension
