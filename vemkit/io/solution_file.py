@@ -26,7 +26,7 @@ from vemkit.io.output_files import atomic_outputs
 from vemkit.io.solution_fields import add_cell_fields, add_contact, add_displacement, add_node_fields
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.files import read_ugrid
-from vemkit.mesh.ugrid import TOPOLOGY_NAMES, mesh_topology, topology_file
+from vemkit.mesh.ugrid import mesh_topology, topology_dimension, topology_file
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -118,8 +118,3 @@ def read_solution(path):
 
         return read_ugrid3d(path), ds
     return read_ugrid(path), ds
-
-
-def topology_dimension(ds) -> int:
-    """2 or 3: the dimension of the mesh of a solution Dataset, as its topology variable names it."""
-    return 3 if TOPOLOGY_NAMES[3] in ds.variables else 2

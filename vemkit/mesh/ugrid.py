@@ -73,11 +73,8 @@ class MeshTopology:
 
     @property
     def cell_dimension(self) -> str:
+        """``mesh2d_nFaces`` or ``mesh3d_nVolumes``: the file dimension of cell values."""
         return f"{self.name}_n{self.cell_location.capitalize()}s"
-
-    def dimension_of(self, location: str) -> str:
-        """The file dimension of an entity: ``node``, ``edge``, ``face`` or ``volume``."""
-        return f"{self.name}_n{location.capitalize()}s"
 
 
 def mesh_topology(mesh) -> MeshTopology:
@@ -95,6 +92,11 @@ def topology_file(topology: MeshTopology) -> FileDescription:
         for v in getattr(topology, section):
             out.add(v.name, v.dims, v.values, v.attrs, coordinate=v.coordinate, encoding=v.encoding)
     return out
+
+
+def topology_dimension(ds) -> int:
+    """2 or 3: the dimension of the mesh of a file or Dataset (its variables), as its topology variable names it."""
+    return 3 if TOPOLOGY_NAMES[3] in ds.variables else 2
 
 
 def mesh_file(mesh) -> FileDescription:

@@ -32,7 +32,7 @@ from matplotlib.patches import Patch
 from matplotlib.tri import Triangulation
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-from vemkit.io.solution_file import topology_dimension
+from vemkit.mesh.ugrid import topology_dimension
 
 STATE_COLORS = {0: ("separated", "#d9d9d9"), 1: ("stick", "#9ecae1"), 2: ("slip", "#fdae6b")}
 FAMILY_COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f")
