@@ -165,7 +165,16 @@ def _polygon_topology(mesh) -> MeshTopology:
         )
         for name in names
     )
-    attrs = {
+    attrs = _xugrid_topology_attrs(t, names, mesh.meta)
+    layout = ("topology", "connectivity", "node_coordinates", "boundary_parts")
+    return MeshTopology(
+        t, 2, attrs, coordinates, connectivity, parts, layout, "face", np.int64, {"Conventions": "CF-1.9 UGRID-1.0"}
+    )
+
+
+def _xugrid_topology_attrs(t: str, names: list[str], meta: dict) -> dict[str, Any]:
+    """The attributes of xugrid's topology variable (UGRID-1.0 ``mesh_topology``), then the part names and meta."""
+    return {
         "cf_role": "mesh_topology",
         "long_name": "Topology data of 2D mesh",
         "topology_dimension": 2,
@@ -178,12 +187,8 @@ def _polygon_topology(mesh) -> MeshTopology:
         "node_coordinates": f"{t}_node_x {t}_node_y",
         "name": t,
         "vemkit_boundary_parts": json.dumps(names),
-        "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
+        "vemkit_meta": json.dumps(meta, default=json_scalar),
     }
-    layout = ("topology", "connectivity", "node_coordinates", "boundary_parts")
-    return MeshTopology(
-        t, 2, attrs, coordinates, connectivity, parts, layout, "face", np.int64, {"Conventions": "CF-1.9 UGRID-1.0"}
-    )
 
 
 def _polyhedron_topology(mesh) -> MeshTopology:
