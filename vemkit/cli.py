@@ -21,7 +21,6 @@ import argparse
 import os
 import sys
 import warnings
-from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -171,12 +170,9 @@ VTU_CELL_FIELDS = {
 
 def _write_solution_vtu(problem, solution, ds, path) -> None:
     """The displacement at the vertices and the cell stresses as VTU (3D: VTK polyhedra, type 42)."""
-    dimension = problem.space.element.dimension
-    write_vtu: Callable[..., None]  # the 2D or the 3D writer
-    if dimension == 3:
-        from vemkit.mesh.files3d import write_vtu3d as write_vtu
-    else:
-        from vemkit.mesh.files import write_vtu
+    from vemkit.mesh.vtu import write_vtu
+
+    dimension = problem.mesh.dimension
     cells = {k: ds[k].values for k in VTU_CELL_FIELDS[dimension]}
     write_vtu(problem.mesh, path, point_data={"displacement": problem.dofs.expand(solution.u)}, cell_data=cells)
 
@@ -219,7 +215,7 @@ def cmd_adapt(args) -> int:
 
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite
-    from vemkit.mesh.files import write_vtu
+    from vemkit.mesh.vtu import write_vtu
     from vemkit.studies.adaptivity import STOP_REASONS, adapt, adaptive_dataset
 
     def progress(step, record):
@@ -296,14 +292,9 @@ def cmd_mesh(args) -> int:
     mesh, family = _scene_mesh(args) if args.scene else _family_mesh(args)
 
     from vemkit.io.output_files import atomic_outputs
+    from vemkit.mesh.ugrid import write_ugrid
+    from vemkit.mesh.vtu import write_vtu
 
-    write_ugrid: Callable[..., None]  # the 2D or the 3D writers
-    write_vtu: Callable[..., None]
-    if getattr(mesh, "dimension", 2) == 3:
-        from vemkit.mesh.files3d import write_ugrid3d as write_ugrid
-        from vemkit.mesh.files3d import write_vtu3d as write_vtu
-    else:
-        from vemkit.mesh.files import write_ugrid, write_vtu
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_ugrid(mesh, output_part)
         if vtu_part is not None:

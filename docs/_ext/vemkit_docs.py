@@ -493,23 +493,22 @@ THREE_D_SETTINGS = ("discretization.mesh.n=8",)
 def three_d_figure(out: Path) -> str:
     """``config/scenes/3d/sheared_box.yaml`` on 8 x 8 x 4 hexahedra, solved and checked as
     ``vemkit solve`` does (:func:`vemkit.studies.scene_solve.solve_scene`), drawn by
-    :func:`vemkit.report.body3d_figures.body3d_figure`: the Markdown that shows it."""
+    :func:`vemkit.report.figures.deformed_figure` (the 2D figures' function): the Markdown that shows it."""
     import vemkit
     from vemkit.report import figures as plots
-    from vemkit.report.body3d_figures import body3d_figure
     from vemkit.studies.scene_solve import solve_scene
 
     scene = vemkit.load_scene(str(THREE_D_SCENE), list(THREE_D_SETTINGS))
     problem, solution, ds = solve_scene(scene, verify=True)
     out.mkdir(parents=True, exist_ok=True)
     title = f"sheared_box: {problem.mesh.n_cells} hexahedra, displacements ×20"
-    plots.save(body3d_figure(problem.mesh, ds, magnification=20, title=title), out / "sheared-box.png", dpi=80)
+    plots.save(plots.deformed_figure(problem.mesh, ds, magnification=20, title=title), out / "sheared-box.png", dpi=80)
     settings = " ".join(f"--set {s}" for s in THREE_D_SETTINGS)
     return (
         "![The sheared box on its foundation: the deformed body coloured by von Mises, and the stick and "
         "slip zones of its contact face](/_generated/three-d/sheared-box.png)\n\n"
         f"*`.venv/bin/vemkit solve config/scenes/3d/sheared_box.yaml -o box.nc {settings}`, drawn "
-        "from the Dataset by `vemkit.report.body3d_figures.body3d_figure` during this build: a box "
+        "from the Dataset by `vemkit.report.figures.deformed_figure` during this build: a box "
         "pressed onto a foundation across a gap that opens along x, its top moved by "
         "(0.004, 0.002, -0.01); left the deformed body, right its contact face projected on the x-y plane "
         f"({solution.method}: {solution.iterations} Newton steps, {problem.n_dofs} unknowns, "

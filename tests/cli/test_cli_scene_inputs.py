@@ -265,7 +265,7 @@ def _netcdf_files(path: Path) -> None:
         faces = nc.createVariable("faces", "i4", ("faces", "corners"), zlib=True, complevel=9)
         faces[:] = np.broadcast_to(np.arange(4, dtype=np.int32), (3_000_000, 4))
     from vemkit.mesh.families import build_mesh
-    from vemkit.mesh.files import write_ugrid
+    from vemkit.mesh.ugrid import write_ugrid
 
     write_ugrid(build_mesh("square", 2), path / "sides.nc")
     with netCDF4.Dataset(path / "sides.nc", "a") as nc:

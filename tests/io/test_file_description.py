@@ -16,7 +16,8 @@ import xugrid
 
 from vemkit.config.scene import load_scene, scene_from_dict
 from vemkit.mesh.families import build_mesh
-from vemkit.mesh.files import mesh_description, padded_face_nodes
+from vemkit.mesh.polyhedral_build import csr_rows
+from vemkit.mesh.ugrid import mesh_file
 from vemkit.studies.scene_solve import solve_scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -100,11 +101,11 @@ def test_the_mesh_description_is_what_xugrid_builds(family):
         mesh.vertices[:, 0],
         mesh.vertices[:, 1],
         -1,
-        padded_face_nodes(mesh),
+        csr_rows(mesh.cell_offsets, mesh.cell_vertices),
         name="mesh2d",
         edge_node_connectivity=mesh.edges,
     ).to_dataset()
-    ours = mesh_description(mesh).to_dataset()
+    ours = mesh_file(mesh).to_dataset()
     assert list(ours.variables)[: len(grid.variables)] == list(grid.variables)
     assert list(ours.coords) == list(grid.coords) and ours.attrs == grid.attrs
     for name in grid.variables:
@@ -128,7 +129,7 @@ def test_the_command_line_solve_imports_no_xarray_nor_pandas(mesh, tmp_path):
     """Neither with a mesh family nor with a mesh file (UGRID, read through netCDF4)."""
     args = [str(PAPER), "-o", str(tmp_path / "out.nc"), "--set", "discretization.mesh.n=2"]
     if mesh == "file":
-        mesh_description(build_mesh("square", 2)).write_netcdf4(tmp_path / "mesh.nc")
+        mesh_file(build_mesh("square", 2)).write_netcdf4(tmp_path / "mesh.nc")
         args += ["--set", f"discretization.mesh={{file: {tmp_path / 'mesh.nc'}}}"]
     run = subprocess.run([sys.executable, "-c", IMPORTED, *args], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr

@@ -8,7 +8,8 @@ import pytest
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.families import build_mesh
-from vemkit.mesh.files import read_mesh, write_ugrid
+from vemkit.mesh.files import read_mesh
+from vemkit.mesh.ugrid import write_ugrid
 
 # a 3 x 2 rectangle [0, 3] x [0, 2]: 12 nodes on a unit grid (tag = 1 + i + 4 j), node 13 a stray
 # geometry point that no element uses

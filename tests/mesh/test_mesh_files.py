@@ -7,7 +7,9 @@ import xarray as xr
 import xugrid
 
 from vemkit.mesh.families import build_mesh
-from vemkit.mesh.files import mesh_to_ugrid_dataset, padded_face_nodes, read_ugrid, write_ugrid, write_vtu
+from vemkit.mesh.files import read_ugrid
+from vemkit.mesh.ugrid import mesh_to_ugrid_dataset, mesh_topology, write_ugrid
+from vemkit.mesh.vtu import write_vtu
 
 MESHES = [
     ("square", {}),
@@ -58,9 +60,9 @@ def test_ugrid_file_layout(tmp_path):
 
 
 @pytest.mark.parametrize("family", ["voronoi", "triangle"])  # mixed sizes; one size (no padding)
-def test_padded_face_nodes_matches_a_loop(family):
+def test_the_face_table_matches_a_loop(family):
     mesh = mesh_of(family, {"seed": 4, "lloyd_iterations": 0} if family == "voronoi" else {})
-    table = padded_face_nodes(mesh)
+    table = mesh_topology(mesh).connectivity[0].values
     assert table.shape == (mesh.n_cells, mesh.cell_sizes.max())
     for k in range(mesh.n_cells):
         row = table[k]
@@ -101,5 +103,5 @@ def test_vtu_is_readable_by_meshio(tmp_path, family, options):
 
 def test_vtu_rejects_data_of_the_wrong_length(tmp_path):
     mesh = mesh_of("square", {})
-    with pytest.raises(ValueError, match="point_data 'u' has 3 entries; the mesh has 49"):
+    with pytest.raises(ValueError, match="points data 'u' has 3 rows; the mesh has 49 points"):
         write_vtu(mesh, tmp_path / "bad.vtu", point_data={"u": np.zeros(3)})

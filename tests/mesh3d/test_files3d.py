@@ -10,8 +10,10 @@ from vemkit.exceptions import MeshError
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.families3d import extrude, hex, octree, tet, voronoi
 from vemkit.mesh.families3d.grid import lattice
-from vemkit.mesh.files3d import VOLUME_FILL, read_mesh3d, read_ugrid3d, write_ugrid3d, write_vtu3d
+from vemkit.mesh.files3d import read_mesh3d, read_ugrid3d
 from vemkit.mesh.polyhedral_build import csr_rows
+from vemkit.mesh.ugrid import VOLUME_FILL, write_ugrid
+from vemkit.mesh.vtu import write_vtu
 
 
 def same_mesh(a, b):
@@ -28,7 +30,7 @@ def same_mesh(a, b):
 )
 def test_netcdf_round_trip(tmp_path, make):
     mesh = make()
-    write_ugrid3d(mesh, tmp_path / "m.nc")
+    write_ugrid(mesh, tmp_path / "m.nc")
     back = read_mesh3d(tmp_path / "m.nc")
     same_mesh(mesh, back)
     assert back.meta["family"] == mesh.meta["family"]
@@ -44,7 +46,7 @@ def test_netcdf_round_trip(tmp_path, make):
 
 def test_a_broken_netcdf_file_is_refused(tmp_path):
     mesh = hex(shape=(2, 1, 1))
-    write_ugrid3d(mesh, tmp_path / "m.nc")
+    write_ugrid(mesh, tmp_path / "m.nc")
     with netCDF4.Dataset(tmp_path / "m.nc", "a") as nc:
         v = nc["mesh3d_volume_faces"][:]
         v[0, :] = -v[0, :] - 1  # cell 0 inside out
@@ -61,7 +63,7 @@ def test_a_broken_netcdf_file_is_refused(tmp_path):
 
 def test_vtu_polyhedra_read_back(tmp_path):
     mesh = octree(shape=(2, 2, 2), rule="random", fraction=0.4, seed=2)
-    write_vtu3d(mesh, tmp_path / "m.vtu", point_data={"u": mesh.vertices}, cell_data={"vol": mesh.cell_volumes})
+    write_vtu(mesh, tmp_path / "m.vtu", point_data={"u": mesh.vertices}, cell_data={"vol": mesh.cell_volumes})
     arrays = vtu_arrays(tmp_path / "m.vtu")
     assert (arrays["types"] == 42).all() and arrays["types"].size == mesh.n_cells
     assert np.array_equal(arrays["Points"].reshape(-1, 3), mesh.vertices)
@@ -76,7 +78,7 @@ def test_vtu_polyhedra_read_back(tmp_path):
 
 def test_meshio_reads_the_vtu_polyhedra(tmp_path):
     mesh = hex(shape=(2, 2, 1))  # all cells with 8 vertices: one meshio block, in mesh order
-    write_vtu3d(mesh, tmp_path / "m.vtu", cell_data={"vol": mesh.cell_volumes})
+    write_vtu(mesh, tmp_path / "m.vtu", cell_data={"vol": mesh.cell_volumes})
     back = meshio.read(tmp_path / "m.vtu")
     assert [b.type for b in back.cells] == ["polyhedron8"] and np.array_equal(back.points, mesh.vertices)
     for c, faces in enumerate(back.cells[0].data):

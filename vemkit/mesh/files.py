@@ -1,4 +1,4 @@
-"""Mesh files: UGRID-1.0 netCDF (round trip), gmsh ``.msh`` (read) and VTU (for ParaView).
+"""Reading 2D mesh files: UGRID-1.0 netCDF and gmsh ``.msh`` (the writers: ``vemkit.mesh.ugrid``, ``vemkit.mesh.vtu``).
 
 ``read_mesh(path)`` reads ``.nc`` (UGRID) or ``.msh`` (gmsh, versions 2 and 4 through meshio) and
 validates the mesh like a family's: a broken mesh is refused with a one-line ``MeshError`` naming
@@ -12,7 +12,7 @@ Line elements carry the sides: each physical line group becomes the boundary par
 physical name, or by its number when it has none. Boundary edges in no group form the part
 ``untagged``; a tagged line that is not a boundary edge is refused.
 
-UGRID layout (what ``mesh_description`` writes, as xugrid would, and ``read_ugrid`` reads):
+UGRID layout (what ``vemkit.mesh.ugrid.write_ugrid`` writes, as xugrid would, and ``read_ugrid`` reads):
 
 - topology variable ``mesh2d`` (cf_role mesh_topology); its attribute ``vemkit_meta`` holds the
   mesh's ``meta`` as JSON text, ``vemkit_boundary_parts`` the boundary part names (JSON list);
@@ -39,88 +39,11 @@ from vemkit.exceptions import MeshError
 from vemkit.mesh.check_kernels import worst_coordinate_over_edge
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.file_budget import parse_within_budget
-from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.geometry import counter_clockwise
 from vemkit.mesh.mesh import Mesh
+from vemkit.mesh.ugrid import FACE_FILL
 
-TOPOLOGY = "mesh2d"
-FILL_VALUE = -1
-
-
-def padded_face_nodes(mesh: Mesh, fill_value: int = FILL_VALUE) -> np.ndarray:
-    """``(M, max cell size)`` vertex indices of every cell, padded with ``fill_value`` (vectorised)."""
-    sizes = mesh.cell_sizes
-    if mesh.n_cells and sizes.min() == sizes.max():  # one cell size: the CSR list is the table
-        return mesh.cell_vertices.reshape(mesh.n_cells, int(sizes[0])).copy()
-    out = np.full((mesh.n_cells, int(sizes.max()) if mesh.n_cells else 0), fill_value, dtype=np.int64)
-    rows = np.repeat(np.arange(mesh.n_cells, dtype=np.int64), sizes)
-    cols = np.arange(mesh.cell_vertices.size, dtype=np.int64) - np.repeat(mesh.cell_offsets[:-1], sizes)
-    out[rows, cols] = mesh.cell_vertices
-    return out
-
-
-def mesh_description(mesh: Mesh) -> FileDescription:
-    """The mesh's UGRID-1.0 file (see the module docstring), ready to take node or face data: what
-    ``xugrid.Ugrid2d(...).to_dataset()`` gives (the same variables, attributes and order; a test
-    compares them), plus the boundary parts and the meta."""
-    t = TOPOLOGY
-    names = list(mesh.boundary)
-    for name in names:
-        if not SIDE_NAME.fullmatch(name):
-            raise ValueError(f"boundary part name {name!r}: use letters, digits, _ and - only")
-    out = FileDescription({"Conventions": "CF-1.9 UGRID-1.0"})
-    out.add(t, (), np.int64(0), _topology_attrs())
-    for name, dims, table in (
-        ("face", (f"{t}_nFaces", f"{t}_nMax_face_nodes"), padded_face_nodes(mesh)),
-        ("edge", (f"{t}_nEdges", "two"), mesh.edges),
-    ):
-        attrs = {"cf_role": f"{name}_node_connectivity", "start_index": 0, "_FillValue": FILL_VALUE}
-        out.add(f"{t}_{name}_nodes", dims, np.asarray(table, dtype=np.int64), attrs)
-    for k, axis in enumerate("xy"):
-        attrs = {"standard_name": f"projection_{axis}_coordinate"}
-        out.add(f"{t}_node_{axis}", f"{t}_nNodes", mesh.vertices[:, k], attrs, coordinate=True)
-    for name in names:
-        out.add(
-            f"boundary_{name}",
-            (f"boundary_{name}_nEdges", "two"),
-            mesh.boundary[name],
-            {
-                "long_name": f"boundary part {name}: edges as vertex pairs, counter-clockwise",
-                "start_index": 0,
-                "mesh": t,
-            },
-        )
-    out[t].attrs["vemkit_boundary_parts"] = json.dumps(names)
-    out[t].attrs["vemkit_meta"] = json.dumps(mesh.meta, default=json_scalar)
-    return out
-
-
-def _topology_attrs() -> dict:
-    """The attributes of xugrid's topology variable (UGRID-1.0 ``mesh_topology``)."""
-    t = TOPOLOGY
-    return {
-        "cf_role": "mesh_topology",
-        "long_name": "Topology data of 2D mesh",
-        "topology_dimension": 2,
-        "node_dimension": f"{t}_nNodes",
-        "edge_dimension": f"{t}_nEdges",
-        "face_dimension": f"{t}_nFaces",
-        "max_face_nodes_dimension": f"{t}_nMax_face_nodes",
-        "edge_node_connectivity": f"{t}_edge_nodes",
-        "face_node_connectivity": f"{t}_face_nodes",
-        "node_coordinates": f"{t}_node_x {t}_node_y",
-        "name": t,
-    }
-
-
-def mesh_to_ugrid_dataset(mesh: Mesh):
-    """The mesh as a UGRID-1.0 ``xarray.Dataset`` (:func:`mesh_description`)."""
-    return mesh_description(mesh).to_dataset()
-
-
-def write_ugrid(mesh: Mesh, path) -> None:
-    """Write the mesh as a UGRID-1.0 netCDF4 file."""
-    mesh_description(mesh).write_netcdf4(path)
+FILL_VALUE = FACE_FILL
 
 
 def read_ugrid(path) -> Mesh:
@@ -163,50 +86,6 @@ def read_ugrid(path) -> Mesh:
 def _attrs(variable) -> dict:
     """A netCDF4 variable's attributes by name."""
     return {key: variable.getncattr(key) for key in variable.ncattrs()}
-
-
-def write_vtu(mesh: Mesh, path, point_data: dict | None = None, cell_data: dict | None = None) -> None:
-    """Write the mesh (and data) as VTU: VTK_POLYGON blocks grouped by vertex count.
-
-    Cells are written grouped by their number of vertices, so the file's cell order differs from
-    the mesh's; the cell data array ``cell_index`` gives every written cell's index in the mesh.
-    Two-component vectors (displacements) are padded with a zero third component for ParaView.
-    """
-    sizes = mesh.cell_sizes
-    groups = [np.flatnonzero(sizes == s) for s in np.unique(sizes)]
-    blocks = [
-        ("polygon", mesh.cell_vertices[mesh.cell_offsets[cells][:, None] + np.arange(sizes[cells[0]])])
-        for cells in groups
-    ]
-    cells_out = {"cell_index": [cells.astype(np.int64) for cells in groups]}
-    for name, values in (cell_data or {}).items():
-        values = _three_components(np.asarray(values), mesh.n_cells, f"cell_data {name!r}")
-        cells_out[name] = [values[cells] for cells in groups]
-    points_out = {
-        name: _three_components(np.asarray(values), mesh.n_vertices, f"point_data {name!r}")
-        for name, values in (point_data or {}).items()
-    }
-    points = np.column_stack([mesh.vertices, np.zeros(mesh.n_vertices)])
-    import meshio
-
-    meshio.Mesh(points, blocks, point_data=points_out, cell_data=cells_out).write(Path(path), file_format="vtu")
-
-
-def _three_components(values: np.ndarray, count: int, what: str) -> np.ndarray:
-    if values.shape[0] != count:
-        raise ValueError(f"{what} has {values.shape[0]} entries; the mesh has {count}")
-    if values.ndim == 2 and values.shape[1] == 2:
-        values = np.column_stack([values, np.zeros(count, dtype=values.dtype)])
-    return values
-
-
-def json_scalar(value):
-    """A numpy value of a mesh's meta as plain JSON (for json.dumps(default=...))."""
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"mesh meta value {value!r} cannot be stored as JSON")
 
 
 # -- any mesh file ------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
-"""3D mesh files (docs/reference/files.md): the ``mesh3d`` UGRID-style netCDF topology (round trip), VTU with VTK
-polyhedron cells (type 42, for ParaView) and gmsh ``.msh`` 3D meshes (read, through meshio).
+"""Reading 3D mesh files (docs/reference/files.md): the ``mesh3d`` UGRID-style netCDF topology and gmsh
+``.msh`` 3D meshes (through meshio). The writers: ``vemkit.mesh.ugrid`` (netCDF) and ``vemkit.mesh.vtu``.
 
-netCDF layout (``mesh3d_description`` / ``read_ugrid3d``):
+netCDF layout (``vemkit.mesh.ugrid.write_ugrid`` / ``read_ugrid3d``):
 
 - ``mesh3d``: the topology variable, ``cf_role = "mesh_topology"``, ``topology_dimension = 3``,
   ``node_coordinates``, ``face_node_connectivity``, ``volume_face_connectivity``; ``vemkit_meta``
@@ -14,11 +14,6 @@ netCDF layout (``mesh3d_description`` / ``read_ugrid3d``):
   ``VOLUME_FILL`` (the most negative int64, since -1 is a face);
 - ``mesh3d_boundary_<name>`` (``mesh3d_boundary_<name>_nFaces``): the faces of each boundary part.
 
-VTU: one ``UnstructuredGrid`` piece, cells in mesh order, all of type 42 (VTK_POLYHEDRON) with
-``connectivity`` (the cell's distinct vertices), ``faces`` (per cell: number of faces, then per
-face its vertex count and vertices, outward) and ``faceoffsets`` (end of each cell's stream),
-binary (base64, UInt64 headers).
-
 gmsh: linear ``tetra``, ``hexahedron``, ``wedge`` and ``pyramid`` elements are the cells (an
 element given with mirrored node order is turned outward); physical SURFACE groups (triangles,
 quadrilaterals) name the sides, by physical name or else number; boundary faces in no group form
@@ -28,7 +23,6 @@ the part ``untagged``. ``read_mesh3d`` parses within the 2D reader's memory budg
 
 from __future__ import annotations
 
-import base64
 import json
 from pathlib import Path
 
@@ -38,61 +32,12 @@ from vemkit.config.domain import SIDE_NAME
 from vemkit.config.mesh_file_header import OTHER_DIMENSION
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
-from vemkit.mesh.file_description import FileDescription
-from vemkit.mesh.files import check_coordinate_precision, json_scalar
+from vemkit.mesh.files import check_coordinate_precision
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import csr_rows, from_face_soup
+from vemkit.mesh.ugrid import FACE_FILL, TOPOLOGY_NAMES, VOLUME_FILL
 
-TOPOLOGY = "mesh3d"
-FACE_FILL = -1
-VOLUME_FILL = np.iinfo(np.int64).min
-VTK_POLYHEDRON = 42
-
-
-def mesh3d_description(mesh: PolyhedralMesh) -> FileDescription:
-    """The ``mesh3d`` topology of the module doc, ready to take node or volume data."""
-    t = TOPOLOGY
-    faces = csr_rows(mesh.face_offsets, mesh.face_vertices, FACE_FILL)
-    volumes = csr_rows(mesh.cell_offsets, mesh.cell_faces, VOLUME_FILL)
-    out = FileDescription()
-    for k, a in enumerate("xyz"):
-        out.add(f"{t}_node_{a}", f"{t}_nNodes", mesh.vertices[:, k])
-    out.add(
-        f"{t}_face_nodes",
-        (f"{t}_nFaces", f"{t}_nMax_face_nodes"),
-        faces,
-        {"cf_role": "face_node_connectivity", "start_index": 0},
-        encoding={"_FillValue": FACE_FILL},
-    )
-    out.add(
-        f"{t}_volume_faces",
-        (f"{t}_nVolumes", f"{t}_nMax_volume_faces"),
-        volumes,
-        {"cf_role": "volume_face_connectivity", "start_index": 0, "orientation": "outward; -(f+1) is face f reversed"},
-        encoding={"_FillValue": VOLUME_FILL},
-    )
-    for name, part in mesh.boundary.items():
-        out.add(f"{t}_boundary_{name}", f"{t}_boundary_{name}_nFaces", np.asarray(part, np.int64))
-    topology = {
-        "cf_role": "mesh_topology",
-        "topology_dimension": 3,
-        "node_coordinates": f"{t}_node_x {t}_node_y {t}_node_z",
-        "face_node_connectivity": f"{t}_face_nodes",
-        "volume_face_connectivity": f"{t}_volume_faces",
-        "vemkit_meta": json.dumps(mesh.meta, default=json_scalar),
-        "vemkit_boundary_parts": json.dumps(list(mesh.boundary)),
-    }
-    out.add(t, (), np.int32(0), topology)
-    return out
-
-
-def mesh3d_to_dataset(mesh: PolyhedralMesh):
-    """The ``mesh3d`` topology as an xarray Dataset (:func:`mesh3d_description`)."""
-    return mesh3d_description(mesh).to_dataset()
-
-
-def write_ugrid3d(mesh: PolyhedralMesh, path) -> None:
-    mesh3d_description(mesh).write_netcdf4(path)
+TOPOLOGY = TOPOLOGY_NAMES[3]
 
 
 def read_ugrid3d(path) -> PolyhedralMesh:
@@ -190,81 +135,6 @@ def _validated(mesh: PolyhedralMesh, path: Path) -> PolyhedralMesh:
     except MeshError as error:
         raise MeshError(f"{path.name}: {error}", key=str(path)) from None
     return mesh
-
-
-# -- VTU ------------------------------------------------------------------------------------------
-def polyhedron_streams(mesh: PolyhedralMesh):
-    """(connectivity, offsets, faces, faceoffsets) of the VTK polyhedron cells, faces outward."""
-    conn_offsets, conn = mesh.cell_vertex_lists
-    cf = mesh.cell_faces
-    faces = np.where(cf >= 0, cf, -cf - 1)
-    sizes = np.diff(mesh.face_offsets)[faces]
-    start = mesh.face_offsets[faces]
-    entry = np.repeat(np.arange(faces.size), sizes)
-    local = np.arange(entry.size) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-    local = np.where(cf[entry] >= 0, local, sizes[entry] - 1 - local)
-    ids = mesh.face_vertices[start[entry] + local]
-    # stream: per cell [nF, (n, ids...) per face]; place the headers and the ids in one array
-    per_cell = np.diff(mesh.cell_offsets)
-    cells = np.repeat(np.arange(mesh.n_cells), per_cell)
-    length = 1 + np.bincount(cells, weights=sizes + 1, minlength=mesh.n_cells).astype(np.int64)
-    ends = np.cumsum(length)
-    stream = np.empty(int(ends[-1]), dtype=np.int64)
-    cell_start = ends - length
-    stream[cell_start] = per_cell
-    face_pos = (
-        cell_start[cells]
-        + 1
-        + (np.cumsum(sizes + 1) - (sizes + 1))
-        - np.repeat((np.cumsum(sizes + 1) - (sizes + 1))[mesh.cell_offsets[:-1]], per_cell)
-    )
-    stream[face_pos] = sizes
-    stream[np.repeat(face_pos + 1, sizes) + (np.arange(entry.size) - np.repeat(np.cumsum(sizes) - sizes, sizes))] = ids
-    return conn, conn_offsets[1:], stream, ends
-
-
-def _data_array(name: str, values: np.ndarray, components: int = 1) -> str:
-    values = np.ascontiguousarray(values)
-    kind = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64", np.dtype(np.uint8): "UInt8"}[values.dtype]
-    raw = values.tobytes()
-    text = base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode("ascii")
-    shape = f' NumberOfComponents="{components}"' if components > 1 else ""
-    return f'<DataArray type="{kind}" Name="{name}"{shape} format="binary">{text}</DataArray>\n'
-
-
-def write_vtu3d(mesh: PolyhedralMesh, path, point_data: dict | None = None, cell_data: dict | None = None) -> None:
-    """Write the mesh (and data: arrays of n_vertices / n_cells rows) as VTU polyhedra (module doc);
-    the cell data array ``cell_index`` numbers the cells as in the mesh."""
-    conn, offsets, faces, faceoffsets = polyhedron_streams(mesh)
-    arrays = {"points": {}, "cells": {}}
-    for where, data, count in (("points", point_data, mesh.n_vertices), ("cells", cell_data, mesh.n_cells)):
-        for name, values in (data or {}).items():
-            values = np.asarray(values, dtype=np.float64)
-            if values.shape[0] != count:
-                raise ValueError(f"{where} data {name!r} has {values.shape[0]} rows; the mesh has {count} {where}")
-            arrays[where][name] = values
-    arrays["cells"]["cell_index"] = np.arange(mesh.n_cells, dtype=np.int64)
-    parts = [
-        '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
-        'header_type="UInt64">\n<UnstructuredGrid>\n',
-        f'<Piece NumberOfPoints="{mesh.n_vertices}" NumberOfCells="{mesh.n_cells}">\n',
-        "<Points>\n",
-        _data_array("Points", mesh.vertices.astype("<f8"), 3),
-        "</Points>\n<Cells>\n",
-        _data_array("connectivity", conn),
-        _data_array("offsets", offsets),
-        _data_array("types", np.full(mesh.n_cells, VTK_POLYHEDRON, dtype=np.uint8)),
-        _data_array("faces", faces),
-        _data_array("faceoffsets", faceoffsets),
-        "</Cells>\n",
-    ]
-    for tag, where in (("PointData", "points"), ("CellData", "cells")):
-        parts.append(f"<{tag}>\n")
-        for name, values in arrays[where].items():
-            parts.append(_data_array(name, values, 1 if values.ndim == 1 else values.shape[1]))
-        parts.append(f"</{tag}>\n")
-    parts.append("</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
-    Path(path).write_text("".join(parts), encoding="ascii")
 
 
 # -- gmsh -----------------------------------------------------------------------------------------

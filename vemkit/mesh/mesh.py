@@ -32,6 +32,8 @@ class Mesh:
     boundary: dict = field(default_factory=dict)
     meta: dict = field(default_factory=dict)
 
+    dimension = 2
+
     def __post_init__(self):
         object.__setattr__(self, "vertices", np.ascontiguousarray(self.vertices, dtype=np.float64))
         object.__setattr__(self, "cell_offsets", np.ascontiguousarray(self.cell_offsets, dtype=np.int64))

@@ -3,16 +3,19 @@
 - :func:`displacement_figure`: u1 and u2 on a polygonal mesh (Figs. 3-5): the vertex values
   interpolated linearly on an ear-clipping triangulation of the cells (Gouraud shading), the
   mesh edges drawn over them;
-- :func:`deformed_figure`: the deformed mesh, displacements magnified, every cell filled in grey
+- :func:`deformed_figure`: 2D, the deformed mesh, displacements magnified, every cell filled in grey
   by its shear energy density |dev sigma|^2/(4 mu) (Fig. 6), the foundation's surface and the
-  penetrated part of Gamma_C marked;
-- :func:`contact_figure`: along Gamma_C, the normal pressure, the tangential stress with the
-  friction bound, the slip and the penetration, over the separated/stick/slip zones;
+  penetrated part of Gamma_C marked; 3D, the deformed boundary faces coloured by the von Mises
+  stress of their cells and, with contact, Gamma_C's zones and slip (:func:`contact_figure`);
+- :func:`contact_figure`: 2D, along Gamma_C, the normal pressure, the tangential stress with the
+  friction bound, the slip and the penetration, over the separated/stick/slip zones; 3D, Gamma_C
+  seen from below: the separated/stick/slip state at every contact vertex and the slip as arrows;
 - :func:`convergence_figure`: log-log errors against h for every family and stabilization, with
   the paper's Table 1 and a slope-1 guide.
 
 Every function returns a ``matplotlib.figure.Figure``; :func:`save` writes it as PNG and PDF.
-They read solution Datasets as written by ``vemkit solve`` (docs/reference/files.md) and convergence Datasets
+They read solution Datasets of either dimension as written by ``vemkit solve`` (docs/reference/files.md:
+the mesh says which, or the Dataset's topology variable) and convergence Datasets
 (``vemkit.studies.convergence``).
 """
 
@@ -24,8 +27,12 @@ import numpy as np
 import yaml
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.tri import Triangulation
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+from vemkit.mesh.ugrid import topology_dimension
 
 STATE_COLORS = {0: ("separated", "#d9d9d9"), 1: ("stick", "#9ecae1"), 2: ("slip", "#fdae6b")}
 FAMILY_COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f")
@@ -97,7 +104,14 @@ def auto_magnification(u: np.ndarray, fraction: float = 0.15) -> float:
     return float(10.0 ** np.floor(np.log10(raw)) * round(raw / 10.0 ** np.floor(np.log10(raw))))
 
 
-def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "", cmap: str = "Greys") -> Figure:
+def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "", cmap: str | None = None) -> Figure:
+    """The deformed body x + M u: a 2D mesh (:func:`_deformed_plane`) or a 3D body (:func:`_deformed_body`)."""
+    if mesh.dimension == 3:
+        return _deformed_body(mesh, ds, magnification, title, cmap or "viridis")
+    return _deformed_plane(mesh, ds, magnification, title, cmap or "Greys")
+
+
+def _deformed_plane(mesh, ds, magnification: float | None, title: str, cmap: str) -> Figure:
     """The deformed mesh x + M u, grey = shear energy density per cell, Gamma_C penetration in red.
 
     The foundation's surface lies at distance g_a below Gamma_C: drawn at y = -M g_a, so that a
@@ -152,6 +166,46 @@ def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "
     return fig
 
 
+def body_magnification(vertices, u, fraction: float = 0.1) -> float:
+    """A factor 1 or 5 times a power of ten that makes the largest displacement about ``fraction``
+    of the body's size (3D)."""
+    size = float(np.ptp(vertices, axis=0).max())
+    top = float(np.abs(u).max())
+    if top == 0.0:
+        return 1.0
+    raw = fraction * size / top
+    return float(10 ** np.floor(np.log10(raw)) * (5 if raw / 10 ** np.floor(np.log10(raw)) >= 5 else 1))
+
+
+def _deformed_body(mesh, ds, magnification: float | None, title: str, cmap: str) -> Figure:
+    """The deformed boundary of a 3D body coloured by von Mises; Gamma_C's states and slip from below."""
+    u = np.stack([ds["u1"].values, ds["u2"].values, ds["u3"].values], axis=1)
+    m = body_magnification(mesh.vertices, u) if magnification is None else float(magnification)
+    xyz = mesh.vertices + m * u
+    faces = mesh.boundary_faces
+    owner = mesh.face_cells[faces].max(axis=1)  # the one cell of a boundary face
+    contact = "contact_state" in ds
+    fig = Figure(figsize=(11.0 if contact else 6.5, 5.0), layout="constrained")
+    ax = fig.add_subplot(1, 2 if contact else 1, 1, projection="3d")
+    surface = Poly3DCollection([xyz[mesh.face(f)] for f in faces], cmap=cmap, edgecolors="k", linewidths=0.25)
+    surface.set_array(np.asarray(ds["von_mises"].values, dtype=float)[owner])
+    ax.add_collection3d(surface)
+    lo, hi = xyz.min(axis=0), xyz.max(axis=0)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(tuple(np.maximum(hi - lo, 1e-12)))
+    ax.view_init(elev=22, azim=-58)
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    ax.set_title(title or f"deformed body, displacements ×{m:g}", fontsize=10)
+    fig.colorbar(surface, ax=ax, shrink=0.7, label="von Mises stress of the cell")
+    if contact:
+        _contact_zones(fig.add_subplot(1, 2, 2), ds)
+    return fig
+
+
 # -- the contact boundary -----------------------------------------------------------------------
 def _state_spans(ax, x, state):
     """Shade the separated/stick/slip zones: each vertex owns the half edges around it."""
@@ -161,6 +215,18 @@ def _state_spans(ax, x, state):
 
 
 def contact_figure(ds, title: str = "") -> Figure:
+    """Gamma_C of a solution of either dimension: its profiles along the line (2D,
+    :func:`_contact_profiles`) or its zones and slip seen from below (3D, :func:`_contact_zones`)."""
+    if topology_dimension(ds) == 3:
+        fig = Figure(figsize=(6.0, 5.0), layout="constrained")
+        _contact_zones(fig.add_subplot(), ds)
+        if title:
+            fig.suptitle(title, fontsize=11)
+        return fig
+    return _contact_profiles(ds, title)
+
+
+def _contact_profiles(ds, title: str) -> Figure:
     """Along Gamma_C, over the separated/stick/slip zones: the normal pressure; the tangential
     stress with the friction bound ±p_tau; the slip and the penetration; the zones."""
     from vemkit.contact.laws import power_law
@@ -211,6 +277,33 @@ def contact_figure(ds, title: str = "") -> Figure:
     ax.set_xlim(x[0], x[-1])
     fig.suptitle(title or r"contact boundary $\Gamma_C$", fontsize=11)
     return fig
+
+
+def _contact_zones(ax, ds) -> None:
+    """3D: Gamma_C projected on its mean plane's two coordinate axes: states and slip arrows."""
+    xyz = np.stack([ds["contact_x"].values, ds["contact_y"].values, ds["contact_z"].values], axis=1)
+    normal = np.array([ds[f"contact_normal_{a}"].values.mean() for a in "xyz"])
+    keep = [i for i in range(3) if i != int(np.argmax(np.abs(normal)))]
+    names = np.array(["x", "y", "z"])[keep]
+    slip = ds["slip"].values  # (n, 2) in the per-vertex basis
+    t1 = np.stack([ds[f"contact_tangent1_{a}"].values for a in "xyz"], axis=1)
+    t2 = np.stack([ds[f"contact_tangent2_{a}"].values for a in "xyz"], axis=1)
+    p, s = xyz[:, keep], (slip[:, :1] * t1 + slip[:, 1:2] * t2)[:, keep]
+    colors = [STATE_COLORS[k][1] for k in ds["contact_state"].values.astype(int)]
+    ax.scatter(p[:, 0], p[:, 1], c=colors, s=30, edgecolors="0.3", linewidths=0.4).set_zorder(2)
+    moving = np.linalg.norm(s, axis=1) > 0
+    if moving.any():
+        ax.quiver(p[moving, 0], p[moving, 1], s[moving, 0], s[moving, 1], color="k", width=0.003, zorder=3)
+    handles = [
+        Line2D([], [], marker="o", ls="", color=STATE_COLORS[k][1], markeredgecolor="0.3", label=STATE_COLORS[k][0])
+        for k in sorted(STATE_COLORS)
+    ]
+    handles.append(Line2D([], [], color="k", label=r"slip $u_\tau$ (direction, relative length)"))
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel(names[0])
+    ax.set_ylabel(names[1])
+    ax.set_title(r"the contact boundary $\Gamma_C$: states and slip", fontsize=10)
 
 
 # -- convergence ----------------------------------------------------------------------------------

@@ -49,8 +49,8 @@ def solution_space(mesh, ds):
 def solution_node_values(space, ds) -> np.ndarray:
     """(n_nodes, 2) the degrees of freedom of a solution file in ``space``: the vertex values ``u1``,
     ``u2`` and, for the other entities of the element's layout, the means written beside them
-    (``vemkit.io.solution_file.ENTITY_VARIABLES``: k = 2 edge and cell means)."""
-    from vemkit.io.solution_file import ENTITY_VARIABLES
+    (``vemkit.io.solution_fields.ENTITY_VARIABLES``: k = 2 edge and cell means)."""
+    from vemkit.io.solution_fields import ENTITY_VARIABLES
 
     parts = [np.stack([ds["u1"].values, ds["u2"].values], axis=1)]
     for entity in (e for e in space.element.layout if e != "vertex"):

@@ -375,11 +375,11 @@ def records_dataset(records, dims, attrs: dict | None = None):
 def write_solution_vtu(mesh, ds, path) -> None:
     """The solution Dataset ``ds`` (mesh3d) on ``mesh`` as VTK polyhedra: point data displacement
     (n, 3), cell data von_mises and the stress and strain components."""
-    from vemkit.mesh.files3d import write_vtu3d
+    from vemkit.mesh.vtu import write_vtu
 
     u = np.stack([ds[c].values for c in ("u1", "u2", "u3")], axis=1)
     cells = {k: ds[k].values for k in ds.data_vars if k == "von_mises" or k.startswith(("stress_", "strain_"))}
-    write_vtu3d(mesh, path, point_data={"displacement": u}, cell_data=cells)
+    write_vtu(mesh, path, point_data={"displacement": u}, cell_data=cells)
 
 
 def boundary_polygons(mesh, displacement=None, scale: float = 1.0):

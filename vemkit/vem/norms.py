@@ -114,7 +114,7 @@ def error_quadrature(mesh, degree: int = 5):
     """(points (Q, d), weights (Q,), cells (Q,)) for the exact errors: in 2D the degree-``degree``
     rule on a triangulation of every cell; on a 3D mesh (``mesh.dimension == 3``) the signed
     tetrahedral fan of ``k1_3d_fields.cell_quadrature`` with QUADRATURE_POINTS_3D points per direction."""
-    if getattr(mesh, "dimension", 2) == 3:
+    if mesh.dimension == 3:
         from vemkit.vem.elements.k1_3d_fields import cell_quadrature  # the 3D element's own rule
 
         return cell_quadrature(mesh, QUADRATURE_POINTS_3D)

@@ -30,7 +30,7 @@ class VirtualElementSpace:
     def __init__(self, mesh: Mesh, element: Element | int = 1):
         self.mesh = mesh
         if isinstance(element, (int, np.integer)):
-            element = element_for(element, getattr(mesh, "dimension", 2))
+            element = element_for(element, mesh.dimension)
         self.element = element
 
     def __repr__(self) -> str:

@@ -40,7 +40,7 @@ def write_meshes(smk):
     """Rules mesh and mesh_levels: the meshes of one family (one per level) as UGRID netCDF."""
     from vemkit.mesh.checks import validate_mesh
     from vemkit.mesh.families import build_mesh
-    from vemkit.mesh.files import write_ugrid
+    from vemkit.mesh.ugrid import write_ugrid
 
     spec = smk.params.spec
     for n, path in zip(smk.params.levels, smk.output, strict=True):

@@ -15,7 +15,7 @@ with logged(smk):
 
     from vemkit.config.scene import load_scene
     from vemkit.io.solution_file import write_netcdf
-    from vemkit.mesh.files import mesh_to_ugrid_dataset
+    from vemkit.mesh.ugrid import mesh_to_ugrid_dataset
     from vemkit.studies.adaptivity import adapt, adaptive_dataset
     from vemkit.studies.adaptivity_compare import run_settings
     from vemkit.studies.adaptivity_errors import scene_true_error

@@ -7,7 +7,7 @@ smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
     import tempfile
 
-    from vemkit.report.contact3d_figures import hertz_pressure_figure
+    from vemkit.report.contact_benchmark_figures import hertz_pressure_figure
     from vemkit.report.figures import save
     from vemkit.studies.hertz import hertz_run, with_profiles
     from vemkit.studies.three_d import load_scene_data, markdown_table, records_dataset, with_solver

@@ -9,7 +9,7 @@ with logged(smk):
     import tempfile
 
     from vemkit.exceptions import ConvergenceError
-    from vemkit.report.contact3d_figures import mindlin_shear_figure, mindlin_zones_figure
+    from vemkit.report.contact_benchmark_figures import mindlin_shear_figure, mindlin_zones_figure
     from vemkit.report.figures import save
     from vemkit.studies.hertz import with_profiles
     from vemkit.studies.mindlin import C_TOLERANCE, mindlin_run

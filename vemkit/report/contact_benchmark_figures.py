@@ -1,5 +1,6 @@
-"""Figures of the 3D contact benchmarks (issue 21 item 5; ``vemkit.studies.hertz``, ``.mindlin``),
-drawn from the Datasets of results/3d/hertz.nc and mindlin.nc (matplotlib's object API):
+"""Figures of the contact benchmarks against closed forms (Hertz, Cattaneo-Mindlin: ``vemkit.studies.hertz``,
+``.mindlin``), drawn from the Datasets of results/3d/hertz.nc and mindlin.nc (matplotlib's object API);
+the figures of one solution are in :mod:`vemkit.report.figures`:
 
 - :func:`hertz_pressure_figure`: p(r) / p0 against r / a of every mesh with Hertz's
   sqrt(1 - r^2 / a^2) (a, p0 Hertz's at each mesh's measured P);
