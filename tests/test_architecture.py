@@ -148,3 +148,48 @@ def test_the_solvers_never_read_a_contact_laws_parameters():
         if isinstance(node, ast.Attribute) and node.attr.startswith(("k_", "m_"))
     ]
     assert not found, f"the solvers read a law's parameters: {found}"
+
+
+def _import_graph() -> dict:
+    """vemkit module -> the vemkit modules it imports (function-level imports included), each import
+    resolved to the module it names (``vemkit.contact.boundary.rank_one_blocks`` -> its module)."""
+    modules = dict(_modules())
+
+    def resolve(name):
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name
+
+    graph = {}
+    for module, path in modules.items():
+        names = set(_imported(path, module))
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("vemkit.") and not node.level:
+                names.update(f"{node.module}.{a.name}" for a in node.names)
+        graph[module] = {resolve(n) for n in names} - {module, ""}
+    return graph
+
+
+def _cycle_through(graph: dict, start: str) -> list | None:
+    """A path of imports from ``start`` back to itself, or None."""
+    stack, seen = [(start, [start])], set()
+    while stack:
+        module, path = stack.pop()
+        for nxt in graph.get(module, ()):
+            if nxt == start:
+                return path + [start]
+            if nxt not in seen:
+                seen.add(nxt)
+                stack.append((nxt, path + [nxt]))
+    return None
+
+
+@pytest.mark.parametrize("layer", ["contact", "solvers"])
+def test_one_contact_boundary_and_one_solver_stack_for_both_dimensions(layer):
+    """No 3D twin of a module (``*3d*``) in contact/ or solvers/, and no import cycle through them
+    (issue 34: the 3D modules that stood beside the 2D ones imported each other inside functions)."""
+    twins = sorted(str(p.relative_to(PACKAGE)) for p in (PACKAGE / layer).rglob("*3d*"))
+    assert not twins, f"3D twins of modules: {twins}"
+    graph = _import_graph()
+    cycles = [c for m in graph if m.startswith(f"vemkit.{layer}") and (c := _cycle_through(graph, m))]
+    assert not cycles, f"import cycles: {cycles[:3]}"

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from vemkit.config.scene import scene_from_dict
-from vemkit.contact.boundary3d import tangent_basis
+from vemkit.contact.rules import tangent_basis
 from vemkit.contact.problem import scene_problem
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.verification import verify_solution

@@ -1,14 +1,10 @@
 """The discrete contact boundary: Gamma_C contact points with their quadrature weights, normals and gaps.
 
-One contact boundary for every element, built from the space's trace on Gamma_C
-(``vemkit.contact.trace_nodes``): ``nodal`` quadrature (docs/reference/mathematics.md) puts the contact points at the
-trace nodes with the element's nodal rule -- the trapezoid at the Gamma_C vertices for k = 1 (half
-the length of each adjacent contact edge as weight), Simpson's rule at the vertices and edge
-midpoints for k = 2. The outward normal of a vertex is the length-weighted mean of the outward
-normals of its contact edges (exact on straight parts), that of a midpoint its edge's normal; the
-tangent is tau = (-nu_2, nu_1) (on the bottom edge nu = (0, -1), tau = (1, 0)). Clamped points and
-points with every component prescribed are dropped: they belong to the closure of Gamma_D, and their
-displacement is given. A point with only some components prescribed (a symmetry roller meeting
+One contact boundary for every element and both dimensions, built from the space's trace on Gamma_C
+through the rule of its facets (``vemkit.contact.rules``: edges in 2D, faces in 3D; the contact
+points, nodal weights, normals, tangent frames and the facets of the ``gauss`` rule). Clamped points
+and points with every component prescribed are dropped: they belong to the closure of Gamma_D, and
+their displacement is given. A point with only some components prescribed (a symmetry roller meeting
 Gamma_C) stays, with either rule: its prescribed components are fixed dofs (``vemkit.vem.dofs``:
 decoupled rows K_ii u_i = K_ii g_i, so u_i = g_i is what the law reads), no contact force or Jacobian
 entry goes into their rows (the constraint's reaction takes it), and the free components carry the
@@ -17,24 +13,21 @@ free components: wrong wherever a roller met Gamma_C.)
 ``ContactBoundary.vertices`` holds node numbers of the space: a mesh vertex v, or n_vertices + e for the
 midpoint of edge e (k = 2). One class for d = 2 and 3: dofs, normals and coordinates are (n_c, d);
 tangential quantities are (n_c,) in 2D and (n_c, 2) in 3D (components along ``tangent`` = t1 and
-``tangent2`` = t2, ``vemkit.contact.boundary3d``), the friction multiplier a scalar in [-1, 1] or a
-vector in the unit disk (``project``, ``direction``, ``magnitude``).
+``tangent2`` = t2), the friction multiplier a scalar in [-1, 1] or a vector in the unit disk
+(``project``, ``direction``, ``magnitude``).
 
-``gauss`` quadrature (``contact_gauss_points`` N per edge in 2D; for an element with linear traces,
+``gauss`` quadrature (``contact_gauss_points`` N per facet; for an element with linear traces,
 k = 1): the normal-compliance term of (3.16),
 
-    int_{Gamma_C} p_nu(u_nu - g) v_nu ds  =  sum_e sum_q |e| w_q p_nu(t_eq) sum_a phi_a(s_q) v_a . nu_e,
+    int_{Gamma_C} p_nu(u_nu - g) v_nu ds  =  sum_f sum_q |f| w_q p_nu(t_fq) sum_a phi_a(x_q) v_a . nu_f,
 
-with t = u_h . nu_e - g interpolated linearly along each edge e between its two end values
-(phi_a the hat functions of the ends, nu_e the edge normal: the normal of a straight edge, which is
-also the vertex normal of the nodal rule on straight parts), and Gauss-Legendre points s_q,
-weights w_q on [0, 1]. A dropped end keeps its prescribed displacement and its own gap. Its consistent linearization is
-sum_q |e| w_q p_nu'(t_eq) phi_a phi_b nu_e nu_e^T, coupling the two ends of an edge (no longer
-one block per vertex). On a constant penetration along an edge both rules give the same force.
-The same code serves 3D (``vemkit.contact.boundary3d``): the sum runs over the Gamma_C facets f
-(edges, faces) and their Gauss points, sum_f sum_q |f| w_q p_nu(t_fq) sum_a phi_a(x_q) v_a . nu_f,
-with t interpolated from the facet's vertices by the interpolants ``gauss_shape`` (the two hat
-functions on an edge; on a face the linear interpolant of its triangle fan).
+with t = u_h . nu_f - g interpolated from the facet's vertices by the interpolants ``gauss_shape``
+(on an edge the two hat functions, linear along it; on a face the linear interpolant of its triangle
+fan), nu_f the facet normal (the normal of a straight edge is also the vertex normal of the nodal
+rule on straight parts), and the Gauss points x_q, weights w_q of ``vemkit.contact.rules``. A
+dropped vertex keeps its prescribed displacement and its own gap. Its consistent linearization is
+sum_q |f| w_q p_nu'(t_fq) phi_a phi_b nu_f nu_f^T, coupling the vertices of a facet (no longer
+one block per vertex). On a constant penetration along a facet both rules give the same force.
 
 The friction term keeps its nodal multiplier in both cases: sum_c w_c p_tau(u_nu,c - g_c)
 lambda_c tau_c. The multiplier lambda lives at the vertices, |lambda_c| <= 1 is a projection vertex
@@ -52,10 +45,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from vemkit.contact.gaps import FoundationLine, _facet_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
-from vemkit.contact.gauss_rules import gauss_rule
-from vemkit.contact.trace_nodes import contact_edges, midpoint_edges, rule_weights
+from vemkit.contact.rules import FACET_RULES
 from vemkit.exceptions import InputError, SceneError
-from vemkit.mesh.mesh import Mesh, edge_indices
 
 QUADRATURES = ("nodal", "gauss")
 
@@ -268,26 +259,15 @@ class ContactBoundary:
         return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs + 1)[:n_dofs]
 
 
-def edge_ends(mesh: Mesh, edges: np.ndarray, end_weight: float):
-    """(|e|, |e| nu_e, vertex weights, vertex normal sums) of the contact ``edges`` (a, b), nu_e the
-    outward normal (CCW boundary): each end of an edge gets ``end_weight`` |e| (trapezoid 1/2,
-    Simpson 1/6) and |e| nu_e (normalised later: the vertex normal)."""
-    t = mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]]
-    length = np.linalg.norm(t, axis=1)
-    weighted_normal = np.stack([t[:, 1], -t[:, 0]], axis=1)
-    weight = np.zeros(mesh.n_vertices)
-    nsum = np.zeros((mesh.n_vertices, 2))
-    for end in (0, 1):
-        np.add.at(weight, edges[:, end], end_weight * length)
-        np.add.at(nsum, edges[:, end], weighted_normal)
-    return length, weighted_normal, weight, nsum
-
-
 def check_quadrature(space, quadrature: str) -> None:
-    """SceneError unless the quadrature suits the element: ``gauss`` needs linear traces (k = 1)."""
-    if space.element.dimension != 2:
-        return  # 3D: ``vemkit.contact.boundary3d`` (nodal only)
-    if quadrature == "gauss" and rule_weights(space.element)[1] is not None:
+    """SceneError unless the quadrature is known and suits the element: ``gauss`` needs linear traces
+    (no edge nodes, k = 1)."""
+    if quadrature not in QUADRATURES:
+        raise SceneError(
+            f"discretization.contact_quadrature = {quadrature!r}: use nodal or gauss",
+            key="discretization.contact_quadrature",
+        )
+    if quadrature == "gauss" and space.element.layout.get("edge", 0):
         raise SceneError(
             f"discretization.contact_quadrature = {quadrature!r} is not available with "
             f"discretization.order = {space.order} (Simpson's rule at the Gamma_C vertices and edge "
@@ -296,82 +276,58 @@ def check_quadrature(space, quadrature: str) -> None:
         )
 
 
-def contact_nodes(dofs, nodes) -> np.ndarray:
-    """The ``nodes`` that are contact points: they carry unknowns and at least one component without
-    Dirichlet data -- a roller meeting Gamma_C stays, its free components in the law (issue 21)."""
-    d = dofs.dimension
-    count = np.bincount(dofs.free_nodes[dofs.fixed_dofs // d], minlength=dofs.n_nodes)
-    return nodes[(dofs.free_index[nodes] >= 0) & (count[nodes] < d)]
-
-
 def fixed_components(dofs, point_dofs: np.ndarray) -> np.ndarray | None:
     """(n_c, d) bool: the contact dofs that are fixed dofs (a prescribed component); None if none."""
     fixed = np.isin(point_dofs, dofs.fixed_dofs)
     return fixed if fixed.any() else None
 
 
-def _vertex_points(mesh: Mesh, edges: np.ndarray, dofs, end_weight: float):
-    """(vertices, weights, normals, edge data) of the Gamma_C vertices that are contact points."""
-    length, weighted_normal, weight, nsum = edge_ends(mesh, edges, end_weight)
-    verts = contact_nodes(dofs, np.unique(edges))
-    normal = nsum[verts] / np.linalg.norm(nsum[verts], axis=1, keepdims=True)
-    return verts, weight[verts], normal, (length, weighted_normal)
-
-
-def _midpoints(space, parts, edges, dofs, length, weighted_normal, mid_weight):
-    """(nodes, weights, normals, coordinates) of the Gamma_C edge midpoints that are contact points."""
-    mids = midpoint_edges(space, parts, dofs)
-    on_edge = {int(e): k for k, e in enumerate(edge_indices(space.mesh, edges))} if mids.size else {}
-    k_mid = np.array([on_edge[int(e)] for e in mids], dtype=np.int64)
-    normal = weighted_normal[k_mid] / length[k_mid, None]
-    coords = 0.5 * (space.mesh.vertices[edges[k_mid, 0]] + space.mesh.vertices[edges[k_mid, 1]])
-    return space.node_range("edge").start + mids, mid_weight * length[k_mid], normal, coords
-
-
 def contact_boundary(space, parts, dofs, gap, quadrature: str = "nodal", gauss_points: int = 3) -> ContactBoundary:
-    """The contact points of the named boundary ``parts`` of ``space`` (module docstring); ``dofs``
-    must already carry the change of variables of the midpoints (``trace_nodes.midpoint_change``).
-    gap(x, y) -> array, or a FoundationLine."""
-    if space.element.dimension != 2:
-        from vemkit.contact.boundary3d import contact_boundary_3d
-
-        return contact_boundary_3d(space, parts, dofs, gap, quadrature, gauss_points)
+    """The contact points of the named boundary ``parts`` of ``space`` (module docstring), by the rule
+    of its Gamma_C facets (``vemkit.contact.rules``); ``dofs`` must already carry the change of
+    variables of the midpoints (``trace_nodes.midpoint_change``). gap(x, ...) -> array, or a
+    FoundationLine."""
     check_quadrature(space, quadrature)
-    mesh = space.mesh
-    edges = contact_edges(mesh, parts)
-    w_end, w_mid = rule_weights(space.element)
-    verts, weight, normal, (length, weighted_normal) = _vertex_points(mesh, edges, dofs, w_end)
-    coords = mesh.vertices[verts]
-    if w_mid is not None:
-        mid, mid_w, mid_normal, mid_coords = _midpoints(space, parts, edges, dofs, length, weighted_normal, w_mid)
-        verts, weight = np.concatenate([verts, mid]), np.concatenate([weight, mid_w])
-        normal = np.concatenate([normal, mid_normal]).reshape(-1, 2)
-        coords = np.concatenate([coords, mid_coords]).reshape(-1, 2)
-    tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
-    free = dofs.free_index[verts]
-    g = _gap_values(gap, coords, normal)
-    point_dofs = np.stack([2 * free, 2 * free + 1], axis=1).reshape(-1, 2)
-    fixed = fixed_components(dofs, point_dofs)
-    if w_mid is not None:  # the Gauss option needs linear traces: no edge data
-        return ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed)
-    return _with_edges(
-        ContactBoundary(verts, point_dofs, weight, normal, tangent, g, coords, quadrature, fixed=fixed),
-        mesh,
-        edges,
-        dofs,
-        gap,
-        length,
-        weighted_normal,
-        gauss_points,
+    rule = FACET_RULES[space.mesh.dimension]
+    nodes, weight, normal, coords = rule.points(space, parts, dofs)
+    tangents = rule.tangents(normal)
+    d = normal.shape[1]
+    point_dofs = (d * dofs.free_index[nodes][:, None] + np.arange(d)[None, :]).reshape(-1, d)
+    cb = ContactBoundary(
+        nodes,
+        point_dofs,
+        weight,
+        normal,
+        tangents[0],
+        _gap_values(gap, coords, normal),
+        coords,
+        quadrature,
+        fixed=fixed_components(dofs, point_dofs),
+        **dict(zip(("tangent2",), tangents[1:])),
     )
+    if quadrature == "nodal":
+        return cb
+    facet_nodes, facet_normal, gauss_weight, gauss_shape = rule.gauss(space, parts, gauss_points)
+    return with_facets(cb, space.mesh, facet_nodes, facet_normal, dofs, gap, gauss_weight, gauss_shape)
 
 
-def _with_edges(cb: ContactBoundary, mesh: Mesh, edges, dofs, gap, length, weighted_normal, gauss_points):
-    """The boundary with its Gamma_C edges as the facets of the ``gauss`` rule (the hat functions of
-    the two ends at the Gauss-Legendre points)."""
-    s, w = gauss_rule(gauss_points) if cb.quadrature == "gauss" else (np.zeros(0), np.zeros(0))
-    shape = np.broadcast_to(np.stack([1.0 - s, s], axis=1), (edges.shape[0], s.size, 2))
-    return with_facets(cb, mesh, edges, weighted_normal / length[:, None], dofs, gap, length[:, None] * w, shape)
+def normals_in_roller_planes(cb: ContactBoundary, gap) -> ContactBoundary:
+    """``cb`` with the normal of every vertex that has prescribed components (a symmetry roller, e.g.
+    u1 = 0 on the plane x = 0) put into the roller's plane: those components of nu set to zero,
+    renormalized, the tangent basis and the gap (``gap``: a callable or FoundationLine) rebuilt.
+
+    The area-weighted normal of a vertex on x = 0 sees the Gamma_C faces on one side only and tilts
+    out of the plane, while the whole symmetric body's normal lies in it; with the roller a stick
+    vertex is then pinned and a sliding one cannot follow its slip direction (the held component's
+    friction force is the constraint's), so ssn's slip-direction test stalls (measured: 4e-4 on the
+    Hertz half sphere). Only for rollers on symmetry planes: a vertex held for another reason keeps
+    the normal of its faces when this is not called."""
+    if cb.fixed is None or not np.any(cb.fixed):
+        return cb
+    normal = np.where(cb.fixed, 0.0, cb.normal)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    tangents = FACET_RULES[cb.dimension].tangents(normal)
+    return replace(cb, normal=normal, tangent=tangents[0], **dict(zip(("tangent2",), tangents[1:]))).with_gap(gap)
 
 
 def with_facets(cb: ContactBoundary, mesh, facet_nodes, facet_normal, dofs, gap, gauss_weight, gauss_shape):

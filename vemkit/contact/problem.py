@@ -207,8 +207,8 @@ def discrete_problem(
         interior = interior_load(space, full_load)
     else:
         f, interior = dofs.restrict(full_load), None
-    if space.element.dimension == 2:  # the k = 2 Gamma_C midpoints (3D bodies: k = 1 only)
-        dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
+    # the Gamma_C edge nodes (k = 2 midpoints) as unknowns; none for an element without edge nodes
+    dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
     K, f = change_variables(K, f, dofs.change)
     K, f = apply_fixed_dofs(K, f, dofs)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)

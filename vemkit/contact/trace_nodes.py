@@ -52,9 +52,12 @@ def rule_weights(element) -> tuple[float, float | None]:
 
 def midpoint_edges(space, parts, dofs) -> np.ndarray:
     """Indices (in ``mesh.edges``) of the Gamma_C edges whose edge node is a contact point: both
-    components unknown (no Dirichlet data on the edge), sorted; none for an element without edge nodes."""
+    components unknown (no Dirichlet data on the edge), sorted; none for an element without edge nodes
+    (k = 1, the 3D element): the element's layout says whether its facets carry nodes."""
+    if not space.element.layout.get("edge", 0):
+        return np.zeros(0, np.int64)
     edges = contact_edges(space.mesh, parts)
-    if edges.size == 0 or rule_weights(space.element)[1] is None:
+    if edges.size == 0:
         return np.zeros(0, np.int64)
     index = np.unique(edge_indices(space.mesh, edges))
     return index[dofs.unconstrained_nodes()[space.node_range("edge").start + index]]

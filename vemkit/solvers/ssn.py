@@ -81,6 +81,7 @@ from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import ReducedSolver, linear_solver
 from vemkit.solvers.solution import ContactSolution, contact_residual, history_arrays, relative_slip
+from vemkit.solvers.ssn_disk import aligned_multiplier, coupled_gamma, disk_direction, final_multiplier
 from vemkit.solvers.ssn_failures import CONTRAST_WARNING, fail
 from vemkit.solvers.ssn_point import Point, converged, energy_slope, evaluate
 from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, tangential_diagonal
@@ -172,8 +173,6 @@ def solve_ssn(
             point = evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
         point = _newton_iteration(newton, point, k)
         if cb.dimension == 3 and not converged(newton, point):
-            from vemkit.solvers.ssn_disk import aligned_multiplier
-
             lam = aligned_multiplier(newton, point)  # the slip direction, when only it is left
             point = point if lam is None else evaluate(newton, point.u, lam)
         if progress is not None:
@@ -228,8 +227,6 @@ def _returned_multiplier(newton, point):
     """(lambda, its move) of a converged point; 3D: in the disk and along the slip (ssn_disk.final_multiplier)."""
     if newton.problem.contact.dimension != 3:
         return point.lam, 0.0
-    from vemkit.solvers.ssn_disk import final_multiplier
-
     return final_multiplier(newton, point)
 
 
@@ -269,8 +266,6 @@ def _prepare(newton, t):
     b_ref = k_tau if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else k_tau)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
     if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
-        from vemkit.solvers.ssn_disk import coupled_gamma
-
         newton.gamma = coupled_gamma(newton.kd_tau, cb.weight, b_lin, newton.b_ref)
     else:
         newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
@@ -355,8 +350,6 @@ def _newton_direction(newton, point, k):
     lam = point.lam
     bound, frictional, slip, stick, changes = sets = _active_sets(newton, point)
     if cb.dimension == 3:  # Coulomb in the unit disk (vemkit.solvers.ssn_disk)
-        from vemkit.solvers.ssn_disk import disk_direction
-
         return disk_direction(newton, point, k, sets, _solve_newton_system)
     sign = np.sign(point.q)
     stick_shift = cb.scatter(zero, np.where(stick, -point.slip, 0.0), n)

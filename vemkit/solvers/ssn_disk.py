@@ -2,7 +2,7 @@
 
 The complementarity function is that of 2D, C = lambda - P(q), q = lambda + gamma u_tau, with P the
 projection onto the unit disk of the tangent plane (lambda, u_tau: two components in the vertex
-basis (t1, t2), ``vemkit.contact.boundary3d``); the contact problem (5.2)-(5.3) with the reduced law
+basis (t1, t2), ``vemkit.contact.rules``); the contact problem (5.2)-(5.3) with the reduced law
 (m_tau = 0 or k_tau = 0, the friction bound b = p_tau independent of u; for m_tau > 0 the Jacobian
 also holds w p_tau'(t) (t1, t2) lambda_hat nu^T, lambda_hat the new multiplier's part that does not
 depend on du, and is unsymmetric, as in 2D). Generalized Newton on
@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.contact.boundary import rank_one_blocks
+from vemkit.solvers.ssn_point import complementarity_weight
 from vemkit.solvers.ssn_steps import disk_slip_step, stick_basis, stick_multiplier, stick_shift
 
 STICK_PENALTY = 1e3  # as vemkit.solvers.ssn: penalty on stick tangents in a rebuilt AMG hierarchy
@@ -93,24 +94,6 @@ def disk_direction(newton, point, k, sets, solve):
     return du, lam_new, its, changes
 
 
-def disk_alignment(newton, point) -> float:
-    """||w b (lambda - u_tau/|u_tau|)|| / scale over the sliding vertices (|q| > 1, |u_tau| > tol max|u|).
-
-    Part of the convergence test in 3D: there C = lambda - P(q) measures the direction of lambda only
-    through q = lambda + gamma u_tau, i.e. damped by gamma |u_tau| / (1 + gamma |u_tau|), which is tiny
-    at a vertex that barely slides (measured: C ~ 1e-3 x the direction error on a Voronoi box); the
-    slip direction (2.8) itself is asked for to tol, as the independent check does."""
-    cb = newton.problem.contact
-    # sliding as the independent check has it (|u_tau| > tol max|u|): a stick vertex's slip of
-    # rounding size (u_tau - u_tau^ref after a stick step) has no direction to follow
-    moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
-    sliding = (cb.magnitude(point.q) > 1.0) & moving
-    miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
-    from vemkit.solvers.ssn_point import complementarity_weight
-
-    return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale
-
-
 def aligned_multiplier(newton, point):
     """lambda = u_tau / |u_tau| at the sliding vertices (disk_alignment's), once the merit is
     converged and only the slip direction (2.8) is not; else None.
@@ -149,8 +132,6 @@ def final_multiplier(newton, point):
     P(lambda) is no farther from lambda than P(q) is, and the sliding vertices' change is
     disk_alignment's miss (a vertex of the stick set that moves by more than tol max|u| -- its state
     changed in the last step -- may move more, hence the measure)."""
-    from vemkit.solvers.ssn_point import complementarity_weight
-
     cb = newton.problem.contact
     lam = _slip_directions(newton, point, cb.project(point.lam), every=True)
     move = complementarity_weight(newton, point.t) * cb.magnitude(lam - point.lam)

@@ -25,8 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vemkit.contact.boundary import FoundationLine
-from vemkit.contact.boundary3d import normals_in_roller_planes
+from vemkit.contact.boundary import FoundationLine, normals_in_roller_planes
 from vemkit.mesh.polyhedral_build import csr_rows
 from vemkit.solvers.solution import contact_state
 

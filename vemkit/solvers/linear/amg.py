@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import LinearSolveError
 from vemkit.solvers.linear.base import LinearSolver, NewtonSystems, reduced_right_hand_side, three_d
 from vemkit.solvers.linear.cycle import CYCLE_PRECISION, v_cycle_preconditioner
@@ -172,8 +173,6 @@ class AMGNewtonSystems(NewtonSystems):
         # 3D: the hierarchy of K follows every step's K + J + stick penalty (vemkit.solvers.amg_update)
         self.updated = None
         if problem.contact.dimension == 3:
-            from vemkit.contact.boundary import rank_one_blocks
-
             cb, ones = problem.contact, np.ones(problem.contact.normal.shape)
             support = rank_one_blocks(cb, np.ones(cb.size), ones, problem.n_dofs)  # every contact block
             self.updated = base.boundary_updated_hierarchy(support)
