@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from vemkit.config.scene import scene_from_dict
-from vemkit.contact.rules import tangent_basis
 from vemkit.contact.problem import scene_problem
+from vemkit.contact.rules import tangent_basis
 from vemkit.solvers.dispatch import solve
 from vemkit.solvers.verification import verify_solution
 

@@ -195,7 +195,7 @@ def test_manufactured_contact_solutions_converge_at_second_order(case):
     assert errors2[-1] < 0.1 * errors1[-1]
     cb = problem.contact
     inside = cb.coords[:, 0] < 1.0 - 1e-12
-    np.testing.assert_allclose(solution.multiplier[inside], multiplier(cb.coords[inside, 0]), atol=0.02)
+    np.testing.assert_allclose(solution.multiplier[inside, 0], multiplier(cb.coords[inside, 0]), atol=0.02)
 
 
 # -- scenes ------------------------------------------------------------------------------------------

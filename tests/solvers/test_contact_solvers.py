@@ -90,7 +90,8 @@ def relative_difference(a, b):
 def assert_coulomb(problem, solution, slip_tol=1e-8):
     """(2.6)-(2.9) vertexwise, from the derived quantities of contact_state."""
     state = contact_state(problem, solution.u, solution.multiplier, tol=slip_tol)
-    bound, stress, slip = state.friction_bound, state.tangential_stress, state.slip
+    # tangential quantities are (n_c, d - 1): the one component of a plane body
+    bound, stress, slip = state.friction_bound, state.tangential_stress[:, 0], state.slip[:, 0]
     scale = np.max(np.abs(solution.u))
     assert np.all(state.normal_pressure >= 0.0)
     assert np.allclose(state.normal_pressure, problem.law.normal_pressure(state.penetration))

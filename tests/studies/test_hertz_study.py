@@ -11,8 +11,7 @@ import pytest
 import yaml
 
 from vemkit.config.scene import scene_from_dict
-from vemkit.contact.boundary import FoundationLine
-from vemkit.contact.boundary import normals_in_roller_planes
+from vemkit.contact.boundary import FoundationLine, normals_in_roller_planes
 from vemkit.contact.problem import scene_problem
 from vemkit.studies.hertz import hertz_run, positive_area, with_profiles
 from vemkit.studies.three_d import records_dataset

@@ -12,9 +12,9 @@ law. (Until issue 21's 3D Gauss rule the ``gauss`` rule dropped such a point and
 free components: wrong wherever a roller met Gamma_C.)
 ``ContactBoundary.vertices`` holds node numbers of the space: a mesh vertex v, or n_vertices + e for the
 midpoint of edge e (k = 2). One class for d = 2 and 3: dofs, normals and coordinates are (n_c, d);
-tangential quantities are (n_c,) in 2D and (n_c, 2) in 3D (components along ``tangent`` = t1 and
-``tangent2`` = t2), the friction multiplier a scalar in [-1, 1] or a vector in the unit disk
-(``project``, ``direction``, ``magnitude``).
+tangential quantities are (n_c, d - 1): their components along the tangent basis ``tangents``
+(``tangent`` = tau in 2D; ``tangent`` = t1 and ``tangent2`` = t2 in 3D), the friction multiplier in
+the unit ball of R^(d-1) (``vemkit.contact.ball``: [-1, 1] in 2D, the unit disk in 3D).
 
 ``gauss`` quadrature (``contact_gauss_points`` N per facet; for an element with linear traces,
 k = 1): the normal-compliance term of (3.16),
@@ -44,6 +44,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.contact import ball
 from vemkit.contact.gaps import FoundationLine, _facet_gaps, _gap_values  # noqa: F401 (FoundationLine re-exported)
 from vemkit.contact.rules import FACET_RULES
 from vemkit.exceptions import InputError, SceneError
@@ -117,8 +118,8 @@ class ContactBoundary:
 
     @property
     def tangents(self) -> list:
-        """The tangent basis per point: [tau] in 2D, [t1, t2] in 3D."""
-        return [self.tangent] if self.dimension == 2 else [self.tangent, self.tangent2]
+        """The tangent basis per point, d - 1 vectors (n_c, d): [tau] in 2D, [t1, t2] in 3D."""
+        return [self.tangent, self.tangent2][: self.dimension - 1]
 
     def _along(self, u, direction):
         """sum_i u[dofs_i] direction_i per contact point."""
@@ -129,63 +130,50 @@ class ContactBoundary:
         return self._along(u, self.normal)
 
     def tangential_displacement(self, u):
-        """u_tau at the contact vertices: a scalar in 2D, (n_c, 2) in the basis (t1, t2) in 3D."""
-        if self.dimension == 2:
-            return self._along(u, self.tangent)
+        """u_tau at the contact vertices, (n_c, d - 1): its components along the tangent basis."""
         return np.stack([self._along(u, t) for t in self.tangents], axis=1)
 
     def scatter(self, normal_part, tangential_part, n_dofs):
         """Free-dof vector of sum_c (normal_part_c nu_c + tangential_part_c . (t1, t2)_c); nothing
-        into the prescribed components."""
+        into the prescribed components. ``tangential_part``: (n_c, d - 1)."""
         out = np.zeros(n_dofs)
-        tangential_part = np.asarray(tangential_part, dtype=float)
+        tangential_part = self.tangential(tangential_part)
         for i in range(self.dofs.shape[1]):
-            if self.dimension == 2:
-                value = normal_part * self.normal[:, i] + tangential_part * self.tangent[:, i]
-            else:
-                value = (
-                    normal_part * self.normal[:, i]
-                    + tangential_part[:, 0] * self.tangent[:, i]
-                    + tangential_part[:, 1] * self.tangent2[:, i]
-                )
+            value = normal_part * self.normal[:, i]
+            for k, t in enumerate(self.tangents):
+                value = value + tangential_part[:, k] * t[:, i]
             if self.fixed is not None:
                 value = np.where(self.fixed[:, i], 0.0, value)
             np.add.at(out, self.dofs[:, i], value)
         return out
 
-    # -- the friction multiplier: a scalar in [-1, 1] (2D), a vector in the unit disk (3D) ------------
+    # -- tangential quantities: (n_c, d - 1), the multiplier in the unit ball (vemkit.contact.ball) --------
     def zero_multiplier(self) -> np.ndarray:
-        return np.zeros(self.size) if self.dimension == 2 else np.zeros((self.size, 2))
+        return np.zeros((self.size, self.dimension - 1))
+
+    def tangential(self, values) -> np.ndarray:
+        """``values`` as tangential quantities (n, d - 1) (a 2D one given as (n,) gets its column)."""
+        return np.asarray(values, dtype=float).reshape(-1, self.dimension - 1)
 
     def project(self, lam) -> np.ndarray:
-        """P: the projection onto [-1, 1] (2D) or onto the unit disk (3D), point by point (5.5)."""
-        lam = np.asarray(lam, dtype=float)
-        if self.dimension == 2:
-            return np.clip(lam, -1.0, 1.0)
-        return lam / np.maximum(np.linalg.norm(lam, axis=1), 1.0)[:, None]
+        """P: the projection onto the unit ball of R^(d-1), point by point (5.5)."""
+        return ball.project(self.tangential(lam))
 
     def magnitude(self, tangential) -> np.ndarray:
-        """|x| of tangential quantities: abs in 2D, the Euclidean norm of the two components in 3D."""
-        tangential = np.asarray(tangential, dtype=float)
-        return np.abs(tangential) if self.dimension == 2 else np.linalg.norm(tangential, axis=1)
+        """|x| of tangential quantities (``vemkit.contact.ball.norm``)."""
+        return ball.norm(self.tangential(tangential))
 
     def direction(self, tangential) -> np.ndarray:
-        """x / |x| (0 where x = 0): sign in 2D, the unit vector in the tangent plane in 3D."""
-        tangential = np.asarray(tangential, dtype=float)
-        if self.dimension == 2:
-            return np.sign(tangential)
-        size = np.linalg.norm(tangential, axis=1)
-        return np.where(size[:, None] > 0.0, tangential / np.where(size > 0.0, size, 1.0)[:, None], 0.0)
+        """x / |x| (0 where x = 0)."""
+        return ball.direction(self.tangential(tangential))
 
     def dot(self, a, b) -> np.ndarray:
-        """a_c . b_c of two tangential quantities (a product in 2D)."""
-        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-        return a * b if self.dimension == 2 else np.sum(a * b, axis=1)
+        """a_c . b_c of two tangential quantities."""
+        return ball.dot(self.tangential(a), self.tangential(b))
 
     def times(self, scalar, tangential) -> np.ndarray:
-        """scalar_c x_c for tangential quantities x (broadcast over the 3D components)."""
-        tangential = np.asarray(tangential, dtype=float)
-        return scalar * tangential if tangential.ndim == 1 else np.asarray(scalar)[:, None] * tangential
+        """scalar_c x_c for tangential quantities x."""
+        return ball.times(scalar, self.tangential(tangential))
 
     def with_gap(self, gap) -> "ContactBoundary":
         """This boundary with another gap, gap(x, y) -> array or a FoundationLine (at the vertices and

@@ -13,7 +13,8 @@ per-vertex tangent basis t1 = e x nu / |e x nu|, e the axis least aligned with n
   ``contact_vertex``, ``contact_weight``, the pressures, bounds and displacements of
   :func:`vemkit.solvers.solution.contact_state`, ``contact_state`` (0 separated, 1 stick, 2 slip);
   a 3D tangential quantity has the dimensions (``contact_node``, ``contact_tangent``): its
-  components along t1 and t2 (the global attribute ``contact_tangent_basis`` says so);
+  components along t1 and t2 (the global attribute ``contact_tangent_basis`` says so); a 2D one,
+  (n_c, 1) in memory (``vemkit.contact.ball``), is the 1-D variable along tau (``as_written``);
 - k = 2 (2D): the edge and cell means ``u1_edge_mean`` ... (``ENTITY_VARIABLES``) and the contact
   points that are edge midpoints (``contact_edge``).
 """
@@ -132,6 +133,14 @@ def add_cell_fields(ds: FileDescription, topology: MeshTopology, problem, soluti
     ds.add(name, where, names.cell_scalar_of(sigma, problem), dict(cell, long_name=long_name, units="daN/mm2"))
 
 
+def as_written(values) -> np.ndarray:
+    """Contact-node values as the files hold them: a tangential quantity of a plane body (one
+    component, (n_c, 1)) as the 1-D variable of the file contract; (n_c, 2) in 3D and scalars as
+    they are. The one place where 2D's tangential column is squeezed."""
+    data = np.asarray(values, dtype=float)
+    return data[:, 0] if data.ndim == 2 and data.shape[1] == 1 else data
+
+
 def add_contact(ds: FileDescription, topology: MeshTopology, problem, solution) -> None:
     """The contact node variables (module docstring), sorted by the contact points' coordinates."""
     names = FIELD_NAMES[topology.dimension]
@@ -154,7 +163,7 @@ def add_contact(ds: FileDescription, topology: MeshTopology, problem, solution) 
         "penetration": st.penetration,
     }
     for name, long_name, units in names.contact_variables:
-        data = np.asarray(values[name], dtype=float)[order]
+        data = as_written(values[name])[order]
         dims = (c,) if data.ndim == 1 else (c, "contact_tangent")
         ds.add(name, dims, data, {"long_name": long_name, "units": units})
     for name, attribute in names.contact_frame:

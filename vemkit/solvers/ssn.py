@@ -84,7 +84,7 @@ from vemkit.solvers.solution import ContactSolution, contact_residual, history_a
 from vemkit.solvers.ssn_disk import aligned_multiplier, coupled_gamma, disk_direction, final_multiplier
 from vemkit.solvers.ssn_failures import CONTRAST_WARNING, fail
 from vemkit.solvers.ssn_point import Point, converged, energy_slope, evaluate
-from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, tangential_diagonal
+from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, stick_shift, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 # gamma = GAMMA_FACTOR[d] kd / (L_C h^(d-2) b_ref), see the module docstring; in 3D 0.1 keeps the
@@ -155,8 +155,8 @@ def solve_ssn(
         return _plain_solution(newton, u)
     _prepare(newton, t)
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
-    if cb.dimension == 2:
-        trial = newton.kd_tau * relative_slip(cb, u, slip_reference) / (cb.weight * newton.b_ref)
+    if cb.dimension == 2:  # (kd u_tau) / (w b_ref): the 2D order of the operations, kept bit for bit
+        trial = cb.times(newton.kd_tau, relative_slip(cb, u, slip_reference)) / (cb.weight * newton.b_ref)[:, None]
     else:
         trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), relative_slip(cb, u, slip_reference))
     point = evaluate(newton, u, cb.project(trial))
@@ -351,10 +351,10 @@ def _newton_direction(newton, point, k):
     bound, frictional, slip, stick, changes = sets = _active_sets(newton, point)
     if cb.dimension == 3:  # Coulomb in the unit disk (vemkit.solvers.ssn_disk)
         return disk_direction(newton, point, k, sets, _solve_newton_system)
-    sign = np.sign(point.q)
-    stick_shift = cb.scatter(zero, np.where(stick, -point.slip, 0.0), n)
-    friction_now = cb.scatter(zero, cb.weight * bound * lam, n)
-    slip_force = cb.scatter(zero, np.where(slip, cb.weight * bound * sign, 0.0), n)
+    sign = np.sign(point.q)  # (n_c, 1)
+    shift = stick_shift(cb, stick, point.slip, n)
+    friction_now = cb.scatter(zero, cb.times(cb.weight * bound, lam), n)
+    slip_force = cb.scatter(zero, np.where(slip[:, None], cb.times(cb.weight * bound, sign), 0.0), n)
     Z = stick_basis(cb, np.flatnonzero(stick), n) if np.any(stick) else None
 
     def penalty():  # for a rebuilt AMG hierarchy: stick tangents nearly clamped
@@ -364,19 +364,19 @@ def _newton_direction(newton, point, k):
     J = cb.normal_jacobian(point.u, law, newton.stiffness_cap)
     slope_blocks = None
     if not law.reduced:
-        lam_hat = np.where(slip, sign, np.where(stick, lam, 0.0))
+        lam_hat = np.where(slip, sign[:, 0], np.where(stick, lam[:, 0], 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
         slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
     # direct: K + J (+ slope) formed as it always was; AMG: K x + J x, no copy of K's values
     A = newton.reduced.operator(K, J) if slope_blocks is None else newton.reduced.operator(K, J, slope_blocks)
-    rhs = -(point.R - friction_now) - A @ stick_shift - slip_force
+    rhs = -(point.R - friction_now) - A @ shift - slip_force
     correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
-    du = stick_shift + correction
+    du = shift + correction
     stick_force = cb.tangential_displacement(rhs - A @ correction)
-    lam_new = np.where(slip, sign, lam)
-    lam_new = np.where(stick, stick_force / (cb.weight * np.where(stick, bound, 1.0)), lam_new)
+    lam_new = np.where(slip[:, None], sign, lam)
+    lam_new = np.where(stick[:, None], stick_force / (cb.weight * np.where(stick, bound, 1.0))[:, None], lam_new)
     slip_new = point.slip + cb.tangential_displacement(du)
-    lam_new = np.where(frictional, lam_new, np.where(slip_new != 0.0, np.sign(slip_new), lam))
+    lam_new = np.where(frictional[:, None], lam_new, np.where(slip_new != 0.0, np.sign(slip_new), lam))
     return du, lam_new, its, changes
 
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vemkit.contact import ball
 from vemkit.solvers.solution import relative_slip, residual_scale
 from vemkit.solvers.sparse_ops import abs_matvec
 
@@ -45,7 +46,7 @@ def evaluate(newton, u, lam) -> Point:
     q = lam + cb.times(newton.gamma, slip)
     C = cb.times(complementarity_weight(newton, t), lam - cb.project(q))
     scale = residual_scale(newton.f_norm, float(np.linalg.norm(normal_force + friction_force)))
-    point = Point(u, lam, t, slip, gradient, R, q, float(R @ R + (C @ C if C.ndim == 1 else np.sum(C * C))), scale)
+    point = Point(u, lam, t, slip, gradient, R, q, float(R @ R + ball.inner(C, C)), scale)
     if newton.energy_merit:
         friction = law.friction_coefficient * (cb.weight @ cb.magnitude(slip))
         point.energy = float(0.5 * (u @ Ku) - f @ u + cb.normal_energy(u, law) + friction)

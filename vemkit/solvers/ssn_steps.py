@@ -38,25 +38,10 @@ def tangential_diagonal(K, cb):
 
 def stick_basis(cb, stick, n):
     """Orthonormal Z (n x (n - (d - 1)|stick|)) spanning {v : t . v_c = 0 for every tangent t of the
-    stick vertices c}: v_c = a nu_c there (the column of the vertex's first dof)."""
-    if cb.dimension == 3:
-        return _stick_basis_3d(cb, stick, n)
-    first, second = cb.dofs[stick, 0], cb.dofs[stick, 1]
-    keep = np.ones(n, dtype=bool)
-    keep[second] = False
-    column = np.cumsum(keep) - 1
-    rows = np.flatnonzero(keep)
-    vals = np.ones(rows.size)
-    vals[column[first]] = cb.normal[stick, 0]
-    rows = np.concatenate([rows, second])
-    cols = np.concatenate([np.arange(vals.size), column[first]])
-    vals = np.concatenate([vals, cb.normal[stick, 1]])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, int(keep.sum())))
-
-
-def _stick_basis_3d(cb, stick, n):
+    stick vertices c}: v_c = a nu_c there (the column of the vertex's first dof); a held stick vertex
+    (``_held``) gets the null space of its constraints on its unprescribed components."""
     first, others = cb.dofs[stick, 0], cb.dofs[stick, 1:]
-    held = np.zeros(stick.size, dtype=bool) if cb.fixed is None else cb.fixed[stick].any(axis=1)
+    held = np.isin(stick, _held(cb, np.isin(np.arange(cb.size), stick)))
     keep = np.ones(n, dtype=bool)
     keep[others.ravel()] = False
     keep[first[held]] = False  # a held stick vertex: its columns are those of held_stick_moves
@@ -66,13 +51,13 @@ def _stick_basis_3d(cb, stick, n):
     free = ~held
     vals[column[first[free]]] = cb.normal[stick[free], 0]
     rows = np.concatenate([rows, others[free].ravel()])
-    cols = np.concatenate([np.arange(vals.size), np.repeat(column[first[free]], 2)])
+    cols = np.concatenate([np.arange(vals.size), np.repeat(column[first[free]], others.shape[1])])
     vals = np.concatenate([vals, cb.normal[stick[free], 1:].ravel()])
     width = int(keep.sum())
     for c in stick[held]:  # the null space of the stick constraints on the unprescribed components
         for direction in held_stick_moves(cb, c)[1]:
             rows = np.concatenate([rows, cb.dofs[c]])
-            cols = np.concatenate([cols, np.full(3, width)])
+            cols = np.concatenate([cols, np.full(cb.dofs.shape[1], width)])
             vals = np.concatenate([vals, direction])
             width += 1
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, width))
@@ -105,8 +90,7 @@ def stick_shift(cb, stick_mask, slip, n):
     there): -(s1 t1 + s2 t2) (-s tau in 2D), or held_stick_moves' v at a vertex with a prescribed
     component."""
     zero = np.zeros(cb.size)
-    mask = stick_mask if cb.dimension == 2 else stick_mask[:, None]
-    shift = cb.scatter(zero, np.where(mask, -slip, 0.0), n)
+    shift = cb.scatter(zero, np.where(stick_mask[:, None], -slip, 0.0), n)
     for c in _held(cb, stick_mask):
         shift[cb.dofs[c]] = held_stick_moves(cb, c, slip[c])[0]
     return shift
@@ -128,6 +112,10 @@ def stick_multiplier(cb, stick_mask, reaction, scale):
 
 
 def _held(cb, stick_mask):
+    """The stick vertices with a prescribed component whose stick constraints are solved on the
+    unprescribed ones (``held_stick_moves``): in 3D only -- in 2D the one constraint tau . v = 0 is
+    the column nu_c of ``stick_basis``, which leaves a roller's held component alone wherever
+    tau is along it."""
     if cb.dimension == 2 or cb.fixed is None:
         return np.zeros(0, np.int64)
     return np.flatnonzero(stick_mask & cb.fixed.any(axis=1))

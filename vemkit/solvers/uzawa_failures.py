@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vemkit.contact import ball
 from vemkit.exceptions import ConvergenceError
 from vemkit.solvers.solution import young_modulus
 
@@ -19,25 +20,26 @@ def boundary_compliance(solver, problem, direction, iterations=20, rtol=1e-3):
     cb = problem.contact
     sqrt_w = np.sqrt(cb.weight)
     zero = np.zeros(cb.size)
+    tangent = direction == "tangent"
     v = sqrt_w / np.linalg.norm(sqrt_w)
-    if direction == "tangent" and cb.dimension == 3:
+    v = v[:, None] if tangent else v  # 2D: the one tangential component
+    if tangent and cb.dimension == 3:
         # both tangents of every vertex, from a seeded random start: a symmetric start misses the
         # twisting modes (measured on a pressed box: the largest one, then unstable at rho's default)
         v = np.random.default_rng(0).standard_normal((cb.size, 2)) * sqrt_w[:, None]
         v /= np.linalg.norm(v)
     estimate, solves = 0.0, 0
     for _ in range(iterations):
-        load = cb.times(sqrt_w, v)
+        load = cb.times(sqrt_w, v) if tangent else sqrt_w * v
         rhs = (
             cb.scatter(zero, load, problem.n_dofs)
-            if direction == "tangent"
+            if tangent
             else cb.scatter(load, cb.zero_multiplier(), problem.n_dofs)
         )
         x = solver.solve(rhs, tol=1e-6)
         solves += max(solver.iterations, 1)
-        comp = cb.tangential_displacement(x) if direction == "tangent" else cb.normal_displacement(x)
-        Sv = cb.times(sqrt_w, comp)
-        new = float(v @ Sv) if v.ndim == 1 else float(np.sum(v * Sv))
+        Sv = cb.times(sqrt_w, cb.tangential_displacement(x)) if tangent else sqrt_w * cb.normal_displacement(x)
+        new = ball.inner(v, Sv) if tangent else float(v @ Sv)
         norm = np.linalg.norm(Sv)
         if norm == 0.0:
             return 0.0, solves

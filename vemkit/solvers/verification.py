@@ -120,11 +120,7 @@ def verify_solution(problem, u, multiplier, tol: float = DEFAULT_CHECK_TOL, slip
         if cb.fixed is not None:  # a prescribed component's reaction is the constraint's
             r = np.where(cb.fixed, 0.0, r)
         r_nu = np.sum(r * cb.normal, axis=1)
-        r_tau = (
-            np.sum(r * cb.tangent, axis=1)
-            if cb.dimension == 2
-            else np.stack([np.sum(r * t, axis=1) for t in cb.tangents], axis=1)
-        )
+        r_tau = np.stack([np.sum(r * t, axis=1) for t in cb.tangents], axis=1)  # (n_c, d - 1)
         scale = residual_scale(float(np.linalg.norm(f)), float(np.linalg.norm(contact_force_vector(problem, u, lam))))
         t = cb.normal_displacement(u) - cb.gap
         slip = relative_slip(cb, u, slip_reference)

@@ -95,7 +95,7 @@ def contact_tractions(problem, solution) -> dict:
         return {}
     state = contact_state(problem, solution.u, solution.multiplier)
     at_nodes = np.zeros((problem.space.n_nodes, 2))
-    at_nodes[cb.vertices] = -state.normal_pressure[:, None] * cb.normal + state.tangential_stress[:, None] * cb.tangent
+    at_nodes[cb.vertices] = -state.normal_pressure[:, None] * cb.normal + state.tangential_stress[:, :1] * cb.tangent
     return {side: at_nodes for side in problem.info.get("contact_sides", ())}
 
 
@@ -172,13 +172,15 @@ def _prolongated_multiplier(refined, problem, solution, new_problem):
     old, new = problem.contact, new_problem.contact
     if _vertex_values_only(new_problem):
         P = refined.prolongation
-        multiplier, on_contact = np.zeros(problem.mesh.n_vertices), np.zeros(problem.mesh.n_vertices)
-        multiplier[old.vertices], on_contact[old.vertices] = solution.multiplier, 1.0
+        lam = old.tangential(solution.multiplier)  # (n_c, d - 1)
+        multiplier, on_contact = np.zeros((problem.mesh.n_vertices, lam.shape[1])), np.zeros(problem.mesh.n_vertices)
+        multiplier[old.vertices], on_contact[old.vertices] = lam, 1.0
         # a new Γ_C vertex next to a clamped end takes its contact neighbour's value, not half of it
         weight = (P @ on_contact)[new.vertices]
-        return (P @ multiplier)[new.vertices] / np.where(weight > 0, weight, 1.0)
+        spread = np.stack([P @ multiplier[:, k] for k in range(lam.shape[1])], axis=1)[new.vertices]
+        return spread / np.where(weight > 0, weight, 1.0)[:, None]
     if old.size == 0 or new.size == 0:
-        return np.zeros(new.size)
+        return new.zero_multiplier()
     from scipy.spatial import cKDTree
 
     return np.asarray(solution.multiplier, dtype=float)[cKDTree(old.coords).query(new.coords)[1]]

@@ -36,6 +36,7 @@ import xarray as xr
 
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import package_versions
+from vemkit.io.solution_fields import as_written
 from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outcome, failed, guarded_solve
 from vemkit.studies.sweep_dimensions import dimension_name
 
@@ -135,7 +136,7 @@ def point_quantities(problem, outcome: Outcome):
             np.linalg.norm(np.sum(w[:, None] * (cb.tangent * stress[:, :1] + cb.tangent2 * stress[:, 1:]), axis=0))
         )
     else:
-        tangential = float(np.sum(w * st.tangential_stress))
+        tangential = float(np.sum(w * st.tangential_stress[:, 0]))
     q = {
         "max_penetration": float(np.max(np.maximum(st.penetration, 0.0), initial=0.0)),
         f"contact_{measure}": float(np.sum(w[st.penetration > 0.0])),
@@ -148,8 +149,7 @@ def point_quantities(problem, outcome: Outcome):
     order = np.lexsort(tuple(cb.coords[:, axis] for axis in reversed(range(cb.dimension))))  # by x, then y (, z)
     values = {"multiplier": np.asarray(sol.multiplier, dtype=float)}
     profiles = {
-        name: np.asarray(values.get(attr, getattr(st, attr, None)), dtype=float)[order]
-        for name, (attr, _, _) in PROFILES.items()
+        name: as_written(values.get(attr, getattr(st, attr, None)))[order] for name, (attr, _, _) in PROFILES.items()
     }
     profiles["state"] = np.asarray(st.state, dtype=np.int8)[order]
     profiles["x"], profiles["y"], profiles["w"] = cb.coords[order, 0], cb.coords[order, 1], cb.weight[order]
