@@ -1,5 +1,5 @@
 """Coulomb friction on a 3D body (docs/reference/files.md, issue 21 items 3-4): uzawa (Steps 1-3 with the multiplier
-projected on the unit disk) and ssn (the semismooth Newton step of vemkit.solvers.ssn_disk) agree to
+projected on the unit disk) and ssn (the semismooth Newton step of vemkit.solvers.ssn_friction) agree to
 1e-10 at tol 1e-12 with stick and slip vertices, the slip direction is not an axis (turning along Gamma_C: a box
 instead of the disk would fail), for the reduced law m_tau = 0 and for m_tau = 1, and the independent
 check sees a multiplier turned off the slip direction and |lambda| > 1."""

@@ -1,7 +1,7 @@
 """Coulomb's coupled law in 3D (m_tau = 1, k_tau = mu k_nu; issue 21 item 2): the friction box of
 benchmarks/peers3d.py (the unit cube, its top moved by (0.001, 0.0005, -0.01), its bottom in normal
 compliance k_nu = 1000 = E against the paraboloid gap 0.02 ((x - 0.4)^2 + (y - 0.55)^2), nodal rule).
-ssn with the local gamma of the coupled law (vemkit.solvers.ssn_disk.coupled_gamma) converges to
+ssn with the local gamma of the coupled law (vemkit.solvers.ssn_point.coupled_gamma) converges to
 tol 1e-10 with stick and slip vertices, the independent check passes, and the Newton iterations stay
 bounded in n. Measured (direct solves) at n = 4, 6, 8, 12:
 

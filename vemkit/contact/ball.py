@@ -48,3 +48,9 @@ def inner(a, b) -> float:
     vectors of scalars: a @ b), else the sum of the products."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     return float(a[:, 0] @ b[:, 0]) if a.shape[1] == 1 else float(np.sum(a * b))
+
+
+def perpendiculars(unit) -> list:
+    """An orthonormal basis of the complement of each unit vector (rows of ``unit``, (n, k)) in R^k,
+    as a list of (n, k) arrays: none for k = 1, the vector turned by 90 degrees for k = 2."""
+    return [np.stack([-unit[:, 1], unit[:, 0]], axis=1) for _ in range(unit.shape[1] - 1)]

@@ -1,6 +1,6 @@
 """Nodal (d x d block) Gauss-Seidel on a scalar CSR matrix: the finest-level smoother of the 3D contact steps.
 
-The semismooth Newton steps on a 3D body (vemkit.solvers.ssn_disk) add to K, at every sliding vertex,
+The semismooth Newton steps on a 3D body (vemkit.solvers.ssn_friction) add to K, at every sliding vertex,
 the tangent stiffness of the slip direction w b slope (e1 t1 + e2 t2)(e1 t1 + e2 t2)^T, slope =
 gamma / (|q| - 1) = 1 / |u_tau| at the solution: ~1e6 gamma where the slip is small, a rank-one
 3 x 3 block that mixes the x and y dofs of the vertex. Scalar Gauss-Seidel relaxes the rows of a

@@ -6,7 +6,7 @@ Unknowns u (free dofs) and the friction multiplier lambda (one per contact verte
     C(u, lambda) = lambda - P(lambda + gamma u_tau) = 0,   P: projection onto [-1, 1].
 
 On a 3D body (docs/reference/files.md) lambda and u_tau have two components in the vertex basis (t1, t2), P is the
-projection onto the unit disk, and the Newton step is vemkit.solvers.ssn_disk.
+projection onto the unit disk; the Newton step (both dimensions) is vemkit.solvers.ssn_friction.
 
 C = 0 is |lambda| <= 1, lambda u_tau = |u_tau| for any gamma > 0. The choice only steers the active
 sets: gamma_c = GAMMA_FACTOR[d] kd_c / (L_C h^(d-2) b_ref), kd_c the stiffness diagonal in the tangential
@@ -19,7 +19,7 @@ made the sets of mixed stick/slip cases flip-flop: 8 -> 19 iterations from 2^-4 
 the old lambda ever more closely: 7, 8, 9, 11, 13-17, 14, 29 Newton iterations at n = 8 ... 86 on
 the sheared box (config/scenes/3d/sheared_box.yaml), against 7 at n = 16, 8 at 32, 9 at 48 and 64
 with h. 3D with m_tau > 0 (Coulomb's coupled law): the local gamma_c = kd_c / (w_c b_c), b_c the
-vertex's own bound at the start (vemkit.solvers.ssn_disk.coupled_gamma; the global one left
+vertex's own bound at the start (vemkit.solvers.ssn_point.coupled_gamma; the global one left
 gamma |u_tau| ~ 1e-6 at the sliding vertices of the Mindlin sphere, so q did not see the slip
 direction). Start: u = the plain linear solution,
 lambda = P(kd u_tau / (w b_ref)) (the local trial multiplier, which finds the slip zone at once);
@@ -77,14 +77,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import ConvergenceError, LinearSolveError
 from vemkit.solvers.linear import ReducedSolver, linear_solver
 from vemkit.solvers.solution import ContactSolution, contact_residual, history_arrays, relative_slip
-from vemkit.solvers.ssn_disk import aligned_multiplier, coupled_gamma, disk_direction, final_multiplier
 from vemkit.solvers.ssn_failures import CONTRAST_WARNING, fail
-from vemkit.solvers.ssn_point import Point, converged, energy_slope, evaluate
-from vemkit.solvers.ssn_steps import direction_diagonal, line_search, stick_basis, stick_shift, tangential_diagonal
+from vemkit.solvers.ssn_friction import friction_direction
+from vemkit.solvers.ssn_point import (
+    Point,
+    aligned_multiplier,
+    converged,
+    coupled_gamma,
+    energy_slope,
+    evaluate,
+    final_multiplier,
+)
+from vemkit.solvers.ssn_steps import direction_diagonal, line_search, tangential_diagonal
 
 NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness diagonal
 # gamma = GAMMA_FACTOR[d] kd / (L_C h^(d-2) b_ref), see the module docstring; in 3D 0.1 keeps the
@@ -96,7 +103,6 @@ INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that start
 SHORT_STEP = 1e-2  # two accepted steps shorter than this with AMG: switch the Newton solves to direct
 DIRECT_FALLBACK_LIMIT = 500_000  # ... if there are at most this many dofs
 AMG_CONTRAST_LIMIT = 1e6  # w p_nu' / (stiffness diagonal) above which the Newton solves are direct
-STICK_PENALTY = 1e3  # penalty (times the stiffness diagonal) on stick tangents in a rebuilt hierarchy
 
 
 @dataclass
@@ -172,8 +178,8 @@ def solve_ssn(
                 return _finish(newton, point.u, lam, k - 1)
             point = evaluate(newton, point.u, lam)  # 3D: go on from the multiplier of the law
         point = _newton_iteration(newton, point, k)
-        if cb.dimension == 3 and not converged(newton, point):
-            lam = aligned_multiplier(newton, point)  # the slip direction, when only it is left
+        if not converged(newton, point):  # 2D: never both (converged is the merit test there)
+            lam = aligned_multiplier(newton, point)  # 3D: the slip direction, when only it is left
             point = point if lam is None else evaluate(newton, point.u, lam)
         if progress is not None:
             progress(k, newton.records[-1])
@@ -224,7 +230,7 @@ def _plain_solution(newton, u):
 
 
 def _returned_multiplier(newton, point):
-    """(lambda, its move) of a converged point; 3D: in the disk and along the slip (ssn_disk.final_multiplier)."""
+    """(lambda, its move) of a converged point; 3D: in the disk and along the slip (ssn_point.final_multiplier)."""
     if newton.problem.contact.dimension != 3:
         return point.lam, 0.0
     return final_multiplier(newton, point)
@@ -265,7 +271,7 @@ def _prepare(newton, t):
     k_tau = law.friction_coefficient
     b_ref = k_tau if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else k_tau)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
-    if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_disk)
+    if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_point.coupled_gamma)
         newton.gamma = coupled_gamma(newton.kd_tau, cb.weight, b_lin, newton.b_ref)
     else:
         newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
@@ -343,41 +349,9 @@ def _active_sets(newton, point):
 
 
 def _newton_direction(newton, point, k):
-    """(du, lambda_new, linear iterations, active-set changes) of the Newton step at ``point``."""
-    problem = newton.problem
-    K, cb, law, n = problem.stiffness, problem.contact, problem.law, problem.n_dofs
-    zero = newton.zero
-    lam = point.lam
-    bound, frictional, slip, stick, changes = sets = _active_sets(newton, point)
-    if cb.dimension == 3:  # Coulomb in the unit disk (vemkit.solvers.ssn_disk)
-        return disk_direction(newton, point, k, sets, _solve_newton_system)
-    sign = np.sign(point.q)  # (n_c, 1)
-    shift = stick_shift(cb, stick, point.slip, n)
-    friction_now = cb.scatter(zero, cb.times(cb.weight * bound, lam), n)
-    slip_force = cb.scatter(zero, np.where(slip[:, None], cb.times(cb.weight * bound, sign), 0.0), n)
-    Z = stick_basis(cb, np.flatnonzero(stick), n) if np.any(stick) else None
-
-    def penalty():  # for a rebuilt AMG hierarchy: stick tangents nearly clamped
-        return rank_one_blocks(cb, np.where(stick, STICK_PENALTY * newton.kd_tau, 0.0), cb.tangent, n)
-
-    # the Newton system: K + J (+ the friction-bound derivative w p_tau' lambda tau nu^T, m_tau > 0)
-    J = cb.normal_jacobian(point.u, law, newton.stiffness_cap)
-    slope_blocks = None
-    if not law.reduced:
-        lam_hat = np.where(slip, sign[:, 0], np.where(stick, lam[:, 0], 0.0))
-        bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
-        slope_blocks = rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal)
-    # direct: K + J (+ slope) formed as it always was; AMG: K x + J x, no copy of K's values
-    A = newton.reduced.operator(K, J) if slope_blocks is None else newton.reduced.operator(K, J, slope_blocks)
-    rhs = -(point.R - friction_now) - A @ shift - slip_force
-    correction, its = _solve_newton_system(newton, point, k, A, Z, rhs, penalty)
-    du = shift + correction
-    stick_force = cb.tangential_displacement(rhs - A @ correction)
-    lam_new = np.where(slip[:, None], sign, lam)
-    lam_new = np.where(stick[:, None], stick_force / (cb.weight * np.where(stick, bound, 1.0))[:, None], lam_new)
-    slip_new = point.slip + cb.tangential_displacement(du)
-    lam_new = np.where(frictional[:, None], lam_new, np.where(slip_new != 0.0, np.sign(slip_new), lam))
-    return du, lam_new, its, changes
+    """(du, lambda_new, linear iterations, active-set changes) of the Newton step at ``point``: the
+    friction part on the unit ball of R^(d-1) (vemkit.solvers.ssn_friction)."""
+    return friction_direction(newton, point, k, _active_sets(newton, point), _solve_newton_system)
 
 
 def _solve_newton_system(newton, point, k, A, Z, rhs, penalty):

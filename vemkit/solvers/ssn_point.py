@@ -1,5 +1,8 @@
 """An iterate of the semismooth Newton method (vemkit.solvers.ssn) and its measures: the residuals,
-the merit theta, the energy of the reduced law and its slope, and the convergence test."""
+the merit theta, the energy of the reduced law and its slope, and the convergence test; in 3D also
+the slip direction's test (``disk_alignment``), the multiplier re-aligned with the slip
+(``aligned_multiplier``, ``final_multiplier``) and the local gamma of Coulomb's coupled law
+(``coupled_gamma``)."""
 
 from __future__ import annotations
 
@@ -11,6 +14,7 @@ from vemkit.contact import ball
 from vemkit.solvers.solution import relative_slip, residual_scale
 from vemkit.solvers.sparse_ops import abs_matvec
 
+BOUND_FLOOR = 1e-3  # coupled_gamma: a vertex's friction bound counted as at least this times b_ref
 ROUNDING_FLOOR = 100.0  # accept a residual this many times eps * || |K| |u| + |f| + |J| |u| || (see converged)
 
 
@@ -29,6 +33,7 @@ class Point:
     scale: float  # residual_scale
     energy: float = 0.0
     floor: float = 0.0
+    verdict: bool | None = None  # converged(), once computed (it depends on the point only)
 
 
 def evaluate(newton, u, lam) -> Point:
@@ -64,7 +69,14 @@ def complementarity_weight(newton, t):
 
 
 def converged(newton, point) -> bool:
-    """Relative residual <= tol, or at the rounding floor of its own evaluation (ill-conditioned cases)."""
+    """Relative residual <= tol, or at the rounding floor of its own evaluation (ill-conditioned cases);
+    in 3D also the slip direction resolved and lambda in the disk. Computed once per point."""
+    if point.verdict is None:
+        point.verdict = _converged(newton, point)
+    return point.verdict
+
+
+def _converged(newton, point) -> bool:
     residual = np.sqrt(point.theta) / point.scale
     if newton.problem.contact.dimension == 3:  # and the slip direction resolved (disk_alignment)
         residual = max(residual, disk_alignment(newton, point))
@@ -109,3 +121,62 @@ def disk_alignment(newton, point) -> float:
     sliding = (cb.magnitude(point.q) > 1.0) & moving
     miss = cb.magnitude(point.lam - cb.direction(point.slip))[sliding]
     return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale
+
+
+def coupled_gamma(kd_tau, weight, bound, b_ref):
+    """gamma_c = kd_c / (w_c b_c) for Coulomb's coupled law (m_tau > 0): b_c the vertex's friction
+    bound p_tau(t_c) at the start (at least BOUND_FLOOR b_ref; b_ref where it is 0), so gamma |u_tau|
+    is the local trial ratio kd |u_tau| / (w b), the natural size of q - lambda at a sliding vertex.
+
+    The global gamma of vemkit.solvers.ssn (0.1 kd / (L_C h b_ref)) is smaller by 0.1 h / L_C and by
+    b_c / b_ref: on the Mindlin half sphere (Gamma_C the whole quarter sphere, L_C ~ 1.8, contact radius
+    0.1) gamma |u_tau| was ~1e-6 at vertices sliding by 1e-4, so q ~ lambda and the slip direction was
+    resolved only by re-aligning lambda, which cycled at h = 0.015 and 0.01 (measured: residual
+    4e-6 <-> 1e-8 for 60 iterations). With this gamma: 6 Newton iterations per load step at h = 0.015
+    and 0.01, and on the GetFEM box (m_tau = 1) 9-12 instead of 11-27 at 2 187 and 14 739 DOFs."""
+    bound = np.where(bound > 0.0, np.maximum(bound, BOUND_FLOOR * b_ref), b_ref)
+    return kd_tau / (weight * bound)
+
+
+def aligned_multiplier(newton, point):
+    """lambda = u_tau / |u_tau| at the sliding vertices (disk_alignment's), once the merit is
+    converged and only the slip direction (2.8) is not; else None.
+
+    At a vertex barely in contact (p_tau(t) ~ 1e-4 of the largest bound) gamma |u_tau| is ~1e-6, so
+    |q| = |lambda + gamma u_tau| ~ 1 and P(q) ~ lambda whatever lambda's direction: Newton turns lambda
+    towards the slip by ~gamma |u_tau| per step (measured on the Mindlin sphere: the direction error
+    2.3e-2 -> 2.1e-2 in 20 steps, disk_alignment stalled at 3.5e-6). Setting the direction moves the
+    friction force by disk_alignment x scale; the next Newton step restores the equilibrium.
+    Only for the reduced law: with m_tau > 0 gamma is local (coupled_gamma), gamma |u_tau| ~ 1e-2, and
+    the re-alignment fought the Newton step (a 3-cycle at a rim vertex of the Mindlin sphere, h = 0.01)."""
+    if np.sqrt(point.theta) / point.scale > newton.tol or not newton.problem.law.reduced:
+        return None  # m_tau > 0: the local gamma (coupled_gamma) lets Newton turn lambda itself
+    return _slip_directions(newton, point, point.lam.copy())
+
+
+def _slip_directions(newton, point, lam, every: bool = False):
+    """``lam`` with u_tau / |u_tau| at disk_alignment's sliding vertices (|q| > 1, |u_tau| > tol max|u|;
+    ``every``: at every vertex with |u_tau| > tol max|u|, as the independent check counts sliding)."""
+    cb = newton.problem.contact
+    moving = cb.magnitude(point.slip) > newton.tol * float(np.max(np.abs(point.u), initial=0.0))
+    sliding = moving if every else (cb.magnitude(point.q) > 1.0) & moving
+    lam[sliding] = cb.direction(point.slip[sliding])
+    return lam
+
+
+def final_multiplier(newton, point):
+    """(lambda, how far it moves the friction force / scale) that ssn returns at a converged 3D point:
+    P(lambda), and u_tau / |u_tau| at every vertex with |u_tau| > tol max|u|, so |lambda| <= 1 (2.7) and
+    lambda . u_tau = |u_tau| (2.8) hold to rounding; ssn returns it if the move is <= tol, else goes on
+    from it.
+
+    The merit weighs C = lambda - P(q) by w p_tau(t) (ssn_point.complementarity_weight), so at a vertex barely
+    in contact |lambda| may end above 1 (measured on the Mindlin sphere: 1.0096) or point away from a
+    slip of 6e-6 max|u| (lambda . u_tau - |u_tau| = 1.2e-5 max|u|) while the merit is below tol.
+    P(lambda) is no farther from lambda than P(q) is, and the sliding vertices' change is
+    disk_alignment's miss (a vertex of the stick set that moves by more than tol max|u| -- its state
+    changed in the last step -- may move more, hence the measure)."""
+    cb = newton.problem.contact
+    lam = _slip_directions(newton, point, cb.project(point.lam), every=True)
+    move = complementarity_weight(newton, point.t) * cb.magnitude(lam - point.lam)
+    return lam, float(np.linalg.norm(move)) / point.scale

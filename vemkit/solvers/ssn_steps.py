@@ -121,24 +121,6 @@ def _held(cb, stick_mask):
     return np.flatnonzero(stick_mask & cb.fixed.any(axis=1))
 
 
-def disk_slip_step(q, lam, gamma):
-    """The Newton step of C = lambda - P(q) at the 3D slip vertices (|q| > 1, q = lambda + gamma u_tau,
-    P the projection on the unit disk): with n = q/|q|, P' = (I - n n^T)/|q|, solving the linearized
-    C = 0 for the new multiplier gives
-
-        lambda_new = n + (I - n n^T)(gamma du_tau - lambda) / (|q| - 1),
-
-    so (returned) lambda_new = base + slope e (e . du_tau): base = n - (e . lambda) e / (|q| - 1),
-    slope = gamma / (|q| - 1), e = the unit vector perpendicular to n in the tangent plane
-    (I - n n^T = e e^T in 2D coordinates). In 2D, I - n n^T = 0: lambda_new = sign(q)."""
-    size = np.linalg.norm(q, axis=1)
-    unit = q / size[:, None]
-    e = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
-    excess = size - 1.0
-    base = unit - (np.sum(e * lam, axis=1) / excess)[:, None] * e
-    return base, gamma / excess, e
-
-
 def line_search(point, trial, slope, d0, energy_merit):
     """Step length along the Newton direction; returns (alpha, the point reached).
 
