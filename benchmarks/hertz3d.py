@@ -9,7 +9,7 @@ frictionless platen (u2 = -delta, u1, u3 free); the curved surface (``sphere``) 
 foundation plane y = -R. E = 1, nu = 0.3, normal compliance p = k t (m = 1), frictionless.
 The mesh, the solve and the measures: ``vemkit.studies.hertz`` (gmsh tetrahedra refined near the
 contact point; P, a_zero, a_fit, p0_nodal, p0_fit against Hertz at the measured P); the Gamma_C normals
-on the roller planes x = 0 and z = 0 lie in the planes (``vemkit.contact.boundary3d.normals_in_roller_planes``).
+on the roller planes x = 0 and z = 0 lie in the planes (``vemkit.contact.boundary.normals_in_roller_planes``).
 This file is a thin front writing the table; the workflow's rule three_d_hertz runs the same study
 (config/three_d.yaml ``hertz:``, results/3d/hertz.{nc,md}).
 

@@ -1,4 +1,4 @@
-"""The gauss rule of the normal-compliance term on 3D Gamma_C faces (vemkit.contact.boundary3d, issue 21
+"""The gauss rule of the normal-compliance term on 3D Gamma_C faces (vemkit.contact.rules, issue 21
 item 1): the patch test on hex, tet and Voronoi meshes, exactness on triangles to the stated degree,
 the exact Newton linearization, gauss -> nodal under refinement, and both solvers agreeing."""
 

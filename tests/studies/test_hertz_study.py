@@ -1,4 +1,4 @@
-"""vemkit.studies.hertz and the roller-plane normals (vemkit.contact.boundary3d): the area of a
+"""vemkit.studies.hertz and the roller-plane normals (vemkit.contact.boundary): the area of a
 linear function's positive part, the Gamma_C normals on the symmetry planes of the gmsh quarter
 sphere (in the plane, nearer the sphere's normal than the area-weighted one), and one coarse Hertz
 solve against Hertz's a and p0."""

@@ -74,14 +74,15 @@ def midpoint_change(space, dofs, edges: np.ndarray) -> sp.csr_matrix | None:
     rows, cols, vals = [], [], []
     m = free_index[space.node_range("edge").start + edges]
     ends = free_index[space.mesh.edges[edges]]  # (k, 2), -1 at clamped ends
-    for c in (0, 1):
-        rows.append(2 * m + c)
-        cols.append(2 * m + c)
+    d = dofs.dimension  # every node carries d components: dof = d node + c
+    for c in range(d):
+        rows.append(d * m + c)
+        cols.append(d * m + c)
         vals.append(np.full(m.size, w_mid - 1.0))
         for end in (0, 1):
             keep = ends[:, end] >= 0
-            rows.append(2 * m[keep] + c)
-            cols.append(2 * ends[keep, end] + c)
+            rows.append(d * m[keep] + c)
+            cols.append(d * ends[keep, end] + c)
             vals.append(np.full(int(keep.sum()), w_end))
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
 
