@@ -152,8 +152,17 @@ class ContactBoundary:
         return np.zeros((self.size, self.dimension - 1))
 
     def tangential(self, values) -> np.ndarray:
-        """``values`` as tangential quantities (n, d - 1) (a 2D one given as (n,) gets its column)."""
-        return np.asarray(values, dtype=float).reshape(-1, self.dimension - 1)
+        """``values`` as tangential quantities (n, d - 1): one row per point (a 2D one given as (n,)
+        gets its column); InputError if a row does not have d - 1 components."""
+        values = np.asarray(values, dtype=float)
+        values = values.reshape(values.shape[0], -1) if values.size else values.reshape(0, self.dimension - 1)
+        if values.shape[1] != self.dimension - 1:
+            raise InputError(
+                f"tangential quantities of a {self.dimension}D contact boundary have {self.dimension - 1} "
+                f"component(s) per point, not {values.shape[1]}",
+                key="multiplier",
+            )
+        return values
 
     def project(self, lam) -> np.ndarray:
         """P: the projection onto the unit ball of R^(d-1), point by point (5.5)."""
