@@ -355,7 +355,7 @@ def check_file_sides(scene, header) -> None:
                 raise SceneError(
                     f"boundary.{part}: side {side!r} is a physical {'line' if three_d else 'surface'} in the mesh "
                     f"file {scene.mesh_options['file']}: the file is a {'2D' if three_d else '3D'} mesh but the "
-                    f"scene is {'3D' if three_d else '2D'}; {'remove model: 3d' if three_d else 'set model: 3d'}",
+                    f"scene is {'3D' if three_d else '2D'}; give a {'3D' if three_d else '2D'} mesh file",
                     key=f"boundary.{part}",
                 )
             listed = ", ".join(header.sides) or "none"
