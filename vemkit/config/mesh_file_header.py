@@ -370,7 +370,9 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
     if str(getattr(topology, "topology_dimension", "2")) == "3":
-        raise _fail(path, "is a 3D mesh (mesh3d) but the scene is 2D; give a 2D mesh file, or write the scene for a 3D body")
+        raise _fail(
+            path, "is a 3D mesh (mesh3d) but the scene is 2D; give a 2D mesh file, or write the scene for a 3D body"
+        )
     if len(coordinates) != 2:
         raise _fail(path, "cannot be read as UGRID netCDF: node_coordinates must name two variables (x y)")
     x, y = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
