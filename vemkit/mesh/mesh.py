@@ -62,6 +62,11 @@ class Mesh:
     def cell_sizes(self) -> np.ndarray:
         return np.diff(self.cell_offsets)
 
+    @property
+    def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (offsets, vertices) of every cell's vertices: ``(cell_offsets, cell_vertices)``, CCW."""
+        return self.cell_offsets, self.cell_vertices
+
     def cell(self, k: int) -> np.ndarray:
         return self.cell_vertices[self.cell_offsets[k] : self.cell_offsets[k + 1]]
 
