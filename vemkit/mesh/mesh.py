@@ -9,7 +9,8 @@ A mesh is
   vertex pairs ``(a, b)`` in the counter-clockwise order in which they appear in their cell;
 - ``meta``: how the mesh was made (family, n, seed, ...), stored with every result.
 
-Derived topology (``edges``, ``edge_cells``, ...) is computed on demand and cached.
+Derived topology (``edges``, ``edge_cells``, ...) is computed on demand and cached. The members of
+:class:`~vemkit.mesh.interface.MeshInterface` (the facets are the edges) are among them, as in 3D.
 """
 
 from __future__ import annotations
@@ -21,11 +22,12 @@ import numba
 import numpy as np
 
 from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
-from vemkit.mesh.geometry import indexed_polygon_areas
+from vemkit.mesh.geometry import areas_centroids, indexed_polygon_areas
+from vemkit.mesh.interface import SharedMeshMembers
 
 
 @dataclass(frozen=True, eq=False)
-class Mesh:
+class Mesh(SharedMeshMembers):
     vertices: np.ndarray
     cell_offsets: np.ndarray
     cell_vertices: np.ndarray
@@ -158,6 +160,51 @@ class Mesh:
     @property
     def h(self) -> float:
         return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+    # -- the mesh interface (vemkit.mesh.interface): the facets are the edges -------------------
+    @cached_property
+    def facets(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (offsets, vertices) of the edges, each ``(a, b)`` as in ``edges``."""
+        return np.arange(0, 2 * self.edges.shape[0] + 1, 2, dtype=np.int64), self.edges.ravel()
+
+    @property
+    def facet_cells(self) -> np.ndarray:
+        """``edge_cells``: column 0 the cell in which the edge runs counter-clockwise (it points out of it)."""
+        return self.edge_cells
+
+    @cached_property
+    def cell_facet_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (``cell_offsets``, signed edges): a cell's half-edges in order, edge e where it runs as
+        in ``edges``, ``-(e + 1)`` where it runs the other way."""
+        forward = self.edge_first_half_edges[self.half_edge_edge] == np.arange(self.half_edge_edge.size)
+        return self.cell_offsets, np.where(forward, self.half_edge_edge, -self.half_edge_edge - 1)
+
+    @cached_property
+    def facet_vector_areas(self) -> np.ndarray:
+        """``(E, 2)``: the tangent b - a of every edge turned clockwise, |e| n_e (outward for column 0
+        of ``edge_cells``)."""
+        tangent = self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]]
+        return np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
+
+    @cached_property
+    def facet_centroids(self) -> np.ndarray:
+        """``(E, 2)`` edge midpoints."""
+        return 0.5 * (self.vertices[self.edges[:, 0]] + self.vertices[self.edges[:, 1]])
+
+    @property
+    def cell_volumes(self) -> np.ndarray:
+        """``cell_areas`` (signed; positive counter-clockwise)."""
+        return self.cell_areas
+
+    @cached_property
+    def cell_centroids(self) -> np.ndarray:
+        """``(M, 2)`` area centroids (``geometry.areas_centroids``, the shoelace formula)."""
+        return areas_centroids(self.vertices[self.cell_vertices], self.cell_offsets)[1]
+
+    @cached_property
+    def boundaries(self) -> dict:
+        """``{side: edge ids}``: the named sides' vertex pairs as indices into ``edges``."""
+        return {name: edge_indices(self, pairs) for name, pairs in self.boundary.items()}
 
     def boundary_vertices(self, name: str) -> np.ndarray:
         """Sorted unique vertices of a named boundary part."""

@@ -10,6 +10,9 @@ graph of ``vemkit.mesh`` has no cycle (tests/mesh/test_mesh_interface.py walks i
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.checks3d import validate_mesh3d
@@ -19,11 +22,11 @@ from vemkit.mesh.files import read_mesh
 from vemkit.mesh.files3d import read_mesh3d
 
 #: dimension -> the mesh check of that dimension
-VALIDATORS = {2: validate_mesh, 3: validate_mesh3d}
+VALIDATORS: dict[int, Callable[..., None]] = {2: validate_mesh, 3: validate_mesh3d}
 #: dimension -> the mesh-file reader of that dimension (it validates what it reads)
-READERS = {2: read_mesh, 3: read_mesh3d}
+READERS: dict[int, Callable[..., Any]] = {2: read_mesh, 3: read_mesh3d}
 #: dimension -> the family builder of that dimension (family name, domain, size, options)
-BUILDERS = {2: build_mesh, 3: build_mesh3d}
+BUILDERS: dict[int, Callable[..., Any]] = {2: build_mesh, 3: build_mesh3d}
 
 __all__ = ["BUILDERS", "READERS", "VALIDATORS", "checked_mesh", "scene_mesh"]
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from typing import Any
 
 from vemkit.config.domain import cells_per_length, domain_from_spec
 from vemkit.exceptions import MeshError
