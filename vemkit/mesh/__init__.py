@@ -20,5 +20,6 @@ from vemkit.mesh.checks import validate_mesh
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.interface import MeshInterface
 from vemkit.mesh.mesh import Mesh, from_polygons
+from vemkit.mesh.meshing import checked_mesh, scene_mesh
 
-__all__ = ["Mesh", "MeshInterface", "build_mesh", "from_polygons", "validate_mesh"]
+__all__ = ["Mesh", "MeshInterface", "build_mesh", "checked_mesh", "from_polygons", "scene_mesh", "validate_mesh"]

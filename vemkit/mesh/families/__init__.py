@@ -20,14 +20,15 @@ from vemkit.mesh.families.hanging import hanging
 from vemkit.mesh.families.square import square, structured_triangle
 from vemkit.mesh.families.triangle import delaunay_triangle
 from vemkit.mesh.families.voronoi import voronoi
-from vemkit.mesh.meshing import checked_mesh, scene_mesh  # re-exported: their home is vemkit.mesh.meshing
+
+# scene_mesh and checked_mesh live in vemkit.mesh.meshing (public: vemkit.mesh); importable from here
+# until vemkit.contact.problem imports them from there, then this line goes
+from vemkit.mesh.meshing import checked_mesh, scene_mesh  # noqa: F401
 
 __all__ = [
     "FAMILIES",
     "TRIANGLE_KINDS",
     "build_mesh",
-    "checked_mesh",
-    "scene_mesh",
     "family_builder",
     "square",
     "structured_triangle",
