@@ -12,6 +12,7 @@ from vemkit.mesh.families3d import extrude, hex, octree, tet, voronoi
 from vemkit.mesh.files import read_mesh
 from vemkit.mesh.files3d import read_mesh3d
 from vemkit.mesh.interface import INTERFACE_MEMBERS, MeshInterface
+from vemkit.mesh.locate import locate_points
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.ugrid import write_ugrid
 
@@ -131,3 +132,54 @@ def test_meshes_read_from_files_have_the_interface(tmp_path):
         assert isinstance(read, MeshInterface) and read.dimension == mesh.dimension
         assert read.cell_volumes.sum() == pytest.approx(mesh.cell_volumes.sum(), rel=1e-12)
         assert {k: v.size for k, v in read.boundaries.items()} == {k: v.size for k, v in mesh.boundaries.items()}
+
+
+# a body with a re-entrant corner, a circular hole and a triangular one (tests/mesh/test_domains.py)
+BRACKET = {
+    "polygon": [[0, 0], [3, 0], [3, 1], [1.2, 1], [1.2, 2], [0, 2]],
+    "sides": ["bottom", "right", "shelf", "step", "top", "left"],
+    "holes": [
+        {"circle": [0.6, 0.6, 0.25], "side": "bore"},
+        {"polygon": [[2.0, 0.3], [2.2, 0.7], [2.5, 0.3]], "sides": ["slot_a", "slot_b", "slot_c"]},
+    ],
+}
+
+
+def _boundary_volume(mesh) -> float:
+    """The body's volume from its boundary alone: (1/d) Σ over the exterior facets of x_F . |F| n_F."""
+    exterior = mesh.exterior_facets
+    return float((mesh.facet_centroids[exterior] * mesh.facet_vector_areas[exterior]).sum()) / mesh.dimension
+
+
+@pytest.mark.parametrize("family, options", [("triangle", {"seed": 3}), ("voronoi", {"seed": 2}), ("square", {})])
+def test_on_a_body_with_holes_the_boundary_normals_point_out_of_it(family, options):
+    plane = build_mesh(family, 6, domain=BRACKET, **options)
+    exterior = plane.exterior_facets
+    step = 1e-6 * plane.facet_areas[exterior, None] * plane.facet_normals[exterior]
+    outside = locate_points(plane, plane.facet_centroids[exterior] + step)
+    inside = locate_points(plane, plane.facet_centroids[exterior] - step)
+    assert (outside == -1).all() and (inside == plane.facet_cells[exterior, 0]).all()
+    assert _boundary_volume(plane) == pytest.approx(plane.cell_volumes.sum(), rel=1e-12)
+    named = np.concatenate(list(plane.boundaries.values()))
+    assert np.array_equal(np.sort(named), exterior)
+    assert set(plane.boundaries) == {
+        "bottom",
+        "right",
+        "shelf",
+        "step",
+        "top",
+        "left",
+        "bore",
+        "slot_a",
+        "slot_b",
+        "slot_c",
+    }
+
+
+def test_on_prisms_over_a_body_with_holes_the_boundary_normals_point_out_of_it():
+    prisms = extrude(build_mesh("triangle", 6, domain=BRACKET, seed=3), 2, 0.5)  # convex cells
+    exterior = prisms.exterior_facets
+    away = prisms.facet_centroids[exterior] - prisms.cell_centroids[prisms.facet_cells[exterior, 0]]
+    assert ((away * prisms.facet_normals[exterior]).sum(axis=1) > 0).all()
+    assert _boundary_volume(prisms) == pytest.approx(prisms.cell_volumes.sum(), rel=1e-12)
+    assert np.array_equal(np.sort(np.concatenate(list(prisms.boundaries.values()))), exterior)
