@@ -108,6 +108,17 @@ def test_the_named_sides_cover_the_boundary_exactly_once(mesh):
         assert sum(on_plane) == 1, side
 
 
+def test_a_sides_vertices_and_edges_are_those_of_its_facets(mesh):
+    offsets, ids = mesh.facets
+    known = {tuple(pair) for pair in np.sort(mesh.edges, axis=1).tolist()}
+    for side, facets in mesh.boundaries.items():
+        vertices = np.concatenate([ids[offsets[f] : offsets[f + 1]] for f in facets])
+        assert np.array_equal(mesh.boundary_vertices(side), np.unique(vertices)), side
+        pairs = mesh.side_edges(side)
+        assert pairs.shape[1] == 2 and {tuple(pair) for pair in np.sort(pairs, axis=1).tolist()} <= known, side
+        assert np.array_equal(np.unique(pairs), np.unique(vertices)), side
+
+
 def test_the_cells_facets_and_edges_make_a_ball():
     """V - E + F - C = 1 (3D) and V - E + C = 1 (2D): the Euler characteristic of a ball, a check
     that ``edges`` lists every side of every face once."""

@@ -38,6 +38,8 @@ The members, property by property (N vertices, M cells, F facets, E edges):
 ``exterior_facets``          the facets of one cell only (the boundary), increasing
 ``boundaries``               ``{side: facet ids}``: the named sides of the boundary
 ``boundary_facets(side)``    ``boundaries[side]``; every exterior facet for ``side=None``
+``boundary_vertices(side)``  the sorted vertices of a named side
+``side_edges(side)``         ``(k, 2)`` vertex pairs: a side's edges (2D), its faces' sides (3D)
 ``meta``                     how the mesh was made (family, n, seed, ...)
 ===========================  ======================================================================
 
@@ -77,6 +79,8 @@ INTERFACE_MEMBERS = (
     "exterior_facets",
     "boundaries",
     "boundary_facets",
+    "boundary_vertices",
+    "side_edges",
     "meta",
 )
 
@@ -144,6 +148,10 @@ class MeshInterface(Protocol):
     def boundaries(self) -> dict: ...
 
     def boundary_facets(self, side: str | None = None) -> np.ndarray: ...
+
+    def boundary_vertices(self, name: str) -> np.ndarray: ...
+
+    def side_edges(self, name: str) -> np.ndarray: ...
 
 
 class SharedMeshMembers:

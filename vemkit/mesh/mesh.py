@@ -210,6 +210,10 @@ class Mesh(SharedMeshMembers):
         """Sorted unique vertices of a named boundary part."""
         return np.unique(self.boundary[name])
 
+    def side_edges(self, name: str) -> np.ndarray:
+        """``(k, 2)`` the edges of a named side as vertex pairs: its ``boundary`` entry."""
+        return self.boundary[name]
+
     def with_boundary(self, **parts) -> "Mesh":
         b = dict(self.boundary)
         b.update(parts)

@@ -68,6 +68,21 @@ class PolyhedralMesh(SharedMeshMembers):
         start = np.repeat(self.face_offsets[faces] - np.cumsum(sizes) + sizes, sizes)
         return self.face_vertices[start + np.arange(int(sizes.sum()), dtype=np.int64)]
 
+    def boundary_vertices(self, name: str) -> np.ndarray:
+        """Sorted unique vertices of the faces of a named side."""
+        return np.unique(self.face_vertex_ids(self.boundary[name]))
+
+    def side_edges(self, name: str) -> np.ndarray:
+        """``(k, 2)`` the sides of a named side's faces as vertex pairs, face after face (an edge shared
+        by two of its faces appears twice)."""
+        faces = self.boundary[name]
+        sizes = self.face_offsets[faces + 1] - self.face_offsets[faces]
+        ids = self.face_vertex_ids(faces)
+        start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+        following = np.arange(ids.shape[0]) + 1
+        following[np.cumsum(sizes) - 1] = start[np.cumsum(sizes) - 1]  # the last vertex closes the face
+        return np.stack([ids, ids[following]], axis=1)
+
     def cell_face_list(self, c: int) -> np.ndarray:
         """The signed faces of cell c."""
         return self.cell_faces[self.cell_offsets[c] : self.cell_offsets[c + 1]]
