@@ -7,6 +7,7 @@ normal, the volume and the centroid of the body are known."""
 import numpy as np
 import pytest
 
+from vemkit.exceptions import MeshError
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.families3d import extrude, hex, octree, tet, voronoi
 from vemkit.mesh.files import read_mesh
@@ -194,3 +195,10 @@ def test_on_prisms_over_a_body_with_holes_the_boundary_normals_point_out_of_it()
     assert ((away * prisms.facet_normals[exterior]).sum(axis=1) > 0).all()
     assert _boundary_volume(prisms) == pytest.approx(prisms.cell_volumes.sum(), rel=1e-12)
     assert np.array_equal(np.sort(np.concatenate(list(prisms.boundaries.values()))), exterior)
+
+
+def test_a_2d_side_that_is_no_edge_is_a_mesh_error_naming_it():
+    mesh = build_mesh("square", 2)
+    broken = mesh.with_boundary(rim=np.array([[0, 4]]))  # a diagonal of the first square
+    with pytest.raises(MeshError, match="boundary part 'rim': \\(0, 4\\) is not an edge"):
+        broken.boundaries  # noqa: B018

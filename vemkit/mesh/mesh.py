@@ -22,6 +22,7 @@ import numba
 import numpy as np
 
 from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
+from vemkit.exceptions import MeshError
 from vemkit.mesh.geometry import areas_centroids, indexed_polygon_areas
 from vemkit.mesh.interface import SharedMeshMembers
 
@@ -203,8 +204,15 @@ class Mesh(SharedMeshMembers):
 
     @cached_property
     def boundaries(self) -> dict:
-        """``{side: edge ids}``: the named sides' vertex pairs as indices into ``edges``."""
-        return {name: edge_indices(self, pairs) for name, pairs in self.boundary.items()}
+        """``{side: edge ids}``: the named sides' vertex pairs as indices into ``edges``; MeshError
+        naming the side of a pair that is no edge."""
+        out = {}
+        for name, pairs in self.boundary.items():
+            try:
+                out[name] = edge_indices(self, pairs)
+            except MeshError as error:
+                raise MeshError(f"boundary part {name!r}: {error}", key=name) from None
+        return out
 
     def boundary_vertices(self, name: str) -> np.ndarray:
         """Sorted unique vertices of a named boundary part."""
@@ -245,7 +253,8 @@ def tag_box_boundary(mesh: Mesh, lower=(0.0, 0.0), upper=(1.0, 1.0), tol=1e-12) 
 
 
 def edge_indices(mesh: Mesh, pairs) -> np.ndarray:
-    """Index in ``mesh.edges`` of every vertex pair (k, 2), in either orientation."""
+    """Index in ``mesh.edges`` of every vertex pair (k, 2), in either orientation; MeshError (a
+    ValueError) naming a pair that is no edge."""
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     nv = np.int64(mesh.n_vertices)
     keys = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * nv + np.maximum(mesh.edges[:, 0], mesh.edges[:, 1])
@@ -255,7 +264,7 @@ def edge_indices(mesh: Mesh, pairs) -> np.ndarray:
     found = order[pos] if keys.size else np.zeros(0, dtype=np.int64)
     if np.any(keys[found] != want):
         bad = pairs[np.flatnonzero(keys[found] != want)[0]]
-        raise ValueError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
+        raise MeshError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
     return found
 
 
