@@ -5,7 +5,9 @@ Every import of a module counts, function-level ones included (found with ast). 
 module a statement names (``from vemkit.mesh.families.by_name import build_mesh`` ->
 ``vemkit.mesh.families.by_name``; ``from vemkit.mesh import polyhedral_kernels`` ->
 ``vemkit.mesh.polyhedral_kernels``); the package ``__init__`` Python runs first is not an edge
-(otherwise every package that re-exports its modules would be a cycle)."""
+(otherwise every package that re-exports its modules would be a cycle). A cycle through a module
+outside vemkit.mesh would need a lower layer to import vemkit.mesh: tests/test_architecture.py
+forbids that."""
 
 import ast
 from pathlib import Path

@@ -87,7 +87,10 @@ INTERFACE_MEMBERS = (
 
 @runtime_checkable
 class MeshInterface(Protocol):
-    """A mesh of any dimension (module doc: every member, its shape and its meaning)."""
+    """A mesh of any dimension (module doc: every member, its shape and its meaning).
+
+    ``isinstance(mesh, MeshInterface)`` checks that every member is there; on Python < 3.12 it
+    evaluates them (cached properties are computed): a test's question, not a dispatch."""
 
     dimension: int
     vertices: np.ndarray
