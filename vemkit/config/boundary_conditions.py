@@ -367,19 +367,6 @@ def check_file_sides(scene, header) -> None:
             )
 
 
-def _loaded_edges(mesh, parts) -> np.ndarray:
-    """(E, 2) the edges of a side: its boundary edges (2D), the edges of its faces (3D)."""
-    if mesh.vertices.shape[1] == 2:
-        return parts
-    faces = np.asarray(parts, dtype=np.int64)
-    sizes = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
-    ids = mesh.face_vertex_ids(faces)
-    start = np.repeat(np.cumsum(sizes) - sizes, sizes)
-    following = np.arange(ids.shape[0]) + 1
-    following[np.cumsum(sizes) - 1] = start[np.cumsum(sizes) - 1]  # the last vertex closes the face
-    return np.stack([ids, ids[following]], axis=1)
-
-
 def check_expressions_on_mesh(scene, mesh) -> None:
     """Every expression finite at the vertices where it acts (a pole at a vertex that the probes
     before meshing missed, or any point of a mesh file's body): tractions and pressures on their
@@ -390,10 +377,9 @@ def check_expressions_on_mesh(scene, mesh) -> None:
     for side in scene.neumann_sides:
         if side not in mesh.boundary:
             continue  # the problem names the missing side
-        parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
-        on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else mesh.face_vertex_ids(parts))
+        on_side = mesh.boundary_vertices(side)  # vemkit.mesh.interface: any dimension
         pressure = scene.pressure(side)
-        edges = _loaded_edges(mesh, parts)
+        edges = mesh.side_edges(side)  # its edges (2D), the sides of its faces (3D)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))
             # and between the vertices: a pole inside an edge (3D: on the faces' edges, where a
