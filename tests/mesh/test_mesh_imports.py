@@ -95,7 +95,19 @@ def test_the_function_level_imports_are_seen():
     modules = _mesh_modules()
     graph = {m: imported_mesh_modules(m, p, modules) for m, p in modules.items()}
     assert "vemkit.mesh.families.by_name" in graph["vemkit.mesh.families3d.build"]
-    assert {"vemkit.mesh.families.by_name", "vemkit.mesh.families3d.build"} <= graph["vemkit.mesh.meshing"]
+
+
+def test_the_modules_meshing_imports_by_name_do_not_import_it():
+    """meshing imports each dimension's functions on first use (a 2D command loads no 3D module): none
+    of those modules may import meshing, directly or through others (that would be a cycle)."""
+    from vemkit.mesh.meshing import BY_DIMENSION
+
+    modules = _mesh_modules()
+    graph = {m: imported_mesh_modules(m, p, modules) for m, p in modules.items()}
+    named = {module for role in BY_DIMENSION.values() for module, _ in role.values()}
+    assert {"vemkit.mesh.families.by_name", "vemkit.mesh.families3d.build", "vemkit.mesh.files3d"} <= named
+    graph["vemkit.mesh.meshing"] = graph["vemkit.mesh.meshing"] | named
+    assert import_cycles(graph) == []
 
 
 def test_no_import_cycle_in_vemkit_mesh():
