@@ -26,14 +26,27 @@ def vtu_arrays(path):
     """Every DataArray of a binary VTU file (UInt64 headers), decoded independently of vemkit."""
     import base64
     import re
+    import zlib
 
     kinds = {"Float64": np.float64, "Int64": np.int64, "UInt8": np.uint8}
+    text_of_file = path.read_text()
+    compressed = 'compressor="vtkZLibDataCompressor"' in text_of_file
     out = {}
-    for kind, name, text in re.findall(
-        r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>', path.read_text()
-    ):
-        raw = base64.b64decode(text)
-        out[name] = np.frombuffer(raw[8 : 8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
+    for kind, name, text in re.findall(r'<DataArray type="(\w+)" Name="(\w+)"[^>]*>([^<]*)</DataArray>', text_of_file):
+        if not compressed:
+            raw = base64.b64decode(text)
+            out[name] = np.frombuffer(raw[8 : 8 + int(np.frombuffer(raw[:8], np.uint64)[0])], kinds[kind])
+            continue
+        blocks = int(np.frombuffer(base64.b64decode(text[:12])[:8], np.uint64)[0])  # 8 bytes: 12 base64 characters
+        size = 8 * (3 + blocks)
+        header_chars = 4 * ((size + 2) // 3)
+        header = np.frombuffer(base64.b64decode(text[:header_chars])[:size], np.uint64)
+        data = base64.b64decode(text[header_chars:])
+        parts, at = [], 0
+        for packed in header[3 : 3 + blocks]:
+            parts.append(zlib.decompress(data[at : at + int(packed)]))
+            at += int(packed)
+        out[name] = np.frombuffer(b"".join(parts), kinds[kind])
     return out
 
 

@@ -23,7 +23,7 @@ __version__ = "0.1.0"
 _API = {
     "Mesh": "vemkit.mesh.mesh",
     "build_mesh": "vemkit.mesh.families",
-    "scene_mesh": "vemkit.mesh.families",
+    "scene_mesh": "vemkit.mesh.meshing",
     "validate_mesh": "vemkit.mesh.checks",
     "load_scene": "vemkit.config.scene",
     "VirtualElementSpace": "vemkit.vem.space",

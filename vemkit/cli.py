@@ -263,7 +263,8 @@ def _family_mesh(args):
     estimate = estimate_resources(*estimate_mesh(options))  # before anything is built
     family, n = options.pop("family"), options.pop("n")
     check_resources(estimate, args.max_dofs, what=f"the {family} mesh with N = {n}", fix="a smaller N")
-    from vemkit.mesh.families import build_mesh, checked_mesh
+    from vemkit.mesh.families import build_mesh
+    from vemkit.mesh.meshing import checked_mesh
 
     return checked_mesh(build_mesh(family, n, **options), f"the {family} mesh with N = {n}", "try another N"), family
 
@@ -282,7 +283,7 @@ def _scene_mesh(args):
     if scene.mesh_file is not None:  # never write over the mesh file the scene reads
         _outputs(args, [args.scene, scene.mesh_file])
     _check_resources(scene, args.max_dofs)
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh.meshing import scene_mesh
 
     return scene_mesh(scene), scene.mesh_options.get("family", "file")
 

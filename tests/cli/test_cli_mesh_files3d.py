@@ -22,8 +22,7 @@ from test_gmsh_files import QUADS, gmsh_v2  # noqa: E402
 
 from vemkit.mesh.families import build_mesh  # noqa: E402
 from vemkit.mesh.families3d.grid import hex  # noqa: E402
-from vemkit.mesh.files import write_ugrid  # noqa: E402
-from vemkit.mesh.files3d import write_ugrid3d  # noqa: E402
+from vemkit.mesh.ugrid import write_ugrid  # noqa: E402
 
 ADDRESS_SPACE = 4 << 30  # each run's limit: a regression is a failed run, not a swapping machine
 PEAK_BYTES = 1 << 30  # a refusal's peak resident memory (before the fix: 1.9-6.3 GB)
@@ -107,7 +106,7 @@ def _files(folder: Path) -> None:
     (folder / "plane.msh").write_text(plane)
     (folder / "plane_nameless.msh").write_text(gmsh_v2({"quad": QUADS}, names=False))
     write_ugrid(build_mesh("square", 2), folder / "plane.nc")
-    write_ugrid3d(hex(shape=(2, 2, 2)), folder / "good.nc")
+    write_ugrid(hex(shape=(2, 2, 2)), folder / "good.nc")
     for name, grow in {
         "face_rows.nc": {"mesh3d_nFaces": 100_000_000},
         "face_columns.nc": {"mesh3d_nMax_face_nodes": 10_000_000},
@@ -150,22 +149,23 @@ CASES = {
     "overlapping cubes": (scene3d("overlap.msh"), "overlap.msh: cells overlap: the point"),
     "3D gmsh in a 2D scene": (
         scene2d("good.msh"),
-        "good.msh: is a 3D mesh (it has volumes) but the scene is 2D; set model: 3d",
+        "good.msh: is a 3D mesh but the scene is written for 2D (boundary.dirichlet.left has 2 components); "
+        "give a 2D mesh file, or 3 components in every vector of the scene",
     ),
-    "3D gmsh 4 in a 2D scene": (scene2d("good4.msh"), "good4.msh: is a 3D mesh (it has volumes)"),
+    "3D gmsh 4 in a 2D scene": (scene2d("good4.msh"), "good4.msh: is a 3D mesh but the scene is written for 2D"),
     "3D gmsh without names in a 2D scene": (scene2d("nameless.msh", "untagged"), "nameless.msh: is a 3D mesh"),
     "2D gmsh in a 3D scene": (
         scene3d("plane.msh", "clamped"),
-        "side 'clamped' is a physical line in the mesh file plane.msh: the file is a 2D mesh but the scene is 3D; "
-        "remove model: 3d",
+        "model = '3d' does not fit the body: the mesh file plane.msh is 2D; the models of a 2D body: "
+        "plane_stress (the default), plane_strain",
     ),
     "2D gmsh without names in a 3D scene": (
         scene3d("plane_nameless.msh", "untagged"),
-        "plane_nameless.msh: is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; remove model: 3d",
+        "model = '3d' does not fit the body: the mesh file plane_nameless.msh is 2D",
     ),
     "2D UGRID in a 3D scene": (
         scene3d("plane.nc", "bottom"),
-        "plane.nc: is a 2D mesh (UGRID mesh2d) but the scene is 3D",
+        "model = '3d' does not fit the body: the mesh file plane.nc is 2D",
     ),
 }
 

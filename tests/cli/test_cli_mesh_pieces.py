@@ -12,8 +12,8 @@ import numpy as np
 
 from vemkit.config.domain3d import Box
 from vemkit.mesh.families3d.build import build_mesh3d
-from vemkit.mesh.files3d import write_ugrid3d
 from vemkit.mesh.polyhedral import PolyhedralMesh
+from vemkit.mesh.ugrid import write_ugrid
 
 FIX = "prescribe a side on that piece in boundary.dirichlet, or remove the piece from the mesh"
 
@@ -98,7 +98,7 @@ def _two_boxes() -> PolyhedralMesh:
 
 def test_a_3d_piece_held_by_nothing_is_named_and_refused(tmp_path):
     mesh = _two_boxes()
-    write_ugrid3d(mesh, tmp_path / "m.nc")
+    write_ugrid(mesh, tmp_path / "m.nc")
     n = mesh.n_cells // 2
     text = (
         "name: two3d\nmodel: 3d\nmaterial: {E: 1000, nu: 0.3}\nbody_force: [0, 0, -1]\n"

@@ -148,7 +148,7 @@ def test_cut_cells_at_a_circular_hole_are_split_with_every_new_vertex_on_the_cir
     cut cells that wrap its corners; vertices moved onto the circle dent them until neither centroid
     nor vertex mean sees every edge. Every refinement splits them from a kernel point instead."""
     from vemkit.config.scene import load_scene
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh import scene_mesh
     from vemkit.studies.adaptivity import curved_sides
 
     scene = load_scene(

@@ -199,7 +199,7 @@ def test_gmsh_3d_errors(tmp_path):
         read_mesh3d(gmsh_file(tmp_path, mesh.vertices, "hexahedron", cells, {"bad": interior}, "gmsh22"))
     tri = tmp_path / "flat.msh"
     meshio.Mesh(np.eye(3), [("triangle", np.array([[0, 1, 2]]))]).write(tri, file_format="gmsh22", binary=False)
-    with pytest.raises(MeshError, match="flat.msh: is a 2D mesh .* remove model: 3d"):
+    with pytest.raises(MeshError, match="flat.msh: is a 2D mesh .* give a 3D mesh file"):
         read_mesh3d(tri)
     (tmp_path / "junk.msh").write_text("$MeshFormat\nnonsense\n")
     with pytest.raises(MeshError, match="junk.msh: cannot be read as gmsh"):

@@ -124,7 +124,7 @@ def test_the_warm_start_finds_the_same_solutions_with_far_fewer_uzawa_iterations
 
 
 def test_a_circular_hole_is_refined_on_the_circle_and_every_mesh_is_valid():
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh import scene_mesh
 
     scene = scene_from_dict(
         {

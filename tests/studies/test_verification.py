@@ -66,7 +66,7 @@ def test_contact_half_width_is_exact_for_a_square_root_edge():
 
 def test_boundary_value_is_exact_for_an_affine_field():
     scene = V.case_scene("cook", SCENES / "cook.yaml", "voronoi", 4.0)
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh import scene_mesh
 
     mesh = scene_mesh(scene)
     u = np.stack([0.3 * mesh.vertices[:, 0] - 2.0, 1.5 + 0.25 * mesh.vertices[:, 1] - 0.1 * mesh.vertices[:, 0]], 1)

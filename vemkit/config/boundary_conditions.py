@@ -355,7 +355,7 @@ def check_file_sides(scene, header) -> None:
                 raise SceneError(
                     f"boundary.{part}: side {side!r} is a physical {'line' if three_d else 'surface'} in the mesh "
                     f"file {scene.mesh_options['file']}: the file is a {'2D' if three_d else '3D'} mesh but the "
-                    f"scene is {'3D' if three_d else '2D'}; {'remove model: 3d' if three_d else 'set model: 3d'}",
+                    f"scene is {'3D' if three_d else '2D'}; give a {'3D' if three_d else '2D'} mesh file",
                     key=f"boundary.{part}",
                 )
             listed = ", ".join(header.sides) or "none"
@@ -365,19 +365,6 @@ def check_file_sides(scene, header) -> None:
                 "or the file",
                 key=f"boundary.{part}",
             )
-
-
-def _loaded_edges(mesh, parts) -> np.ndarray:
-    """(E, 2) the edges of a side: its boundary edges (2D), the edges of its faces (3D)."""
-    if mesh.vertices.shape[1] == 2:
-        return parts
-    faces = np.asarray(parts, dtype=np.int64)
-    sizes = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
-    ids = mesh.face_vertex_ids(faces)
-    start = np.repeat(np.cumsum(sizes) - sizes, sizes)
-    following = np.arange(ids.shape[0]) + 1
-    following[np.cumsum(sizes) - 1] = start[np.cumsum(sizes) - 1]  # the last vertex closes the face
-    return np.stack([ids, ids[following]], axis=1)
 
 
 def check_expressions_on_mesh(scene, mesh) -> None:
@@ -390,10 +377,9 @@ def check_expressions_on_mesh(scene, mesh) -> None:
     for side in scene.neumann_sides:
         if side not in mesh.boundary:
             continue  # the problem names the missing side
-        parts = mesh.boundary[side]  # 2D: edges (vertex pairs); 3D: face numbers
-        on_side = np.unique(parts if mesh.vertices.shape[1] == 2 else mesh.face_vertex_ids(parts))
+        on_side = mesh.boundary_vertices(side)  # vemkit.mesh.interface: any dimension
         pressure = scene.pressure(side)
-        edges = _loaded_edges(mesh, parts)
+        edges = mesh.side_edges(side)  # its edges (2D), the sides of its faces (3D)
         for expression in (pressure,) if pressure is not None else scene.traction(side):
             evaluate_checked(expression, tuple(c[on_side] for c in coordinates))
             # and between the vertices: a pole inside an edge (3D: on the faces' edges, where a

@@ -65,7 +65,38 @@ def body_dimension(data: dict, source: str | None = None) -> tuple[int, str]:
             "with a mesh file the file is the body: drop domain or give a 3D mesh file",
             key="domain",
         )
+    if data.get("model") is None:
+        _check_vectors_fit(data, dimension, name)
     return dimension, f"the mesh file {name}"
+
+
+def _scene_vectors(data: dict):
+    """(key, vector) of every vector the scene writes: body force, Dirichlet values, tractions, exact field."""
+    if isinstance(data.get("body_force"), list):
+        yield "body_force", data["body_force"]
+    boundary = data.get("boundary", {})
+    dirichlet = boundary.get("dirichlet", {})
+    for side, value in dirichlet.items() if isinstance(dirichlet, dict) else ():
+        yield f"boundary.dirichlet.{side}", value
+    for side, load in (boundary.get("neumann") or {}).items():
+        if isinstance(load, dict) and isinstance(load.get("traction"), list):
+            yield f"boundary.neumann.{side}.traction", load["traction"]
+    exact = (data.get("exact") or {}).get("displacement")
+    if isinstance(exact, list):
+        yield "exact.displacement", exact
+
+
+def _check_vectors_fit(data: dict, dimension: int, name: str) -> None:
+    """A scene without ``model`` whose mesh file is the body: its vectors must have the file's
+    dimension; the first that does not says which dimension the scene was written for."""
+    for key, vector in _scene_vectors(data):
+        if isinstance(vector, list) and len(vector) in (2, 3) and len(vector) != dimension:
+            raise SceneError(
+                f"{name}: is a {dimension}D mesh but the scene is written for {len(vector)}D ({key} has "
+                f"{len(vector)} components); give a {len(vector)}D mesh file, or {dimension} components "
+                f"in every vector of the scene",
+                key=key,
+            )
 
 
 def fill_model(data: dict, source: str | None = None) -> int:

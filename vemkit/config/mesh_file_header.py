@@ -142,7 +142,7 @@ def mesh_file_dimension(path) -> int | None:
         return None
     try:
         size = os.fstat(fd).st_size
-        return _gmsh_dimension(fd, size) if path.suffix == ".msh" else _ugrid_dimension(path)
+        return _gmsh_file_dimension(fd, size) if path.suffix == ".msh" else _ugrid_dimension(path)
     except (MeshError, OSError, ValueError, IndexError, struct.error, UnicodeError):
         return None
     finally:
@@ -160,7 +160,8 @@ def _ugrid_dimension(path: Path) -> int | None:
         return int(value) if value in ("2", "3") else None
 
 
-def _gmsh_dimension(fd: int, size: int) -> int | None:
+def _gmsh_file_dimension(fd: int, size: int) -> int | None:
+    """The body's dimension by the file's format line, entities, physical names or (text gmsh 2) element types."""
     start = _read_at(fd, 0, 4096)
     match = re.search(rb"(?m)^\$MeshFormat\r?\n([^\n]*)\n", start)
     if match is None:
@@ -265,8 +266,8 @@ def _gmsh_header(fd: int, path: Path, size: int, dimension: int = 2) -> MeshFile
 #: the refusal of a mesh file of the other dimension, by the dimension the file shows (the header's
 #: and the gmsh readers' words, after "<file>: ")
 OTHER_DIMENSION = {
-    3: "is a 3D mesh (it has volumes) but the scene is 2D; set model: 3d",
-    2: "is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; remove model: 3d, or give a 3D mesh file",
+    3: "is a 3D mesh (it has volumes) but the scene is 2D; give a 2D mesh file, or write the scene for a 3D body",
+    2: "is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; give a 3D mesh file, or drop model: 3d",
 }
 
 
@@ -369,7 +370,9 @@ def _ugrid_counts(nc, path: Path, size: int) -> MeshFileHeader:
     topology = topologies[0]
     coordinates = str(getattr(topology, "node_coordinates", "")).split()
     if str(getattr(topology, "topology_dimension", "2")) == "3":
-        raise _fail(path, "is a 3D mesh (mesh3d) but the scene is 2D; drop model or set model: 3d")
+        raise _fail(
+            path, "is a 3D mesh (mesh3d) but the scene is 2D; give a 2D mesh file, or write the scene for a 3D body"
+        )
     if len(coordinates) != 2:
         raise _fail(path, "cannot be read as UGRID netCDF: node_coordinates must name two variables (x y)")
     x, y = (_ugrid_variable(nc, name, path, "node coordinate", 1) for name in coordinates)
@@ -400,7 +403,7 @@ def _mesh3d_counts(nc, path: Path, size: int) -> MeshFileHeader:
     values: a 40 kB file can declare gigabytes)."""
     topologies = [v for v in nc.variables.values() if getattr(v, "cf_role", None) == "mesh_topology"]
     if len(topologies) == 1 and str(getattr(topologies[0], "topology_dimension", "2")) == "2":
-        raise _fail(path, "is a 2D mesh (UGRID mesh2d) but the scene is 3D; remove model: 3d, or give a 3D mesh file")
+        raise _fail(path, "is a 2D mesh (UGRID mesh2d) but the scene is 3D; give a 3D mesh file, or drop model: 3d")
     if len(topologies) != 1 or str(getattr(topologies[0], "topology_dimension", "")) != "3":
         raise _fail(
             path,

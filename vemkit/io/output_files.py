@@ -20,7 +20,6 @@
 from __future__ import annotations
 
 import os
-import re
 import secrets
 import signal
 import stat
@@ -30,6 +29,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from vemkit.exceptions import OutputError
+from vemkit.io.temporary_names import temporary_name
 
 __all__ = ["CREATED", "atomic_outputs", "deliver", "exit_on_signals", "output_target", "same_file", "shown"]
 
@@ -205,19 +205,6 @@ def _report(record: str) -> None:
     ``hold`` / ``free`` around the final write (a signal then waits for the writer)."""
     if REPORT_FD is not None:
         os.write(REPORT_FD, (record + "\n").encode("utf-8", "surrogateescape"))
-
-
-#: the longest name :func:`temporary_name` gives (a stem of 100 characters, the token, the dots):
-#: far below NAME_MAX (255 on Linux), so a target name up to NAME_MAX bytes has its temporary file
-TEMPORARY_STEM = 100
-TEMPORARY_NAME_MAX = 1 + TEMPORARY_STEM + 1 + 12 + len(".part")
-
-
-def temporary_name(name: str, token: str) -> str:
-    """``.NAME.TOKEN.part`` for a target called ``name``: ASCII (the netCDF library encodes names as
-    UTF-8: a target name that is not UTF-8 must not reach it) and at most TEMPORARY_NAME_MAX bytes
-    for a 12-character token, whatever the length of ``name`` (the stem is its first 100 characters)."""
-    return f".{re.sub(r'[^A-Za-z0-9._-]', '_', name[:TEMPORARY_STEM])}.{token}.part"
 
 
 def _temporary_next_to(target: Path) -> Path:

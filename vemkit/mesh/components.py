@@ -34,7 +34,7 @@ class MeshPieces:
     def point_in(self, mesh, piece: int) -> np.ndarray:
         """A point of the piece to name it by: the vertex mean of its cell nearest to the vertex mean
         of the whole piece (that mean itself may lie outside a piece that is not convex)."""
-        offsets, ids = _cell_vertex_csr(mesh)
+        offsets, ids = mesh.cell_vertex_lists
         cells = self.cells(piece)
         sizes = offsets[cells + 1] - offsets[cells]
         take = np.repeat(offsets[cells] - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
@@ -43,16 +43,10 @@ class MeshPieces:
         return centres[np.argmin(((centres - middle) ** 2).sum(axis=1))]
 
 
-def _cell_vertex_csr(mesh) -> tuple[np.ndarray, np.ndarray]:
-    if getattr(mesh, "dimension", 2) == 3:
-        return mesh.cell_vertex_lists
-    return mesh.cell_offsets, mesh.cell_vertices
-
-
 def mesh_pieces(mesh) -> MeshPieces:
-    """The pieces of ``mesh`` (a 2D :class:`~vemkit.mesh.mesh.Mesh` or a 3D
-    :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`): cells that share a vertex are in one piece."""
-    offsets, ids = _cell_vertex_csr(mesh)
+    """The pieces of ``mesh`` (any :class:`~vemkit.mesh.interface.MeshInterface`: its
+    ``cell_vertex_lists``): cells that share a vertex are in one piece."""
+    offsets, ids = mesh.cell_vertex_lists
     m, n = mesh.n_cells, mesh.n_vertices
     rows = np.repeat(np.arange(m, dtype=np.int64), np.diff(offsets))
     incidence = sp.csr_matrix((np.ones(ids.shape[0], dtype=np.int8), (rows, m + ids)), shape=(m + n, m + n))

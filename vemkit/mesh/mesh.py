@@ -9,7 +9,8 @@ A mesh is
   vertex pairs ``(a, b)`` in the counter-clockwise order in which they appear in their cell;
 - ``meta``: how the mesh was made (family, n, seed, ...), stored with every result.
 
-Derived topology (``edges``, ``edge_cells``, ...) is computed on demand and cached.
+Derived topology (``edges``, ``edge_cells``, ...) is computed on demand and cached. The members of
+:class:`~vemkit.mesh.interface.MeshInterface` (the facets are the edges) are among them, as in 3D.
 """
 
 from __future__ import annotations
@@ -21,11 +22,13 @@ import numba
 import numpy as np
 
 from vemkit.config.domain import UNIT_SQUARE_SIDE_LINES
-from vemkit.mesh.geometry import indexed_polygon_areas
+from vemkit.exceptions import MeshError
+from vemkit.mesh.geometry import areas_centroids, indexed_polygon_areas
+from vemkit.mesh.interface import SharedMeshMembers
 
 
 @dataclass(frozen=True, eq=False)
-class Mesh:
+class Mesh(SharedMeshMembers):
     vertices: np.ndarray
     cell_offsets: np.ndarray
     cell_vertices: np.ndarray
@@ -61,6 +64,11 @@ class Mesh:
     @cached_property
     def cell_sizes(self) -> np.ndarray:
         return np.diff(self.cell_offsets)
+
+    @property
+    def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (offsets, vertices) of every cell's vertices: ``(cell_offsets, cell_vertices)``, CCW."""
+        return self.cell_offsets, self.cell_vertices
 
     def cell(self, k: int) -> np.ndarray:
         return self.cell_vertices[self.cell_offsets[k] : self.cell_offsets[k + 1]]
@@ -154,9 +162,65 @@ class Mesh:
     def h(self) -> float:
         return float(self.cell_diameters.max()) if self.n_cells else 0.0
 
+    # -- the mesh interface (vemkit.mesh.interface): the facets are the edges -------------------
+    @cached_property
+    def facets(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (offsets, vertices) of the edges, each ``(a, b)`` as in ``edges``."""
+        return np.arange(0, 2 * self.edges.shape[0] + 1, 2, dtype=np.int64), self.edges.ravel()
+
+    @property
+    def facet_cells(self) -> np.ndarray:
+        """``edge_cells``: column 0 the cell in which the edge runs counter-clockwise (it points out of it)."""
+        return self.edge_cells
+
+    @cached_property
+    def cell_facet_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (``cell_offsets``, signed edges): a cell's half-edges in order, edge e where it runs as
+        in ``edges``, ``-(e + 1)`` where it runs the other way."""
+        forward = self.edge_first_half_edges[self.half_edge_edge] == np.arange(self.half_edge_edge.size)
+        return self.cell_offsets, np.where(forward, self.half_edge_edge, -self.half_edge_edge - 1)
+
+    @cached_property
+    def facet_vector_areas(self) -> np.ndarray:
+        """``(E, 2)``: the tangent b - a of every edge turned clockwise, |e| n_e (outward for column 0
+        of ``edge_cells``)."""
+        tangent = self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]]
+        return np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
+
+    @cached_property
+    def facet_centroids(self) -> np.ndarray:
+        """``(E, 2)`` edge midpoints."""
+        return 0.5 * (self.vertices[self.edges[:, 0]] + self.vertices[self.edges[:, 1]])
+
+    @property
+    def cell_volumes(self) -> np.ndarray:
+        """``cell_areas`` (signed; positive counter-clockwise)."""
+        return self.cell_areas
+
+    @cached_property
+    def cell_centroids(self) -> np.ndarray:
+        """``(M, 2)`` area centroids (``geometry.areas_centroids``, the shoelace formula)."""
+        return areas_centroids(self.vertices[self.cell_vertices], self.cell_offsets)[1]
+
+    @cached_property
+    def boundaries(self) -> dict:
+        """``{side: edge ids}``: the named sides' vertex pairs as indices into ``edges``; MeshError
+        naming the side of a pair that is no edge."""
+        out = {}
+        for name, pairs in self.boundary.items():
+            try:
+                out[name] = edge_indices(self, pairs)
+            except MeshError as error:
+                raise MeshError(f"boundary part {name!r}: {error}", key=name) from None
+        return out
+
     def boundary_vertices(self, name: str) -> np.ndarray:
         """Sorted unique vertices of a named boundary part."""
         return np.unique(self.boundary[name])
+
+    def side_edges(self, name: str) -> np.ndarray:
+        """``(k, 2)`` the edges of a named side as vertex pairs: its ``boundary`` entry."""
+        return self.boundary[name]
 
     def with_boundary(self, **parts) -> "Mesh":
         b = dict(self.boundary)
@@ -189,7 +253,8 @@ def tag_box_boundary(mesh: Mesh, lower=(0.0, 0.0), upper=(1.0, 1.0), tol=1e-12) 
 
 
 def edge_indices(mesh: Mesh, pairs) -> np.ndarray:
-    """Index in ``mesh.edges`` of every vertex pair (k, 2), in either orientation."""
+    """Index in ``mesh.edges`` of every vertex pair (k, 2), in either orientation; MeshError (a
+    ValueError) naming a pair that is no edge."""
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     nv = np.int64(mesh.n_vertices)
     keys = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * nv + np.maximum(mesh.edges[:, 0], mesh.edges[:, 1])
@@ -199,7 +264,7 @@ def edge_indices(mesh: Mesh, pairs) -> np.ndarray:
     found = order[pos] if keys.size else np.zeros(0, dtype=np.int64)
     if np.any(keys[found] != want):
         bad = pairs[np.flatnonzero(keys[found] != want)[0]]
-        raise ValueError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
+        raise MeshError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
     return found
 
 

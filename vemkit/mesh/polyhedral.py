@@ -12,7 +12,8 @@ A 3D mesh is
   outward);
 - ``meta``: how the mesh was made.
 
-Derived topology and geometry are computed on demand and cached.
+Derived topology and geometry are computed on demand and cached. The members of
+:class:`~vemkit.mesh.interface.MeshInterface` (the facets are the faces) are among them, as in 2D.
 """
 
 from __future__ import annotations
@@ -24,10 +25,11 @@ import numba
 import numpy as np
 
 from vemkit.mesh import polyhedral_kernels
+from vemkit.mesh.interface import SharedMeshMembers
 
 
 @dataclass(frozen=True, eq=False)
-class PolyhedralMesh:
+class PolyhedralMesh(SharedMeshMembers):
     vertices: np.ndarray
     face_offsets: np.ndarray
     face_vertices: np.ndarray
@@ -65,6 +67,21 @@ class PolyhedralMesh:
         sizes = self.face_offsets[faces + 1] - self.face_offsets[faces]
         start = np.repeat(self.face_offsets[faces] - np.cumsum(sizes) + sizes, sizes)
         return self.face_vertices[start + np.arange(int(sizes.sum()), dtype=np.int64)]
+
+    def boundary_vertices(self, name: str) -> np.ndarray:
+        """Sorted unique vertices of the faces of a named side."""
+        return np.unique(self.face_vertex_ids(self.boundary[name]))
+
+    def side_edges(self, name: str) -> np.ndarray:
+        """``(k, 2)`` the sides of a named side's faces as vertex pairs, face after face (an edge shared
+        by two of its faces appears twice)."""
+        faces = self.boundary[name]
+        sizes = self.face_offsets[faces + 1] - self.face_offsets[faces]
+        ids = self.face_vertex_ids(faces)
+        start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+        following = np.arange(ids.shape[0]) + 1
+        following[np.cumsum(sizes) - 1] = start[np.cumsum(sizes) - 1]  # the last vertex closes the face
+        return np.stack([ids, ids[following]], axis=1)
 
     def cell_face_list(self, c: int) -> np.ndarray:
         """The signed faces of cell c."""
@@ -137,6 +154,41 @@ class PolyhedralMesh:
     @property
     def h(self) -> float:
         return float(self.cell_diameters.max()) if self.n_cells else 0.0
+
+    # -- the mesh interface (vemkit.mesh.interface): the facets are the faces -------------------
+    facets = property(lambda self: (self.face_offsets, self.face_vertices), doc="CSR (offsets, vertices) of the faces")
+    facet_cells = property(lambda self: self.face_cells, doc="``face_cells``")
+    cell_facet_lists = property(lambda self: (self.cell_offsets, self.cell_faces), doc="CSR (offsets, signed faces)")
+    facet_vector_areas = property(lambda self: self.face_vector_areas, doc="``face_vector_areas``")
+    facet_centroids = property(lambda self: self.face_centroids, doc="``face_centroids``")
+    boundaries = property(lambda self: self.boundary, doc="``boundary``: {side: face ids}")
+
+    @cached_property
+    def cell_centroids(self) -> np.ndarray:
+        """``(M, 3)`` volume centroids: the pyramids from the cell's first vertex p over its outward faces,
+        of volumes w_F = (x_F - p) . |F| n_F / 3 (as ``cell_volumes``) and centroids p + 3/4 (x_F - p)."""
+        sign = np.where(self.cell_faces >= 0, 1.0, -1.0)
+        faces = np.where(self.cell_faces >= 0, self.cell_faces, -self.cell_faces - 1)
+        cells = np.repeat(np.arange(self.n_cells, dtype=np.int64), np.diff(self.cell_offsets))
+        first = self.cell_vertex_lists[1][self.cell_vertex_lists[0][:-1]] if self.n_cells else np.zeros(0, np.int64)
+        apex = self.vertices[first]
+        x = self.face_centroids[faces] - apex[cells]
+        weight = sign * np.einsum("ij,ij->i", x, self.face_vector_areas[faces]) / 3.0
+        volume = np.bincount(cells, weights=weight, minlength=self.n_cells)
+        moment = np.stack(
+            [np.bincount(cells, weights=weight * 0.75 * x[:, a], minlength=self.n_cells) for a in range(3)]
+        )
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return apex + moment.T / volume[:, None]
+
+    @cached_property
+    def edges(self) -> np.ndarray:
+        """``(E, 2)`` the sides of the faces, each once as (smaller, larger) vertex, in increasing order."""
+        offsets, ids = self.face_offsets, self.face_vertices
+        following = np.arange(1, ids.size + 1, dtype=np.int64)
+        following[offsets[1:][offsets[1:] > offsets[:-1]] - 1] = offsets[:-1][offsets[1:] > offsets[:-1]]
+        pairs = np.sort(np.stack([ids, ids[following]], axis=1), axis=1) if ids.size else np.zeros((0, 2), np.int64)
+        return np.unique(pairs, axis=0)
 
 
 @numba.njit(cache=True)

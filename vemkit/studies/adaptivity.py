@@ -33,7 +33,7 @@ from vemkit.contact.problem import DiscreteProblem, scene_problem
 from vemkit.exceptions import InputError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.curves import domain_curves
-from vemkit.mesh.families import checked_mesh, scene_mesh
+from vemkit.mesh.meshing import checked_mesh, scene_mesh
 from vemkit.mesh.refine import refine_cells
 from vemkit.mesh.triangulate import triangulate_cells
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve

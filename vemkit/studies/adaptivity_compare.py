@@ -178,7 +178,7 @@ def reference_dataset(scene, reference: dict, theta: float = 0.5, progress=None)
     same mesh: the common-refinement error of ``adaptivity_errors`` is exact on straight sides)."""
     import numpy as np
 
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh.meshing import scene_mesh
     from vemkit.mesh.refine import refine_cells
     from vemkit.studies.adaptivity import AdaptivitySettings, adapt, adaptive_dataset, curved_sides
     from vemkit.studies.scene_solve import solve_scene

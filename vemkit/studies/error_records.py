@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vemkit.io.output_files import temporary_name
 from vemkit.io.solution_file import read_solution
+from vemkit.io.temporary_names import temporary_name
 from vemkit.studies.solution_order import projected_solution_file, refuse_order2, require_order1, solution_order
 
 #: keys of one error record, with their meaning and units

@@ -176,7 +176,7 @@ def run_grid(scene, grid, *, reuse=True, time_budget=None, check_tol=DEFAULT_CHE
     progress(index, values, point) after each point.
     """
     from vemkit.contact.problem import scene_problem
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh.meshing import scene_mesh
 
     grid = normalize_grid(grid)
     keys = list(grid)

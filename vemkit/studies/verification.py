@@ -128,7 +128,7 @@ def free_boundary_stress(mesh, u: np.ndarray, side: str, point, window: float, E
     (σ_nn = σ_nt = 0 there), ε_tt the stretch of the chord between the side's two vertices farthest
     apart along the side within ``window`` of the point: (u_+ - u_-) · (x_+ - x_-) / |x_+ - x_-|²,
     exact for u_h along straight edges, O(window²) from the curvature of the field."""
-    verts = np.unique(mesh.boundary[side])
+    verts = mesh.boundary_vertices(side)
     x = mesh.vertices[verts]
     near = np.flatnonzero(np.linalg.norm(x - point, axis=1) <= window)
     if near.size < 2:

@@ -26,7 +26,7 @@ from vemkit.config.domain3d import (
     domain3d_from_spec,
 )
 from vemkit.exceptions import SceneError
-from vemkit.mesh.families import build_mesh
+from vemkit.mesh.families.by_name import build_mesh
 from vemkit.mesh.families3d.extrude import extrude
 from vemkit.mesh.families3d.gmsh_tet import delaunay_tet, delaunay_tet_extruded, n_for_cells, surface_area
 from vemkit.mesh.families3d.grid import hex, tet

@@ -149,7 +149,7 @@ def dirichlet_components(mesh, dirichlet):
     values = np.zeros((mesh.n_vertices, 3))
     items = dirichlet.items() if isinstance(dirichlet, dict) else ((side, (0.0, 0.0, 0.0)) for side in dirichlet)
     for side, components in items:
-        vs = np.unique(mesh.face_vertex_ids(mesh.boundary[side]))
+        vs = mesh.boundary_vertices(side)
         x, y, z = mesh.vertices[vs].T
         for k, g in enumerate(components):
             if g is None:

@@ -150,7 +150,7 @@ def dirichlet_components(mesh: Mesh, dirichlet) -> tuple[np.ndarray, np.ndarray]
     prescribed = np.zeros((mesh.n_vertices, 2), dtype=bool)
     values = np.zeros((mesh.n_vertices, 2))
     for side, components in entries:
-        vertices = np.unique(mesh.boundary[side])
+        vertices = mesh.boundary_vertices(side)
         x, y = mesh.vertices[vertices, 0], mesh.vertices[vertices, 1]
         for c, component in enumerate(components):
             if component is None:
