@@ -61,7 +61,7 @@ def _timed(call):
 def run_case(family: str, n: int) -> dict:
     from vemkit.config.scene import load_scene
     from vemkit.contact.problem import scene_problem
-    from vemkit.mesh.families import scene_mesh
+    from vemkit.mesh import scene_mesh
     from vemkit.solvers.dispatch import solve
     from vemkit.solvers.verification import verify_solution
     from vemkit.studies.scene_solve import check_tolerance

@@ -28,8 +28,8 @@ from vemkit.contact.laws import ContactLaw, FoundationLaw, contact_law
 from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
 from vemkit.exceptions import SceneError
 from vemkit.mesh.components import mesh_pieces
-from vemkit.mesh.families import scene_mesh
 from vemkit.mesh.mesh import Mesh
+from vemkit.mesh.meshing import scene_mesh
 from vemkit.vem.condensation import condense_load, interior_load, recover_interior
 from vemkit.vem.dofs import DofMap, apply_fixed_dofs
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes

@@ -23,7 +23,6 @@ from vemkit.mesh.families.voronoi import voronoi
 
 # scene_mesh and checked_mesh live in vemkit.mesh.meshing (public: vemkit.mesh); importable from here
 # until vemkit.contact.problem imports them from there, then this line goes
-from vemkit.mesh.meshing import checked_mesh, scene_mesh  # noqa: F401
 
 __all__ = [
     "FAMILIES",
