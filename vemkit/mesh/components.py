@@ -48,8 +48,12 @@ def mesh_pieces(mesh) -> MeshPieces:
     ``cell_vertex_lists``): cells that share a vertex are in one piece."""
     offsets, ids = mesh.cell_vertex_lists
     m, n = mesh.n_cells, mesh.n_vertices
-    rows = np.repeat(np.arange(m, dtype=np.int64), np.diff(offsets))
-    incidence = sp.csr_matrix((np.ones(ids.shape[0], dtype=np.int8), (rows, m + ids)), shape=(m + n, m + n))
+    # the incidence matrix as CSR straight from the cell lists (cell c's row holds m + its vertices; the
+    # vertices' rows are empty, the graph is taken undirected): no COO sort (0.35 s at 1e6 cells)
+    index = np.int32 if m + n + ids.shape[0] < 2**31 else np.int64  # csgraph's own index type: no copies
+    row_starts = np.concatenate([offsets, np.full(n, offsets[-1], dtype=offsets.dtype)]).astype(index)
+    columns = (ids + m).astype(index)
+    incidence = sp.csr_matrix((np.ones(ids.shape[0], dtype=np.int8), columns, row_starts), shape=(m + n, m + n))
     _, labels = connected_components(incidence, directed=False)
     cell_labels = labels[:m]
     # number the pieces in the order of their first cell
