@@ -32,7 +32,6 @@ def run(n: int) -> dict:
     from vemkit.mesh.families3d import build_mesh3d
     from vemkit.solvers.linear import AMGSolver
     from vemkit.vem.elasticity import rigid_body_modes
-    from vemkit.vem.elements.k1_3d_fields import face_vertex_ids
     from vemkit.vem.space import VirtualElementSpace
 
     seconds, cpu = {}, {}
@@ -47,7 +46,7 @@ def run(n: int) -> dict:
     mesh = step("mesh", lambda: build_mesh3d("hex", CUBE, n=n))
     space = VirtualElementSpace(mesh, 1)
     clamped = np.zeros(space.n_nodes, dtype=bool)
-    clamped[face_vertex_ids(mesh, mesh.boundary["bottom"])] = True
+    clamped[mesh.boundary_vertices("bottom")] = True
     dofs = space.numbering(clamped)
     K = step("assembly", lambda: space.stiffness_matrix(LAM, MU, "dofi-2mu", dofs))
     top = mesh.boundary["top"]
