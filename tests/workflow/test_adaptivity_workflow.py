@@ -4,30 +4,19 @@ scenes added by name and skipped when their file is missing, bad settings refuse
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
+from snakemake_runs import dry_run as run_dry
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = yaml.safe_load((ROOT / "config" / "adaptivity.yaml").read_text())["adaptivity_study"]
 
 
 def dry_run(*args) -> subprocess.CompletedProcess:
-    exe = Path(sys.executable).with_name("snakemake")
-    exe = str(exe) if exe.exists() else shutil.which("snakemake")
-    if exe is None:
-        pytest.skip("snakemake is not installed")
-    return subprocess.run(
-        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return run_dry(*args, cores=2)
 
 
 def planned(*args) -> dict:

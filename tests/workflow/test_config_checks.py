@@ -9,13 +9,11 @@ problem and the fix. Dry runs only: nothing is built.
 from __future__ import annotations
 
 import re
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
+from snakemake_runs import dry_run
 
 from vemkit.exceptions import WorkflowConfigError
 from vemkit.studies.workflow_config import config_source
@@ -24,20 +22,6 @@ ROOT = Path(__file__).resolve().parents[2]
 #: Snakemake's own notice for every --configfile; not an error line
 NOTICE = re.compile(r"^Config file \S+ is extended by additional config specified via the command line\.$")
 TINY_SWEEP = {"overrides": ["discretization.mesh.n=2"], "grid": {"contact.normal.k": [1.0]}}
-
-
-def dry_run(*args) -> subprocess.CompletedProcess:
-    exe = Path(sys.executable).with_name("snakemake")
-    exe = str(exe) if exe.exists() else shutil.which("snakemake")
-    if exe is None:
-        pytest.skip("snakemake is not installed")
-    return subprocess.run(
-        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "1", *args],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
 
 
 def error_lines(run) -> list[str]:

@@ -5,13 +5,12 @@ refused naming the key."""
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
+from snakemake_runs import dry_run as run_dry
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((ROOT / "config" / "three_d.yaml").read_text())
@@ -19,17 +18,7 @@ THREE_D = CONFIG["three_d"]
 
 
 def dry_run(*args) -> subprocess.CompletedProcess:
-    exe = Path(sys.executable).with_name("snakemake")
-    exe = str(exe) if exe.exists() else shutil.which("snakemake")
-    if exe is None:
-        pytest.skip("snakemake is not installed")
-    return subprocess.run(
-        [exe, "--dry-run", "--forceall", "--nolock", "--cores", "2", *args],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return run_dry(*args, cores=2)
 
 
 def planned(*args) -> dict:
