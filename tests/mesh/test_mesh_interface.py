@@ -6,6 +6,7 @@ normal, the volume and the centroid of the body are known."""
 
 import numpy as np
 import pytest
+from test_domains import BRACKET  # a re-entrant corner, a circular hole and a triangular one
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.families import build_mesh
@@ -144,17 +145,6 @@ def test_meshes_read_from_files_have_the_interface(tmp_path):
         assert isinstance(read, MeshInterface) and read.dimension == mesh.dimension
         assert read.cell_volumes.sum() == pytest.approx(mesh.cell_volumes.sum(), rel=1e-12)
         assert {k: v.size for k, v in read.boundaries.items()} == {k: v.size for k, v in mesh.boundaries.items()}
-
-
-# a body with a re-entrant corner, a circular hole and a triangular one (tests/mesh/test_domains.py)
-BRACKET = {
-    "polygon": [[0, 0], [3, 0], [3, 1], [1.2, 1], [1.2, 2], [0, 2]],
-    "sides": ["bottom", "right", "shelf", "step", "top", "left"],
-    "holes": [
-        {"circle": [0.6, 0.6, 0.25], "side": "bore"},
-        {"polygon": [[2.0, 0.3], [2.2, 0.7], [2.5, 0.3]], "sides": ["slot_a", "slot_b", "slot_c"]},
-    ],
-}
 
 
 def _boundary_volume(mesh) -> float:

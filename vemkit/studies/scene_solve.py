@@ -39,8 +39,15 @@ def check_tolerance(solver_options: dict) -> float:
 def checked(problem, solution, solver_options) -> dict:
     """The independent check at :func:`check_tolerance`, recorded and not enforced:
     {check_worst, check_tolerance} (the Python API's Dataset; :func:`verified` enforces it)."""
+    return _check_record(*_independent_check(problem, solution, solver_options))
+
+
+def _independent_check(problem, solution, solver_options) -> tuple[dict, float]:
     tol = check_tolerance(solver_options)
-    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
+    return verify_solution(problem, solution.u, solution.multiplier, tol), tol
+
+
+def _check_record(checks: dict, tol: float) -> dict:
     return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
 
 
@@ -54,8 +61,7 @@ def check_advice(method: str) -> str:
 def verified(problem, solution, solver_options, where: str = "", source: str = " (from solver.tol)") -> dict:
     """The independent check at :func:`check_tolerance`: {check_worst, check_tolerance}, or a
     VerificationError whose message says ``where`` the solve was (e.g. " on the 96-cell adapted mesh")."""
-    tol = check_tolerance(solver_options)
-    checks = verify_solution(problem, solution.u, solution.multiplier, tol)
+    checks, tol = _independent_check(problem, solution, solver_options)
     if not checks["passed"]:
         worst = max(CHECK_KEYS, key=lambda k: checks[k])
         raise VerificationError(
@@ -64,7 +70,7 @@ def verified(problem, solution, solver_options, where: str = "", source: str = "
             solver=solution.method,
             iterations=solution.iterations,
         )
-    return {"check_worst": float(checks["worst"]), "check_tolerance": tol}
+    return _check_record(checks, tol)
 
 
 def mesh_family(mesh) -> str:
