@@ -193,3 +193,25 @@ def test_one_contact_boundary_and_one_solver_stack_for_both_dimensions(layer):
     graph = _import_graph()
     cycles = [c for m in graph if m.startswith(f"vemkit.{layer}") and (c := _cycle_through(graph, m))]
     assert not cycles, f"import cycles: {cycles[:3]}"
+
+
+def test_at_most_eight_branches_on_the_dimension_outside_the_mesh_and_the_elements():
+    """Issue 34: the dimension is a parameter; the per-dimension code lives in mesh/ and
+    vem/elements/ (the count's rules: tests/dimension_branches.py)."""
+    sys.path.insert(0, str(PACKAGE.parent / "tests"))
+    from dimension_branches import dimension_branches
+
+    branches = dimension_branches()
+    assert len(branches) <= 8, f"{len(branches)} branches on the dimension: {branches}"
+
+
+@pytest.mark.parametrize("layer", ["contact", "io", "solvers", "report"])
+def test_no_3d_twin_of_a_module(layer):
+    twins = sorted(str(p.relative_to(PACKAGE)) for p in (PACKAGE / layer).rglob("*3d*"))
+    assert not twins, f"3D twins of modules: {twins}"
+
+
+def test_no_import_cycle_anywhere_in_the_package():
+    graph = _import_graph()
+    cycles = [c for m in graph if (c := _cycle_through(graph, m))]
+    assert not cycles, f"import cycles: {cycles[:3]}"
