@@ -117,7 +117,7 @@ def cmd_solve(args) -> int:
     _check_resources(scene, args.max_dofs)  # before anything is built
 
     from vemkit.io.output_files import atomic_outputs
-    from vemkit.io.solution_file import check_finite, write_file
+    from vemkit.io.solution_file import check_finite, write_file, write_solution_vtu
     from vemkit.studies.scene_solve import solve_scene
 
     progress = _Progress(not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
@@ -129,7 +129,7 @@ def cmd_solve(args) -> int:
     with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_file(ds, output_part)
         if vtu_part is not None:
-            _write_solution_vtu(problem, solution, ds, vtu_part)
+            write_solution_vtu(problem, solution, ds, vtu_part)
     if not args.quiet:
         print(
             f"{_name(args.output)}: {solved_how(problem, solution)}, "
@@ -151,54 +151,34 @@ def solved_how(problem, solution) -> str:
 
 def _check_resources(scene, max_dofs):
     """The predicted cells, DOFs and memory of the scene's solve, refused beyond the limits."""
-    if scene.dimension == 3:
-        from vemkit.mesh.families3d.resources import check_scene_resources3d
-
-        return check_scene_resources3d(scene, max_dofs)
-    from vemkit.config.limits import check_scene_resources
+    from vemkit.mesh.meshing import of_dimension
     from vemkit.vem.elements import element_for
 
-    return check_scene_resources(scene, max_dofs, element_for(scene.order).layout)
-
-
-#: the cell fields of a solution's VTU file (2D, 3D)
-VTU_CELL_FIELDS = {
-    2: ("stress_11", "stress_22", "stress_12", "shear_energy_density"),
-    3: ("stress_11", "stress_22", "stress_33", "stress_12", "stress_13", "stress_23", "von_mises"),
-}
-
-
-def _write_solution_vtu(problem, solution, ds, path) -> None:
-    """The displacement at the vertices and the cell stresses as VTU (3D: VTK polyhedra, type 42)."""
-    from vemkit.mesh.vtu import write_vtu
-
-    dimension = problem.mesh.dimension
-    cells = {k: ds[k].values for k in VTU_CELL_FIELDS[dimension]}
-    write_vtu(problem.mesh, path, point_data={"displacement": problem.dofs.expand(solution.u)}, cell_data=cells)
+    layout = element_for(scene.order, scene.dimension).layout
+    return of_dimension("check_resources", scene.dimension)(scene, max_dofs, layout)
 
 
 def _adapt_inputs(args):
     """The scene, the adaptivity settings, the true-error measure and the output targets of ``adapt``."""
-    from vemkit.config.limits import check_scene_resources
     from vemkit.config.scene import load_scene
+    from vemkit.mesh.meshing import BY_DIMENSION
     from vemkit.studies.adaptivity import AdaptivitySettings
     from vemkit.studies.adaptivity_errors import reference_path, scene_true_error
-    from vemkit.vem.elements import element_for
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
-    if scene.dimension == 3:
+    refined = BY_DIMENSION["refine"]  # the dimensions whose meshes refine
+    if scene.dimension not in refined:
+        bodies = " and ".join(f"{d}D" for d in refined)
         raise InputError(
-            f"vemkit adapt: {args.scene} is a 3D scene (its body is 3D); adaptivity is for 2D bodies "
-            "(see docs/reference/files.md); solve it with vemkit solve",
+            f"vemkit adapt: {args.scene} is a {scene.dimension}D scene (its body is {scene.dimension}D); "
+            f"adaptivity is for {bodies} bodies (see docs/reference/files.md); solve it with vemkit solve",
             key="domain",
         )
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
     targets = _outputs(args, inputs)
-    check_scene_resources(
-        scene, args.max_dofs, element_for(scene.order).layout
-    )  # the first mesh; the loop keeps below max_dofs
+    _check_resources(scene, args.max_dofs)  # the first mesh; the loop keeps below max_dofs
     return scene, AdaptivitySettings.from_scene(scene, args.max_dofs), scene_true_error(scene), targets
 
 
@@ -334,16 +314,16 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="DOFS",
         help=f"refuse requests of more degrees of freedom (default {DEFAULT_MAX_DOFS:,})",
     )
-    solve = sub.add_parser("solve", help="solve a scene and write the solution as netCDF")
-    solve.add_argument("scene", help="scene YAML file (see config/scenes/paper.yaml)")
-    solve.add_argument("-o", "--output", required=True, help="solution file (netCDF4, UGRID)")
-    solve.add_argument(
-        "--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. solver.method=uzawa"
+    _scene_command(
+        sub.add_parser("solve", help="solve a scene and write the solution as netCDF"),
+        cmd_solve,
+        limit,
+        scene="scene YAML file (see config/scenes/paper.yaml)",
+        output="solution file (netCDF4, UGRID)",
+        example="solver.method=uzawa",
+        vtu="also write a VTU file for ParaView",
+        quiet="no progress display and no summary line",
     )
-    solve.add_argument("--vtu", help="also write a VTU file for ParaView")
-    solve.add_argument("--max-dofs", **limit)
-    solve.add_argument("-q", "--quiet", action="store_true", help="no progress display and no summary line")
-    solve.set_defaults(func=cmd_solve)
     mesh = sub.add_parser(
         "mesh", help="build a mesh (of a family on the unit square, or of a scene's body) and write it as UGRID netCDF"
     )
@@ -359,26 +339,32 @@ def build_parser() -> argparse.ArgumentParser:
     mesh.add_argument("--max-dofs", **limit)
     mesh.add_argument("-q", "--quiet", action="store_true")
     mesh.set_defaults(func=cmd_mesh)
-    adapt = sub.add_parser(
-        "adapt",
-        help="solve, estimate, mark and refine until the scene's adaptivity target; write the final "
-        "solution with the indicator and the history",
+    _scene_command(
+        sub.add_parser(
+            "adapt",
+            help="solve, estimate, mark and refine until the scene's adaptivity target; write the final "
+            "solution with the indicator and the history",
+        ),
+        cmd_adapt,
+        limit,
+        scene="scene YAML file; its adaptivity: block sets the loop (defaults filled in)",
+        output="final solution file (netCDF4, UGRID) with error_indicator and the adapt_* history",
+        example="adaptivity.target=0.05",
+        vtu="also write the final mesh with the displacement and the indicator (VTU)",
+        quiet="no progress lines and no summary line",
     )
-    adapt.add_argument("scene", help="scene YAML file; its adaptivity: block sets the loop (defaults filled in)")
-    adapt.add_argument(
-        "-o",
-        "--output",
-        required=True,
-        help="final solution file (netCDF4, UGRID) with error_indicator and the adapt_* history",
-    )
-    adapt.add_argument(
-        "--set", action="append", metavar="KEY=VALUE", help="override a scene value, e.g. adaptivity.target=0.05"
-    )
-    adapt.add_argument("--vtu", help="also write the final mesh with the displacement and the indicator (VTU)")
-    adapt.add_argument("--max-dofs", **limit)
-    adapt.add_argument("-q", "--quiet", action="store_true", help="no progress lines and no summary line")
-    adapt.set_defaults(func=cmd_adapt)
     return parser
+
+
+def _scene_command(command, func, limit: dict, *, scene, output, example, vtu, quiet) -> None:
+    """The arguments of a command that runs a scene (solve, adapt), with their help texts."""
+    command.add_argument("scene", help=scene)
+    command.add_argument("-o", "--output", required=True, help=output)
+    command.add_argument("--set", action="append", metavar="KEY=VALUE", help=f"override a scene value, e.g. {example}")
+    command.add_argument("--vtu", help=vtu)
+    command.add_argument("--max-dofs", **limit)
+    command.add_argument("-q", "--quiet", action="store_true", help=quiet)
+    command.set_defaults(func=func)
 
 
 MAX_MESSAGE = 1000  # characters of an error line: a 4000-character path or a list of cells is cut

@@ -89,7 +89,8 @@ class WorkflowConfigError(InputError):
         super().__init__(message, key=text or "(top level)")
 
 
-#: why a solve failed (``SolveError.reason``); the robustness study classifies by these
+#: why a solve failed (``SolveError.reason``); the robustness study classifies by these, in this order
+#: (its status codes, ``vemkit.solvers.verification.FAILURE_CLASSES``)
 SOLVE_FAILURE_REASONS = (
     "diverged",
     "stagnated",
@@ -97,8 +98,8 @@ SOLVE_FAILURE_REASONS = (
     "inaccurate_stop",
     "other",
     "time_budget",
-    "linear_solver_failed",
     "check_failed",
+    "linear_solver_failed",
 )
 
 

@@ -117,6 +117,11 @@ class ContactBoundary:
         return self.normal.shape[1]
 
     @property
+    def ball(self) -> ball.Disk:
+        """The unit ball of R^(d-1) the friction multiplier lives in (``vemkit.contact.ball``)."""
+        return ball.BALLS[self.dimension - 1]
+
+    @property
     def tangents(self) -> list:
         """The tangent basis per point, d - 1 vectors (n_c, d): [tau] in 2D, [t1, t2] in 3D."""
         return [self.tangent, self.tangent2][: self.dimension - 1]

@@ -133,12 +133,18 @@ def add_cell_fields(ds: FileDescription, topology: MeshTopology, problem, soluti
     ds.add(name, where, names.cell_scalar_of(sigma, problem), dict(cell, long_name=long_name, units="daN/mm2"))
 
 
-def as_written(values) -> np.ndarray:
-    """Contact-node values as the files hold them: a tangential quantity of a plane body (one
-    component, (n_c, 1)) as the 1-D variable of the file contract; (n_c, 2) in 3D and scalars as
-    they are. The one place where 2D's tangential column is squeezed."""
+#: a contact node's tangential quantity as the file holds it, per dimension: 2D's one component
+#: ((n_c, 1) in memory, ``vemkit.contact.ball``) is the 1-D variable along tau; 3D's two components
+#: are the dimension ``contact_tangent``
+TANGENTIAL_FILE_SHAPE = {2: (), 3: (2,)}
+
+
+def as_written(values, dimension: int) -> np.ndarray:
+    """Contact-node values as the files of a body of ``dimension`` hold them: a tangential quantity
+    ((n_c, d - 1)) in :data:`TANGENTIAL_FILE_SHAPE`, a scalar ((n_c,)) as it is."""
     data = np.asarray(values, dtype=float)
-    return data[:, 0] if data.ndim == 2 and data.shape[1] == 1 else data
+    tangential = data.ndim == 2
+    return data.reshape(data.shape[0], *TANGENTIAL_FILE_SHAPE[dimension]) if tangential else data
 
 
 def add_contact(ds: FileDescription, topology: MeshTopology, problem, solution) -> None:
@@ -163,7 +169,7 @@ def add_contact(ds: FileDescription, topology: MeshTopology, problem, solution) 
         "penetration": st.penetration,
     }
     for name, long_name, units in names.contact_variables:
-        data = as_written(values[name])[order]
+        data = as_written(values[name], topology.dimension)[order]
         dims = (c,) if data.ndim == 1 else (c, "contact_tangent")
         ds.add(name, dims, data, {"long_name": long_name, "units": units})
     for name, attribute in names.contact_frame:

@@ -7,7 +7,7 @@ read back (docs/reference/files.md).
 cell scalar, the contact boundary quantities (``contact_node``; :mod:`vemkit.io.solution_fields`),
 the solver history (``iteration``), and global attributes: the scene as YAML, solver, iterations,
 wall time, version. :func:`solution_dataset` is its xarray Dataset (the Python API, the studies)
-and :func:`write_file` writes either (the command line writes the description directly: no
+and :func:`write_file` writes either, :func:`write_solution_vtu` its VTU twin for ParaView (the command line writes the description directly: no
 xarray, no pandas at its start-up). ``write_netcdf`` refuses NaN and writes through a temporary
 file renamed over the target on success, so a failed or interrupted run leaves the target as it
 was. :func:`read_solution` reads either dimension back, as its topology variable says.
@@ -23,7 +23,7 @@ import numpy as np
 import vemkit
 from vemkit.exceptions import ResultError
 from vemkit.io.output_files import atomic_outputs
-from vemkit.io.solution_fields import add_cell_fields, add_contact, add_displacement, add_node_fields
+from vemkit.io.solution_fields import FIELD_NAMES, add_cell_fields, add_contact, add_displacement, add_node_fields
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.files import read_ugrid
 from vemkit.mesh.ugrid import mesh_topology, topology_dimension, topology_file
@@ -73,6 +73,16 @@ def with_solver_record(ds: FileDescription, problem, solution, scene_yaml: str, 
     )
     ds.attrs.update(extra_attrs or {})
     return ds
+
+
+def write_solution_vtu(problem, solution, ds: xr.Dataset | FileDescription, path) -> None:
+    """The displacement at the vertices and the cell stresses and cell scalar of the solution file
+    ``ds`` as VTU (3D: VTK polyhedra, type 42)."""
+    from vemkit.mesh.vtu import write_vtu
+
+    names = FIELD_NAMES[problem.mesh.dimension]
+    cells = {k: ds[k].values for k in [f"stress_{ij}" for ij in names.components] + [names.cell_scalar[0]]}
+    write_vtu(problem.mesh, path, point_data={"displacement": problem.dofs.expand(solution.u)}, cell_data=cells)
 
 
 def check_finite(ds: xr.Dataset | FileDescription, what: str = "result") -> None:

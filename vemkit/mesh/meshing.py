@@ -18,13 +18,20 @@ from typing import Any
 from vemkit.exceptions import MeshError
 
 #: role -> dimension -> (module, function): the mesh check, the mesh-file reader (it validates what it
-#: reads) and the family builder (family name, domain, size, options) of each dimension. Named, not
-#: imported: a 2D command never loads the 3D modules (their imports cost a fixed time per process,
+#: reads), the family builder (family name, domain, size, options) and the resource prediction of each
+#: dimension. Named, not imported: a 2D command never loads the 3D modules (their imports cost a fixed time per process,
 #: tests/cli/test_cli_imports.py); none of them imports this module, so there is no cycle either.
 BY_DIMENSION: dict[str, dict[int, tuple[str, str]]] = {
     "validate": {2: ("vemkit.mesh.checks", "validate_mesh"), 3: ("vemkit.mesh.checks3d", "validate_mesh3d")},
     "read": {2: ("vemkit.mesh.files", "read_mesh"), 3: ("vemkit.mesh.files3d", "read_mesh3d")},
     "build": {2: ("vemkit.mesh.families.by_name", "build_mesh"), 3: ("vemkit.mesh.families3d.build", "build_mesh3d")},
+    # the prediction of a scene's cells, DOFs and memory before its mesh is built (scene, max_dofs, layout)
+    "check_resources": {
+        2: ("vemkit.config.limits", "check_scene_resources"),
+        3: ("vemkit.mesh.families3d.resources", "check_scene_resources3d"),
+    },
+    # the refinement of marked cells with hanging vertices (vemkit adapt): plane meshes
+    "refine": {2: ("vemkit.mesh.refine", "refine_cells")},
 }
 
 

@@ -161,10 +161,8 @@ def solve_ssn(
         return _plain_solution(newton, u)
     _prepare(newton, t)
     # start: the plain linear solution and the multiplier its slip would need at the local stiffness
-    if cb.dimension == 2:  # (kd u_tau) / (w b_ref): the 2D order of the operations, kept bit for bit
-        trial = cb.times(newton.kd_tau, relative_slip(cb, u, slip_reference)) / (cb.weight * newton.b_ref)[:, None]
-    else:
-        trial = cb.times(newton.kd_tau / (cb.weight * newton.b_ref), relative_slip(cb, u, slip_reference))
+    slip = cb.tangential(relative_slip(cb, u, slip_reference))
+    trial = cb.ball.trial_multiplier(newton.kd_tau, slip, cb.weight * newton.b_ref)
     point = evaluate(newton, u, cb.project(trial))
     if initial is not None:
         warm = evaluate(newton, np.asarray(initial[0], float), cb.project(initial[1]))
@@ -230,8 +228,9 @@ def _plain_solution(newton, u):
 
 
 def _returned_multiplier(newton, point):
-    """(lambda, its move) of a converged point; 3D: in the disk and along the slip (ssn_point.final_multiplier)."""
-    if newton.problem.contact.dimension != 3:
+    """(lambda, its move) of a converged point: P(q) where the projection gives the slip's direction
+    (the interval, vemkit.contact.ball), else in the disk and along the slip (ssn_point.final_multiplier)."""
+    if newton.problem.contact.ball.direction_from_projection:
         return point.lam, 0.0
     return final_multiplier(newton, point)
 
@@ -271,7 +270,9 @@ def _prepare(newton, t):
     k_tau = law.friction_coefficient
     b_ref = k_tau if law.reduced else (float(np.max(b_lin)) if np.max(b_lin) > 0 else k_tau)
     newton.b_ref = b_ref if b_ref > 0.0 else 1.0
-    if cb.dimension == 3 and not law.reduced:  # Coulomb's coupled law: per-vertex gamma (ssn_point.coupled_gamma)
+    if not (
+        law.reduced or cb.ball.direction_from_projection
+    ):  # Coulomb's coupled law in the disk: ssn_point.coupled_gamma
         newton.gamma = coupled_gamma(newton.kd_tau, cb.weight, b_lin, newton.b_ref)
     else:
         newton.gamma = GAMMA_FACTOR[cb.dimension] * newton.kd_tau / (_gamma_length(cb) * newton.b_ref)
@@ -287,9 +288,10 @@ def _fall_back(newton):
 
 
 def _gamma_length(cb) -> float:
-    """L_C h^(d-2) of the module docstring: |Gamma_C| in 2D, sqrt(|Gamma_C| |Gamma_C| / n_c) in 3D."""
+    """L_C h^(d-2) of the module docstring, sqrt(|Gamma_C|^2 / n_c^(d-2)) with h ~ (|Gamma_C| / n_c)^(1/(d-1)):
+    |Gamma_C| in 2D (exactly: sqrt(a * a) = a in binary floating point), |Gamma_C| / sqrt(n_c) in 3D."""
     area = float(np.sum(cb.weight))
-    return area if cb.dimension == 2 else float(np.sqrt(area * area / cb.size))
+    return float(np.sqrt(area * area / cb.size ** (cb.dimension - 2)))
 
 
 def _newton_iteration(newton, point, k) -> Point:

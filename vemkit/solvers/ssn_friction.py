@@ -124,7 +124,7 @@ def _bound_slope(newton, point, sets, slip_base, J):
     problem = newton.problem
     K, cb, law, n = problem.stiffness, problem.contact, problem.law, problem.n_dofs
     bound, frictional, slip, stick, _ = sets
-    if cb.dimension == 2:  # lambda_hat = sign(q) at slip: the exact derivative; the term added last
+    if cb.ball.direction_from_projection:  # lambda_hat = sign(q) at slip: the exact derivative; the term added last
         lam_hat = np.where(slip, slip_base[:, 0], np.where(stick, point.lam[:, 0], 0.0))
         bound_slope = cb.weight * law.friction_bound_derivative(point.t) * lam_hat
         return newton.reduced.operator(K, J, rank_one_blocks(cb, bound_slope, cb.tangent, n, cb.normal))

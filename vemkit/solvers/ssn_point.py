@@ -78,7 +78,7 @@ def converged(newton, point) -> bool:
 
 def _converged(newton, point) -> bool:
     residual = np.sqrt(point.theta) / point.scale
-    if newton.problem.contact.dimension == 3:  # and the slip direction resolved (disk_alignment)
+    if not newton.problem.contact.ball.direction_from_projection:  # and the slip direction resolved (disk_alignment)
         residual = max(residual, disk_alignment(newton, point))
         # and lambda in the unit disk to tol, as the independent check asks: neither the weighted C nor
         # the rounding floor below sees |lambda| > 1 where w b is small against the body's forces

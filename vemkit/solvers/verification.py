@@ -46,21 +46,10 @@ from functools import cache
 
 import numpy as np
 
-from vemkit.exceptions import InputError, LinearSolveError, SolveError, TimeBudgetExceeded
+from vemkit.exceptions import SOLVE_FAILURE_REASONS, InputError, LinearSolveError, SolveError, TimeBudgetExceeded
 from vemkit.solvers.solution import contact_force_vector, contact_residual, relative_slip, residual_scale
 
-FAILURE_CLASSES = (
-    "diverged",
-    "stagnated",
-    "max_iterations",
-    "inaccurate_stop",
-    "other",
-    "time_budget",
-    "check_failed",
-    "linear_solver_failed",
-    "invalid_input",
-    "unexpected_exception",
-)
+FAILURE_CLASSES = SOLVE_FAILURE_REASONS + ("invalid_input", "unexpected_exception")
 _NOT_CONVERGED = FAILURE_CLASSES[:7]
 #: status code i <-> STATUS_MEANINGS[i] (netCDF flag_values / flag_meanings)
 STATUS_MEANINGS = ("converged",) + tuple(

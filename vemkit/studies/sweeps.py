@@ -149,7 +149,8 @@ def point_quantities(problem, outcome: Outcome):
     order = np.lexsort(tuple(cb.coords[:, axis] for axis in reversed(range(cb.dimension))))  # by x, then y (, z)
     values = {"multiplier": np.asarray(sol.multiplier, dtype=float)}
     profiles = {
-        name: as_written(values.get(attr, getattr(st, attr, None)))[order] for name, (attr, _, _) in PROFILES.items()
+        name: as_written(values.get(attr, getattr(st, attr, None)), cb.dimension)[order]
+        for name, (attr, _, _) in PROFILES.items()
     }
     profiles["state"] = np.asarray(st.state, dtype=np.int8)[order]
     profiles["x"], profiles["y"], profiles["w"] = cb.coords[order, 0], cb.coords[order, 1], cb.weight[order]

@@ -130,9 +130,10 @@ def scene_resources3d(scene):
     return estimate_resources3d(cells * layers, vertices * (layers + 1), cells * (layers + 1) + edges * layers)
 
 
-def check_scene_resources3d(scene, max_dofs):
+def check_scene_resources3d(scene, max_dofs, layout: dict | None = None):
     """The prediction of :func:`scene_resources3d`, checked as in 2D
-    (``vemkit.config.limits.check_scene_estimate``)."""
+    (``vemkit.config.limits.check_scene_estimate``). ``layout`` (the element's nodes per entity) is
+    the 2D check's argument: the 3D element has one node per vertex."""
     from vemkit.config.limits import check_scene_estimate
 
     return check_scene_estimate(scene, scene_resources3d(scene), max_dofs, dimension=3)

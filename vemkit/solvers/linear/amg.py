@@ -140,14 +140,10 @@ class AMGSolver(LinearSolver):
         )
         self.iterations = count[0]
         self.residual = float(np.linalg.norm(b - A @ x) / bnorm)
-        if info != 0 or not np.all(np.isfinite(x)):
-            raise LinearSolveError(
-                f"AMG-CG stopped after {count[0]} iterations at relative residual {self.residual:.2e} "
-                f"(asked {tol:.1e}); try solver.linear=direct",
-                solver="amg",
-                iterations=count[0],
-            )
-        return x
+        stopped = (
+            f"AMG-CG stopped after {count[0]} iterations at relative residual {self.residual:.2e} (asked {tol:.1e})"
+        )
+        return _converged(x, info, count[0], stopped)
 
     def newton_systems(self, problem, baseline) -> NewtonSystems:
         return AMGNewtonSystems(problem, self, baseline)
@@ -219,14 +215,8 @@ class AMGNewtonSystems(NewtonSystems):
             count[0] += 1
 
         y, info = krylov(A_red, b, x0=x0, rtol=eta, atol=atol, maxiter=5000, M=M, callback=callback)
-        if info != 0 or not np.all(np.isfinite(y)):
-            raise LinearSolveError(
-                f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations; "
-                f"try solver.linear=direct",
-                solver="amg",
-                iterations=count[0],
-            )
-        return y, count[0]
+        stopped = f"AMG-preconditioned Krylov solve of the Newton step stopped after {count[0]} iterations"
+        return _converged(y, info, count[0], stopped), count[0]
 
 
 def _gmres(A, b, x0, rtol, atol, maxiter, M, callback):
@@ -237,3 +227,10 @@ def _gmres(A, b, x0, rtol, atol, maxiter, M, callback):
 
 
 BACKEND = AMGSolver
+
+
+def _converged(x, info: int, iterations: int, stopped: str) -> np.ndarray:
+    """x of a Krylov solve that converged (info 0, finite); LinearSolveError saying how it ``stopped``."""
+    if info != 0 or not np.all(np.isfinite(x)):
+        raise LinearSolveError(f"{stopped}; try solver.linear=direct", solver="amg", iterations=iterations)
+    return x
