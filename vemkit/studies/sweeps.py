@@ -9,7 +9,7 @@ the assembled problem: K and the load are assembled once per combination of the 
 when it takes a prebuilt one (``vemkit.studies.robustness.prebuilt_linear_supported``). Each point gets
 ``dataclasses.replace(problem, law=..., contact=...)``.
 
-Per point (see :data:`QUANTITIES`): max penetration max (u_nu - g)_+, contact length (sum of the
+Per point (see ``vemkit.studies.sweep_quantities``): max penetration max (u_nu - g)_+, contact length (sum of the
 nodal weights where u_nu - g > 0), stick and slip lengths (``contact_state``), resultant normal
 force sum w p_nu and tangential force sum w sigma_tau (over all Gamma_C vertices: with the
 reduced law m_tau = 0 the friction bound acts on separated vertices too), iterations, wall time,
