@@ -105,10 +105,10 @@ def auto_magnification(u: np.ndarray, fraction: float = 0.15) -> float:
 
 
 def deformed_figure(mesh, ds, magnification: float | None = None, title: str = "", cmap: str | None = None) -> Figure:
-    """The deformed body x + M u: a 2D mesh (:func:`_deformed_plane`) or a 3D body (:func:`_deformed_body`)."""
-    if mesh.dimension == 3:
-        return _deformed_body(mesh, ds, magnification, title, cmap or "viridis")
-    return _deformed_plane(mesh, ds, magnification, title, cmap or "Greys")
+    """The deformed body x + M u: a 2D mesh (:func:`_deformed_plane`) or a 3D body (:func:`_deformed_body`),
+    ``DEFORMED_FIGURES``."""
+    draw, default_cmap = DEFORMED_FIGURES[mesh.dimension]
+    return draw(mesh, ds, magnification, title, cmap or default_cmap)
 
 
 def _deformed_plane(mesh, ds, magnification: float | None, title: str, cmap: str) -> Figure:
@@ -204,6 +204,10 @@ def _deformed_body(mesh, ds, magnification: float | None, title: str, cmap: str)
     if contact:
         _contact_zones(fig.add_subplot(1, 2, 2), ds)
     return fig
+
+
+#: dimension -> (the figure of the deformed body, its default colour map)
+DEFORMED_FIGURES = {2: (_deformed_plane, "Greys"), 3: (_deformed_body, "viridis")}
 
 
 # -- the contact boundary -----------------------------------------------------------------------

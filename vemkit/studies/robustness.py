@@ -22,6 +22,12 @@ from vemkit.solvers.verification import (
 )
 
 
+def status_attributes(long_name: str, dtype=np.int8) -> dict:
+    """The attributes of a status variable: its long name, flag values and meanings (``STATUS_MEANINGS``)."""
+    flags = np.arange(len(STATUS_MEANINGS), dtype=dtype)
+    return {"long_name": long_name, "flag_values": flags, "flag_meanings": " ".join(STATUS_MEANINGS)}
+
+
 # -- the stability matrix ---------------------------------------------------------------------------
 def _case(name, group, **settings):
     return {"name": name, "group": group, "set": settings}
@@ -96,6 +102,10 @@ CASES = [
 ]
 
 
+#: dimension -> the mesh family of a case that names none (None: the scene's own, hex by default)
+CASE_FAMILIES = {2: "square", 3: None}
+
+
 def case_overrides(case: dict, n: int, family: str = "square") -> list[str]:
     """Scene overrides of a case at n cells per unit length (a mesh entry replaces the whole mesh
     section; ``family`` where the case names none: squares in 2D, the scene's own family in 3D)."""
@@ -115,7 +125,7 @@ def run_case(scene, case: dict, solvers: dict, n: int, *, time_budget=None, chec
 
     result = {"case": case, "n_dofs": -1, "parameters": {}, "outcomes": {}}
     try:
-        family = "square" if scene.dimension == 2 else scene.mesh_options.get("family", "hex")
+        family = CASE_FAMILIES[scene.dimension] or scene.mesh_options.get("family", "hex")
         case_scene = scene.with_overrides(case_overrides(case, n, family))
         result["parameters"] = case_parameters(case_scene)
         problem = scene_problem(case_scene)
@@ -237,15 +247,7 @@ def stability_dataset(results, *, scene_yaml: str = "", settings=None):
         np.array([r["n_dofs"] for r in results], np.int64),
         {"long_name": "free unknowns (-1: not built)"},
     )
-    ds["status"] = (
-        dims,
-        status,
-        {
-            "long_name": "outcome of the solve",
-            "flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int8),
-            "flag_meanings": " ".join(STATUS_MEANINGS),
-        },
-    )
+    ds["status"] = (dims, status, status_attributes("outcome of the solve"))
     ds["iterations"] = (dims, iterations, {"long_name": "nonlinear iterations (-1: unknown)"})
     ds["wall_time"] = (dims, wall, {"long_name": "wall time of the solve", "units": "s"})
     for k, values in checks.items():

@@ -9,7 +9,7 @@ the assembled problem: K and the load are assembled once per combination of the 
 when it takes a prebuilt one (``vemkit.studies.robustness.prebuilt_linear_supported``). Each point gets
 ``dataclasses.replace(problem, law=..., contact=...)``.
 
-Per point (see :data:`QUANTITIES`): max penetration max (u_nu - g)_+, contact length (sum of the
+Per point (see ``vemkit.studies.sweep_quantities``): max penetration max (u_nu - g)_+, contact length (sum of the
 nodal weights where u_nu - g > 0), stick and slip lengths (``contact_state``), resultant normal
 force sum w p_nu and tangential force sum w sigma_tau (over all Gamma_C vertices: with the
 reduced law m_tau = 0 the friction bound acts on separated vertices too), iterations, wall time,
@@ -36,42 +36,19 @@ import xarray as xr
 
 from vemkit.io.fill_values import FLOAT_FILL, INT_FILL, read_with_fill_values, write_with_fill_values
 from vemkit.io.provenance import package_versions
-from vemkit.io.solution_fields import as_written
-from vemkit.solvers.verification import DEFAULT_CHECK_TOL, STATUS_MEANINGS, Outcome, failed, guarded_solve
+from vemkit.solvers.verification import DEFAULT_CHECK_TOL, Outcome, failed, guarded_solve
+from vemkit.studies.robustness import status_attributes
 from vemkit.studies.sweep_dimensions import dimension_name
+from vemkit.studies.sweep_quantities import (  # noqa: F401  (QUANTITIES*: re-exported)
+    CONTACT_GEOMETRY,
+    PROFILES,
+    QUANTITIES,
+    QUANTITIES_3D,
+    coordinate_names,
+    point_quantities,
+)
 
 SHARED_PREFIXES = ("contact.", "solver.")  # keys that leave K, the load and the mesh unchanged
-QUANTITIES = {  # name: (long name, units)
-    "max_penetration": ("max over Gamma_C of (u_nu - g_a)_+", "mm"),
-    "contact_length": ("length of Gamma_C where u_nu - g_a > 0 (nodal weights)", "mm"),
-    "stick_length": ("length of Gamma_C in contact and sticking (contact_state)", "mm"),
-    "slip_length": ("length of Gamma_C in contact and slipping (contact_state)", "mm"),
-    "normal_force": (
-        "resultant normal contact force: the integral of p_nu(u_nu - g_a) over Gamma_C with the "
-        "scene's contact quadrature (nodal: sum_c w_c p_nu)",
-        "daN/mm",
-    ),
-    "tangential_force": ("resultant tangential contact stress sum_c w_c sigma_tau (all Gamma_C vertices)", "daN/mm"),
-    "residual": ("worst independent check of the discrete conditions (vemkit.studies.robustness)", "1"),
-}
-#: a 3D body (docs/reference/files.md): Gamma_C is a surface, so areas instead of lengths, forces instead of forces per
-#: unit depth, and the tangential force is the magnitude of the resultant vector sum_c w_c sigma_tau,c
-QUANTITIES_3D = {
-    "max_penetration": QUANTITIES["max_penetration"],
-    "contact_area": ("area of Gamma_C where u_nu - g_a > 0 (nodal weights)", "mm2"),
-    "stick_area": ("area of Gamma_C in contact and sticking (contact_state)", "mm2"),
-    "slip_area": ("area of Gamma_C in contact and slipping (contact_state)", "mm2"),
-    "normal_force": (QUANTITIES["normal_force"][0], "daN"),
-    "tangential_force": ("magnitude of the resultant tangential contact force |sum_c w_c sigma_tau,c|", "daN"),
-    "residual": QUANTITIES["residual"],
-}
-PROFILES = {  # name: (ContactState attribute or "multiplier", long name, units)
-    "pressure": ("normal_pressure", "p_nu(u_nu - g_a) along Gamma_C", "daN/mm2"),
-    "tangential_stress": ("tangential_stress", "sigma_tau = -p_tau lambda along Gamma_C", "daN/mm2"),
-    "slip": ("slip", "tangential displacement u_tau along Gamma_C", "mm"),
-    "penetration": ("penetration", "u_nu - g_a along Gamma_C", "mm"),
-    "multiplier": ("multiplier", "friction multiplier lambda along Gamma_C", "1"),
-}
 
 
 def normalize_grid(grid) -> dict:
@@ -112,51 +89,6 @@ class _Point:
     def __init__(self, outcome: Outcome, n_dofs=-1, quantities=None, profiles=None, setup_time=0.0, dimension=2):
         self.outcome, self.n_dofs, self.setup_time, self.dimension = outcome, n_dofs, setup_time, dimension
         self.quantities, self.profiles = quantities or {}, profiles
-
-
-def _normal_force(problem, u, state) -> float:
-    """The resultant normal force with the problem's contact quadrature: sum_c F_c . nu_c."""
-    cb = problem.contact
-    if cb.quadrature == "nodal":
-        return float(np.sum(cb.weight * state.normal_pressure))
-    return float(np.sum(cb.normal_displacement(cb.normal_force(u, problem.law))))
-
-
-def point_quantities(problem, outcome: Outcome):
-    """(quantities, profiles) of a converged solve; profiles ordered along Gamma_C by (x, y)."""
-    from vemkit.solvers.solution import SLIP, STICK, contact_state
-
-    cb, sol = problem.contact, outcome.solution
-    st = contact_state(problem, sol.u, sol.multiplier)
-    w = cb.weight
-    measure = "area" if cb.dimension == 3 else "length"
-    if cb.dimension == 3:  # the resultant vector of w sigma_tau in space (components in the vertex bases)
-        stress = st.tangential_stress
-        tangential = float(
-            np.linalg.norm(np.sum(w[:, None] * (cb.tangent * stress[:, :1] + cb.tangent2 * stress[:, 1:]), axis=0))
-        )
-    else:
-        tangential = float(np.sum(w * st.tangential_stress[:, 0]))
-    q = {
-        "max_penetration": float(np.max(np.maximum(st.penetration, 0.0), initial=0.0)),
-        f"contact_{measure}": float(np.sum(w[st.penetration > 0.0])),
-        f"stick_{measure}": float(np.sum(w[st.state == STICK])),
-        f"slip_{measure}": float(np.sum(w[st.state == SLIP])),
-        "normal_force": _normal_force(problem, sol.u, st),
-        "tangential_force": tangential,
-        "residual": float(outcome.checks.get("worst", np.nan)),
-    }
-    order = np.lexsort(tuple(cb.coords[:, axis] for axis in reversed(range(cb.dimension))))  # by x, then y (, z)
-    values = {"multiplier": np.asarray(sol.multiplier, dtype=float)}
-    profiles = {
-        name: as_written(values.get(attr, getattr(st, attr, None)), cb.dimension)[order]
-        for name, (attr, _, _) in PROFILES.items()
-    }
-    profiles["state"] = np.asarray(st.state, dtype=np.int8)[order]
-    profiles["x"], profiles["y"], profiles["w"] = cb.coords[order, 0], cb.coords[order, 1], cb.weight[order]
-    if cb.dimension == 3:
-        profiles["z"] = cb.coords[order, 2]
-    return q, profiles
 
 
 def _contact_problem(problem, scene):
@@ -269,16 +201,16 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
     wall, setup = np.zeros(shape), np.zeros(shape)
     messages = np.full(shape, "", dtype=object)
     dimension = max((p.dimension for p in results.values()), default=2)
-    table = QUANTITIES_3D if dimension == 3 else QUANTITIES
+    geometry, axes = CONTACT_GEOMETRY[dimension], coordinate_names(dimension)
+    table = geometry.quantities
     quantities = {k: np.full(shape, np.nan) for k in table}
     profiles = [p.profiles for p in results.values() if p.profiles is not None]
     sizes = {p["x"].tobytes() + p["y"].tobytes() for p in profiles}
     keep_profiles = len(sizes) == 1
     n_c = len(profiles[0]["x"]) if keep_profiles else 0
-    # 3D: tangential profiles have two components in the vertex basis (contact_tangent, docs/reference/files.md)
-    tangent_shape = (
-        {k: (2,) if dimension == 3 and np.ndim(profiles[0][k]) == 2 else () for k in PROFILES} if keep_profiles else {}
-    )
+    # tangential profiles of a solid have d - 1 components in the vertex basis (contact_tangent,
+    # docs/reference/files.md); a plane body's one is squeezed (as_written)
+    tangent_shape = {k: np.shape(profiles[0][k])[1:] for k in PROFILES} if keep_profiles else {}
     profile_data = {k: np.full(shape + (n_c,) + tangent_shape.get(k, ()), np.nan) for k in PROFILES}
     state = np.full(shape + (n_c,), INT_FILL, np.int8)
     for index, point in results.items():
@@ -291,15 +223,7 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             for k in PROFILES:
                 profile_data[k][index] = point.profiles[k]
             state[index] = point.profiles["state"]
-    ds["status"] = (
-        dims,
-        status,
-        {
-            "long_name": "outcome of the point",
-            "flag_values": np.arange(len(STATUS_MEANINGS), dtype=np.int8),
-            "flag_meanings": " ".join(STATUS_MEANINGS),
-        },
-    )
+    ds["status"] = (dims, status, status_attributes("outcome of the point"))
     ds["valid"] = (
         dims,
         (status == 0).astype(np.int8),
@@ -322,19 +246,14 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
     ds["message"] = (dims, messages, {"long_name": "failure message (empty when converged)"})
     if keep_profiles:
         first = profiles[0]
-        ds = ds.assign_coords(
-            contact_x=("contact_node", first["x"], {"long_name": "x of the contact vertex", "units": "mm"}),
-            contact_y=("contact_node", first["y"], {"long_name": "y of the contact vertex", "units": "mm"}),
-            contact_weight=(
-                "contact_node",
-                first["w"],
-                {"long_name": "nodal quadrature weight", "units": "mm2" if dimension == 3 else "mm"},
-            ),
-        )
-        if dimension == 3:
-            ds = ds.assign_coords(
-                contact_z=("contact_node", first["z"], {"long_name": "z of the contact vertex", "units": "mm"})
-            )
+
+        def coordinate(axis):
+            return ("contact_node", first[axis], {"long_name": f"{axis} of the contact vertex", "units": "mm"})
+
+        weight = ("contact_node", first["w"], {"long_name": "nodal quadrature weight", "units": geometry.measure_units})
+        # the file's order: the plane's coordinates, the weight, then z
+        ds = ds.assign_coords({f"contact_{a}": coordinate(a) for a in axes[:2]} | {"contact_weight": weight})
+        ds = ds.assign_coords({f"contact_{a}": coordinate(a) for a in axes[2:]})
         pdims = dims + ("contact_node",)
         for k, (_, long_name, units) in PROFILES.items():
             extra = ("contact_tangent",) if tangent_shape.get(k) else ()
@@ -361,7 +280,7 @@ def sweep_dataset(results: dict, grid, *, scene_yaml: str = "", attrs=None) -> x
             "grid": json.dumps({k: list(v) for k, v in grid.items()}),
             "points": int(np.prod(shape)),
             "converged_points": int(np.sum(status == 0)),
-            "profiles": f"along Gamma_C (contact_node ordered by {'x, y, z' if dimension == 3 else 'x, y'})"
+            "profiles": f"along Gamma_C (contact_node ordered by {', '.join(axes)})"
             if keep_profiles
             else "omitted: the grid changes the contact nodes (mesh)"
             if sizes

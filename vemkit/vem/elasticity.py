@@ -21,28 +21,31 @@ def elasticity_matrix_3d(lam: float, mu: float) -> np.ndarray:
     return D
 
 
+def _rotations_2d(offsets: np.ndarray) -> np.ndarray:
+    """(2N, 1) the infinitesimal rotation (-y, x) about the centroid (``offsets`` (N, 2) from it)."""
+    rotation = np.empty_like(offsets)
+    rotation[:, 0] = -offsets[:, 1]
+    rotation[:, 1] = offsets[:, 0]
+    return rotation.reshape(-1, 1)
+
+
+def _rotations_3d(offsets: np.ndarray) -> np.ndarray:
+    """(3N, 3) the rotations omega_k x (x - xbar) about the three axes (``offsets`` (N, 3) = x - xbar)."""
+    return np.stack([np.cross(np.eye(3)[k], offsets).ravel() for k in range(3)], axis=1)
+
+
+#: dimension -> the infinitesimal rotations of a body, node-major (dof = d node + component)
+ROTATIONS = {2: _rotations_2d, 3: _rotations_3d}
+
+
 def rigid_body_modes(coords: np.ndarray) -> np.ndarray:
-    """The rigid-body motions at node coordinates (N, d): (2N, 3) for d = 2, two translations and
-    the infinitesimal rotation; (3N, 6) for d = 3, three translations and three rotations
-    omega_k x (x - xbar) (dof = d node + component)."""
+    """The rigid-body motions at node coordinates (N, d): the d translations, then the rotations
+    (``ROTATIONS``): (2N, 3) for d = 2, (3N, 6) for d = 3 (dof = d node + component)."""
     coords = np.asarray(coords, dtype=float)
-    if coords.shape[1] == 3:
-        return _rigid_body_modes_3d(coords)
-    n = coords.shape[0]
-    B = np.zeros((2 * n, 3))
-    B[0::2, 0] = 1.0
-    B[1::2, 1] = 1.0
-    c = coords - coords.mean(axis=0)
-    B[0::2, 2] = -c[:, 1]
-    B[1::2, 2] = c[:, 0]
-    return B
-
-
-def _rigid_body_modes_3d(coords: np.ndarray) -> np.ndarray:
-    n = coords.shape[0]
-    B = np.zeros((3 * n, 6))
-    d = coords - coords.mean(axis=0)
-    for k in range(3):
-        B[k::3, k] = 1.0
-        B[:, 3 + k] = np.cross(np.eye(3)[k], d).ravel()
-    return B
+    n, dimension = coords.shape
+    rotations = ROTATIONS[dimension](coords - coords.mean(axis=0))
+    modes = np.zeros((dimension * n, dimension + rotations.shape[1]))
+    for k in range(dimension):
+        modes[k::dimension, k] = 1.0
+    modes[:, dimension:] = rotations
+    return modes

@@ -294,7 +294,7 @@ def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
     """The datum of values at the trace nodes of ``edges``, interpolated as the space's trace
     (linear between the ends for k = 1)."""
     nodes = space.edge_nodes(edges)
-    if nodes.shape[1] == 2:
+    if space.element.order == 1:  # two trace nodes per edge
         ta, tb = at_nodes[nodes[:, 0]], at_nodes[nodes[:, 1]]
 
         def datum(_points, t):

@@ -110,15 +110,26 @@ QUADRATURE_POINTS_3D = 4
 CHUNK_POINTS_3D = 200_000
 
 
-def error_quadrature(mesh, degree: int = 5):
-    """(points (Q, d), weights (Q,), cells (Q,)) for the exact errors: in 2D the degree-``degree``
-    rule on a triangulation of every cell; on a 3D mesh (``mesh.dimension == 3``) the signed
-    tetrahedral fan of ``k1_3d_fields.cell_quadrature`` with QUADRATURE_POINTS_3D points per direction."""
-    if mesh.dimension == 3:
-        from vemkit.vem.elements.k1_3d_fields import cell_quadrature  # the 3D element's own rule
-
-        return cell_quadrature(mesh, QUADRATURE_POINTS_3D)
+def _plane_rule(mesh, degree: int):
     return reference_quadrature(mesh, degree=degree)
+
+
+def _polyhedral_rule(mesh, degree: int):
+    from vemkit.vem.elements.k1_3d_fields import cell_quadrature  # the 3D element's own rule
+
+    return cell_quadrature(mesh, QUADRATURE_POINTS_3D)
+
+
+#: dimension -> (the rule of the exact errors on a mesh, at most how many points are evaluated at once)
+ERROR_RULES = {2: (_plane_rule, None), 3: (_polyhedral_rule, CHUNK_POINTS_3D)}
+
+
+def error_quadrature(mesh, degree: int = 5):
+    """(points (Q, d), weights (Q,), cells (Q,)) for the exact errors (``ERROR_RULES``): in 2D the
+    degree-``degree`` rule on a triangulation of every cell; on a 3D mesh the signed tetrahedral fan
+    of ``k1_3d_fields.cell_quadrature`` with QUADRATURE_POINTS_3D points per direction."""
+    rule, _chunk = ERROR_RULES[mesh.dimension]
+    return rule(mesh, degree)
 
 
 def exact_errors(mesh: Mesh, proj, u_exact, grad_exact, quadrature=None) -> dict:
@@ -130,7 +141,7 @@ def exact_errors(mesh: Mesh, proj, u_exact, grad_exact, quadrature=None) -> dict
     """
     points, weights, cells = quadrature if quadrature is not None else error_quadrature(mesh)
     l2 = semi = 0.0
-    chunk = CHUNK_POINTS_3D if points.shape[1] == 3 else max(points.shape[0], 1)
+    chunk = ERROR_RULES[points.shape[1]][1] or max(points.shape[0], 1)
     for start in range(0, points.shape[0], chunk):
         part = slice(start, start + chunk)
         x, w, c = points[part], weights[part], cells[part]

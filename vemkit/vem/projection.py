@@ -8,21 +8,22 @@ import numpy as np
 
 #: the strain and stress components of a 3D body, in the solution file's order (docs/reference/files.md)
 COMPONENTS_3D = ("11", "22", "33", "12", "13", "23")
-_PAIRS_3D = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+#: dimension -> the (i, j) of the strain and stress components, the d normal ones first (Voigt order)
+VOIGT_PAIRS = {2: ((0, 0), (1, 1), (0, 1)), 3: ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))}
+_DIMENSION_OF_COMPONENTS = {len(pairs): dimension for dimension, pairs in VOIGT_PAIRS.items()}
 
 
 def strain_of(gradient: np.ndarray) -> np.ndarray:
     """(P, 3) eps11, eps22, eps12 of displacement gradients (P, 2, 2) [i, j] = d u_i / d x_j; in 3D
     (P, 3, 3) -> (P, 6) eps11, eps22, eps33, eps12, eps13, eps23 (``COMPONENTS_3D``)."""
     g = gradient
-    pairs = _PAIRS_3D if g.shape[1] == 3 else ((0, 0), (1, 1), (0, 1))
-    return np.stack([0.5 * (g[:, i, j] + g[:, j, i]) for i, j in pairs], axis=1)
+    return np.stack([0.5 * (g[:, i, j] + g[:, j, i]) for i, j in VOIGT_PAIRS[g.shape[1]]], axis=1)
 
 
 def stress(strain: np.ndarray, lam: float, mu: float) -> np.ndarray:
     """sigma = C eps = lam tr(eps) I + 2 mu eps (docs/reference/mathematics.md): (M, 3) sigma11, sigma22, sigma12 from
     (eps11, eps22, eps12), or in 3D (M, 6) from (M, 6) in the order of ``COMPONENTS_3D``."""
-    diagonal = 3 if strain.shape[1] == 6 else 2
+    diagonal = _DIMENSION_OF_COMPONENTS[strain.shape[1]]  # the normal components come first
     tr = strain[:, :diagonal].sum(axis=1)
     sigma = 2 * mu * strain
     sigma[:, :diagonal] += lam * tr[:, None]

@@ -17,7 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
-from vemkit.mesh.mesh import Mesh, edge_indices
+from vemkit.mesh.mesh import Mesh
 from vemkit.vem.dofs import DofMap, cell_order_numbering
 from vemkit.vem.elements import Element, element_for
 
@@ -94,12 +94,7 @@ class VirtualElementSpace:
         """(n_nodes,) mask of the trace nodes of the given boundary edges (vertex pairs (k, 2)): what
         ``dirichlet: [side]`` clamps. In 3D ``edges`` are boundary faces (face numbers): their vertices."""
         mask = np.zeros(self.n_nodes, dtype=bool)
-        if self.element.dimension == 3:
-            mask[self.mesh.face_vertex_ids(edges)] = True  # type: ignore[attr-defined]  # a PolyhedralMesh
-            return mask
-        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        if edges.size:
-            mask[self.edge_nodes(edges).ravel()] = True
+        mask[self.element.boundary_nodes(self.mesh, edges)] = True
         return mask
 
     def dirichlet_components(self, dirichlet) -> tuple[np.ndarray, np.ndarray]:
@@ -127,11 +122,7 @@ class VirtualElementSpace:
 
     def edge_nodes(self, edges: np.ndarray) -> np.ndarray:
         """(E, k + 1) the trace nodes of every edge (a, b): its two vertices, then its edge nodes."""
-        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        if "edge" not in self.element.layout:
-            return edges
-        first = self.node_range("edge").start
-        return np.concatenate([edges, first + edge_indices(self.mesh, edges)[:, None]], axis=1)
+        return self.element.edge_nodes(self.mesh, edges)
 
     def boundary_trace(self, edges: np.ndarray, node_values: np.ndarray, s: np.ndarray) -> np.ndarray:
         """(E, 2) the trace of a discrete field (n_nodes, 2) at parameter s[e] in [0, 1] of every edge (a, b)."""

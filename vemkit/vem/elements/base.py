@@ -46,6 +46,8 @@ from collections.abc import Callable
 from importlib import import_module
 from typing import Any
 
+import numpy as np
+
 STABILIZATIONS = ("dofi", "dofi-2mu", "trace")
 
 
@@ -112,6 +114,21 @@ class Element:
 
         edges, traction = pressure_traction(mesh, edges, pressure)
         return self.traction_load(mesh, edges, traction)
+
+    def edge_nodes(self, mesh, edges) -> np.ndarray:
+        """(E, k + 1) the trace nodes of every edge (a, b): its two vertices, then its edge nodes."""
+        from vemkit.mesh.mesh import edge_indices
+
+        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        if "edge" not in self.layout:
+            return edges
+        return np.concatenate([edges, self.first_node(mesh, "edge") + edge_indices(mesh, edges)[:, None]], axis=1)
+
+    def boundary_nodes(self, mesh, sides) -> np.ndarray:
+        """The nodes on boundary ``sides`` (edges (k, 2) of a side; 3D elements: face numbers): what
+        ``dirichlet: [side]`` clamps. On edges, their trace nodes (``edge_nodes``)."""
+        edges = np.asarray(sides, dtype=np.int64).reshape(-1, 2)
+        return self.edge_nodes(mesh, edges).ravel() if edges.size else np.zeros(0, dtype=np.int64)
 
     def __repr__(self) -> str:
         return f"<{self.name} virtual element (k = {self.order}, d = {self.dimension})>"

@@ -107,6 +107,10 @@ class FirstOrder3D(Element):
     def node_coordinates(self, mesh) -> np.ndarray:
         return mesh.vertices
 
+    def boundary_nodes(self, mesh, sides) -> np.ndarray:
+        """The vertices of boundary faces ``sides`` (face numbers)."""
+        return mesh.face_vertex_ids(sides)
+
     def interpolate(self, mesh, field) -> np.ndarray:
         x, y, z = mesh.vertices.T
         return np.stack(np.broadcast_arrays(*field(x, y, z)), axis=1).astype(float)
