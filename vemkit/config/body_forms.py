@@ -46,37 +46,28 @@ class BodyForm:
     foundation: str
 
 
+#: each fact (a field of :class:`BodyForm`) of a plane body and of a solid, side by side
+_FACTS = {
+    "other_dimension": (3, 2),
+    "models": (("plane_stress", "plane_strain"), ("3d",)),
+    "model_fix": (
+        "drop model, or give a 3D body (domain box, a polygon with extrude, or a 3D mesh file)",
+        "drop model or set model: 3d",
+    ),
+    "mesh_words": ("a plane mesh", "a 3D mesh"),
+    "mesh_file_words": ("a plane (2D) mesh", "a 3D mesh"),
+    "file_in_other_scene": (
+        "is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; give a 3D mesh file, or drop model: 3d",
+        "is a 3D mesh (it has volumes) but the scene is 2D; give a 2D mesh file, or write the scene for a 3D body",
+    ),
+    "cells_per_vertex": (2, 10),
+    "gmsh_items_per_node": (7, 17),
+    "netcdf_words": ("UGRID netCDF", "a mesh3d netCDF file"),
+    "side_entity": ("line", "surface"),
+    "coordinate_words": ("x and y", "x, y and z"),
+    "foundation": ("line", "plane"),
+}
 FORMS = {
-    2: BodyForm(
-        dimension=2,
-        other_dimension=3,
-        models=("plane_stress", "plane_strain"),
-        model_fix="drop model, or give a 3D body (domain box, a polygon with extrude, or a 3D mesh file)",
-        mesh_words="a plane mesh",
-        mesh_file_words="a plane (2D) mesh",
-        file_in_other_scene="is a 2D mesh (it has surfaces but no volumes) but the scene is 3D; give a 3D mesh "
-        "file, or drop model: 3d",
-        cells_per_vertex=2,
-        gmsh_items_per_node=7,
-        netcdf_words="UGRID netCDF",
-        side_entity="line",
-        coordinate_words="x and y",
-        foundation="line",
-    ),
-    3: BodyForm(
-        dimension=3,
-        other_dimension=2,
-        models=("3d",),
-        model_fix="drop model or set model: 3d",
-        mesh_words="a 3D mesh",
-        mesh_file_words="a 3D mesh",
-        file_in_other_scene="is a 3D mesh (it has volumes) but the scene is 2D; give a 2D mesh file, or write "
-        "the scene for a 3D body",
-        cells_per_vertex=10,
-        gmsh_items_per_node=17,
-        netcdf_words="a mesh3d netCDF file",
-        side_entity="surface",
-        coordinate_words="x, y and z",
-        foundation="plane",
-    ),
+    dimension: BodyForm(dimension=dimension, **{fact: values[k] for fact, values in _FACTS.items()})
+    for k, dimension in enumerate((2, 3))
 }

@@ -218,15 +218,16 @@ def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
 def refuse_penetration(side: str, distance: np.ndarray, points: tuple) -> None:
     """SceneError when a point of ``side`` (coordinates ``points``: x, y (, z)) lies beyond the
     foundation, ``distance`` being its signed distance to it (positive on the body's side)."""
-    if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
-        i = int(np.argmin(distance))
-        at = ", ".join(f"{name}={c[i]:.6g}" for name, c in zip("xyz", points))
-        raise SceneError(
-            f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation "
-            f"{FORMS[len(points)].foundation} at {at} (the body starts out penetrating it); move "
-            "contact.foundation.point or flip contact.foundation.normal",
-            key="contact.foundation",
-        )
+    if not distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
+        return
+    i = int(np.argmin(distance))
+    at = ", ".join(f"{name}={c[i]:.6g}" for name, c in zip("xyz", points))
+    figure = FORMS[len(points)].foundation  # a line in the plane, a plane in space
+    raise SceneError(
+        f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation {figure} at {at} (the body "
+        "starts out penetrating it); move contact.foundation.point or flip contact.foundation.normal",
+        key="contact.foundation",
+    )
 
 
 def check_mesh_size(mesh: dict) -> None:

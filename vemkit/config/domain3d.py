@@ -48,8 +48,6 @@ DOMAIN_KEY_DIMENSION = {"box": 3, "extrude": 3}
 class Box:
     """An axis-aligned box [lower, upper] with its six sides named (xmin, xmax, ymin, ymax, zmin, zmax)."""
 
-    dimension = 3
-
     lower: tuple
     upper: tuple
     sides: tuple = BOX_SIDES
@@ -63,8 +61,6 @@ class Box:
 @dataclass(frozen=True)
 class Extruded:
     """A docs/reference/files.md domain extruded along z to ``depth``, its end faces named ``ends`` (z = 0, z = depth)."""
-
-    dimension = 3
 
     base: Domain
     depth: float
@@ -87,7 +83,7 @@ def domain_dimension(spec) -> int:
     a polygon, a :class:`~vemkit.config.domain.Domain`)."""
     if isinstance(spec, dict):
         return max((DOMAIN_KEY_DIMENSION.get(key, PLANE) for key in spec), default=PLANE)
-    return getattr(spec, "dimension", PLANE)
+    return SOLID_DIMENSION.get(type(spec), PLANE)
 
 
 def domain3d_from_spec(spec):
@@ -175,6 +171,8 @@ def _extruded(spec: dict) -> Extruded:
     return Extruded(domain, depth, ends)
 
 
+#: the dimension of a parsed solid (any other body, a :class:`~vemkit.config.domain.Domain`: plane)
+SOLID_DIMENSION = {Box: 3, Extruded: 3}
 #: the parser of a solid ``domain`` mapping by its key
 _SOLIDS = {"box": _box, "extrude": _extruded}
 
