@@ -6,7 +6,8 @@ polygon and a plane mesh file are 2D. The ``model`` key says the constitution on
 tensor's lambda and mu, :mod:`vemkit.config.material`): ``plane_stress`` or ``plane_strain`` on a 2D
 body, ``3d`` on a 3D body; omitted, it is the body's default (``x-default-by-dimension`` of the
 schema: plane_stress in 2D, 3d in 3D). A model that does not fit the body is a one-line
-:class:`SceneError` naming ``model``, the body's dimension and the models that fit.
+:class:`SceneError` naming ``model``, the body's dimension and the models that fit. The facts of
+each dimension (its models, the words of the messages) are :data:`vemkit.config.body_forms.FORMS`.
 
 A mesh file that does not say its dimension (a binary gmsh 2 file without a physical volume, a
 file that cannot be opened) keeps the rule of before: 3D with ``model: 3d`` or a 3D ``domain``,
@@ -59,8 +60,9 @@ def _domain_words(domain) -> str:
 
 
 def written_dimension(data: dict) -> int:
-    """The dimension the scene's words say, its mesh file unread: its domain's, or 3 when it names
-    the model ``3d`` (the rule of before for a mesh file that does not say; module docstring)."""
+    """The dimension the scene's words say, its mesh file unread: the larger of its domain's and its
+    model's (``3d``: 3; a plane model or none: 2), the rule of before for a mesh file that does not
+    say (module docstring)."""
     model_dimension = MODEL_DIMENSION.get(data.get("model"), min(FORMS))
     return max(domain_dimension(data.get("domain", "unit_square")), model_dimension)
 
