@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vemkit.config.body_forms import FORMS
 from vemkit.config.domain import Domain
 from vemkit.config.expression_tree import shorten
 from vemkit.config.expressions import Expression, compile_expression
@@ -80,10 +81,11 @@ def compile_checked(key: str, value, dimension: int = 2) -> Expression:
         expression = compile_expression(value, name=key)
     except ExpressionError as error:
         raise SceneError(str(error), key=key) from None
-    if dimension == 2 and "z" in expression.variables:
+    beyond = [name for name in "xyz"[dimension:] if name in expression.variables]  # coordinates the body lacks
+    if beyond:
         raise SceneError(
-            f"{key} = {shorten(expression.text)!r}: uses z, but this scene is 2D (its expressions take "
-            "x and y); remove z",
+            f"{key} = {shorten(expression.text)!r}: uses {beyond[0]}, but this scene is {dimension}D (its expressions "
+            f"take {FORMS[dimension].coordinate_words}); remove {beyond[0]}",
             key=key,
         )
     return expression
@@ -210,14 +212,22 @@ def check_foundation(foundation: dict, sides, domain: Domain | None) -> None:
     for side in sides:
         x, y = side_points(domain, side, np.linspace(0.0, 1.0, PROBES + 1))
         distance = ((x - point[0]) * normal[0] + (y - point[1]) * normal[1]) / np.hypot(*normal)
-        if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
-            i = int(np.argmin(distance))
-            raise SceneError(
-                f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation line "
-                f"at x={x[i]:.6g}, y={y[i]:.6g} (the body starts out penetrating it); move "
-                "contact.foundation.point or flip contact.foundation.normal",
-                key="contact.foundation",
-            )
+        refuse_penetration(side, distance, (x, y))
+
+
+def refuse_penetration(side: str, distance: np.ndarray, points: tuple) -> None:
+    """SceneError when a point of ``side`` (coordinates ``points``: x, y (, z)) lies beyond the
+    foundation, ``distance`` being its signed distance to it (positive on the body's side)."""
+    if not distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
+        return
+    i = int(np.argmin(distance))
+    at = ", ".join(f"{name}={c[i]:.6g}" for name, c in zip("xyz", points))
+    figure = FORMS[len(points)].foundation  # a line in the plane, a plane in space
+    raise SceneError(
+        f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation {figure} at {at} (the body "
+        "starts out penetrating it); move contact.foundation.point or flip contact.foundation.normal",
+        key="contact.foundation",
+    )
 
 
 def check_mesh_size(mesh: dict) -> None:
@@ -351,11 +361,12 @@ def check_file_sides(scene, header) -> None:
             if side in header.sides or (not header.sides_complete and (side.isdigit() or side == "untagged")):
                 continue
             if side in getattr(header, "other_sides", ()):
-                three_d = scene.dimension == 3
+                scene_form = FORMS[scene.dimension]
+                file_form = FORMS[scene_form.other_dimension]
                 raise SceneError(
-                    f"boundary.{part}: side {side!r} is a physical {'line' if three_d else 'surface'} in the mesh "
-                    f"file {scene.mesh_options['file']}: the file is a {'2D' if three_d else '3D'} mesh but the "
-                    f"scene is {'3D' if three_d else '2D'}; give a {'3D' if three_d else '2D'} mesh file",
+                    f"boundary.{part}: side {side!r} is a physical {file_form.side_entity} in the mesh file "
+                    f"{scene.mesh_options['file']}: the file is a {file_form.dimension}D mesh but the scene is "
+                    f"{scene_form.dimension}D; give a {scene_form.dimension}D mesh file",
                     key=f"boundary.{part}",
                 )
             listed = ", ".join(header.sides) or "none"

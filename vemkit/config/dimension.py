@@ -6,7 +6,8 @@ polygon and a plane mesh file are 2D. The ``model`` key says the constitution on
 tensor's lambda and mu, :mod:`vemkit.config.material`): ``plane_stress`` or ``plane_strain`` on a 2D
 body, ``3d`` on a 3D body; omitted, it is the body's default (``x-default-by-dimension`` of the
 schema: plane_stress in 2D, 3d in 3D). A model that does not fit the body is a one-line
-:class:`SceneError` naming ``model``, the body's dimension and the models that fit.
+:class:`SceneError` naming ``model``, the body's dimension and the models that fit. The facts of
+each dimension (its models, the words of the messages) are :data:`vemkit.config.body_forms.FORMS`.
 
 A mesh file that does not say its dimension (a binary gmsh 2 file without a physical volume, a
 file that cannot be opened) keeps the rule of before: 3D with ``model: 3d`` or a 3D ``domain``,
@@ -17,15 +18,26 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from vemkit.config.domain3d import is_3d_domain
+from vemkit.config.body_forms import FORMS
+from vemkit.config.domain3d import domain_dimension
 from vemkit.config.mesh_file_header import mesh_file_dimension
 from vemkit.config.scene_schema import schema_root
 from vemkit.exceptions import SceneError
 
-__all__ = ["MODELS_BY_DIMENSION", "body_dimension", "default_model", "fill_model", "mesh_file_path"]
+__all__ = [
+    "MODELS_BY_DIMENSION",
+    "MODEL_DIMENSION",
+    "body_dimension",
+    "default_model",
+    "fill_model",
+    "mesh_file_path",
+    "written_dimension",
+]
 
 #: the models (the constitution) that fit a body of each dimension, the default first
-MODELS_BY_DIMENSION = {2: ("plane_stress", "plane_strain"), 3: ("3d",)}
+MODELS_BY_DIMENSION = {dimension: form.models for dimension, form in FORMS.items()}
+#: the dimension of the body each model fits
+MODEL_DIMENSION = {model: dimension for dimension, models in MODELS_BY_DIMENSION.items() for model in models}
 
 
 def default_model(dimension: int) -> str:
@@ -47,22 +59,30 @@ def _domain_words(domain) -> str:
     return f"domain {domain}"
 
 
+def written_dimension(data: dict) -> int:
+    """The dimension the scene's words say, its mesh file unread: the larger of its domain's and its
+    model's (``3d``: 3; a plane model or none: 2), the rule of before for a mesh file that does not
+    say (module docstring)."""
+    model_dimension = MODEL_DIMENSION.get(data.get("model"), min(FORMS))
+    return max(domain_dimension(data.get("domain", "unit_square")), model_dimension)
+
+
 def body_dimension(data: dict, source: str | None = None) -> tuple[int, str]:
     """``(dimension, body)`` of a scene given as plain data (schema-valid, before the defaults):
     the dimension of its body and the words naming that body in a message."""
     domain = data.get("domain", "unit_square")
-    domain_3d = is_3d_domain(domain)
     name = data.get("discretization", {}).get("mesh", {}).get("file")
     if name is None:
-        return (3 if domain_3d else 2), _domain_words(domain)
+        return domain_dimension(domain), _domain_words(domain)
     dimension = mesh_file_dimension(mesh_file_path(name, source))
     if dimension is None:  # the file does not say: the rule of before (module docstring)
-        dimension = 3 if domain_3d or data.get("model") == "3d" else 2
-        return dimension, f"the mesh file {name}"
-    if domain_3d and dimension == 2:
+        return written_dimension(data), f"the mesh file {name}"
+    solid = domain_dimension(domain)
+    if dimension < solid:  # a 3D domain beside a plane mesh file
         raise SceneError(
-            f"{_domain_words(domain)} is a 3D body but the mesh file {name} is a plane (2D) mesh; "
-            "with a mesh file the file is the body: drop domain or give a 3D mesh file",
+            f"{_domain_words(domain)} is a {solid}D body but the mesh file {name} is "
+            f"{FORMS[dimension].mesh_file_words}; with a mesh file the file is the body: drop domain or give a "
+            f"{solid}D mesh file",
             key="domain",
         )
     if data.get("model") is None:
@@ -90,7 +110,7 @@ def _check_vectors_fit(data: dict, dimension: int, name: str) -> None:
     """A scene without ``model`` whose mesh file is the body: its vectors must have the file's
     dimension; the first that does not says which dimension the scene was written for."""
     for key, vector in _scene_vectors(data):
-        if isinstance(vector, list) and len(vector) in (2, 3) and len(vector) != dimension:
+        if isinstance(vector, list) and len(vector) in FORMS and len(vector) != dimension:
             raise SceneError(
                 f"{name}: is a {dimension}D mesh but the scene is written for {len(vector)}D ({key} has "
                 f"{len(vector)} components); give a {len(vector)}D mesh file, or {dimension} components "
@@ -109,14 +129,9 @@ def fill_model(data: dict, source: str | None = None) -> int:
         data["model"] = default_model(dimension)
     elif model not in valid:
         names = ", ".join(f"{m} (the default)" if m == default_model(dimension) else m for m in valid)
-        fix = (
-            "drop model or set model: 3d"
-            if dimension == 3
-            else "drop model, or give a 3D body (domain box, a polygon with extrude, or a 3D mesh file)"
-        )
         raise SceneError(
             f"model = {model!r} does not fit the body: {body} is {dimension}D; the models of a "
-            f"{dimension}D body: {names}; {fix}",
+            f"{dimension}D body: {names}; {FORMS[dimension].model_fix}",
             key="model",
         )
     return dimension

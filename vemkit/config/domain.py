@@ -3,8 +3,8 @@
 A :class:`Domain` is plain data: the outer polygon (counter-clockwise), one side name per outer
 edge (edge i runs from corner i to corner i + 1), and holes, each a polygon with one side name per
 edge or a circle ``(cx, cy, r)`` with one side name. An outer edge may be an arc (``arcs``, an
-extension of docs/reference/files.md): ``arcs[i] = (cx, cy)`` makes edge i the shorter arc (less than a half circle)
-of the circle through its two corners centred at (cx, cy); ``None`` keeps it straight. The arc
+extension of docs/reference/files.md, :mod:`vemkit.config.domain_arcs`): ``arcs[i] = (cx, cy)``
+makes edge i the shorter arc (less than a half circle) of the circle through its two corners centred at (cx, cy); ``None`` keeps it straight. The arc
 bulges away from its centre: outwards when the centre lies on the body's side of the chord.
 ``domain_from_spec`` builds it from the scene
 mapping of docs/reference/files.md (or ``"unit_square"``) and refuses a broken domain with a one-line
@@ -29,6 +29,14 @@ from typing import NamedTuple
 import numpy as np
 import shapely
 
+from vemkit.config.domain_arcs import (
+    MIN_CIRCLE_VERTICES,
+    arc_angles,
+    arc_box,
+    arc_points,
+    arcs_from_spec,
+    point_words,
+)
 from vemkit.exceptions import InputError
 
 #: the sides of the unit square (docs/reference/files.md): name -> (axis, value) of the line x_axis = value it lies on
@@ -48,8 +56,6 @@ def _edge_sides_on_lines(corners, lines) -> tuple:
 
 UNIT_SQUARE_EDGE_SIDES = _edge_sides_on_lines(UNIT_SQUARE_CORNERS, UNIT_SQUARE_SIDE_LINES)  # bottom, right, top, left
 SIDE_NAME = re.compile(r"[A-Za-z0-9_-]+")
-#: fewest vertices of the polygon that stands for a circle
-MIN_CIRCLE_VERTICES = 8
 
 
 @dataclass(frozen=True)
@@ -74,43 +80,6 @@ class CircleHole:
         m = max(MIN_CIRCLE_VERTICES, math.ceil(2.0 * math.pi * self.r / h))
         t = 2.0 * np.pi * np.arange(m) / m
         return np.stack([self.cx + self.r * np.cos(t), self.cy + self.r * np.sin(t)], axis=1)
-
-
-def arc_angles(a, b, centre) -> tuple:
-    """(r, t0, dt) of the shorter arc from corner a to corner b around ``centre``: radius (the
-    distance to a), start angle and signed sweep, |dt| < π (dt > 0: counter-clockwise)."""
-    (ax, ay), (bx, by), (cx, cy) = a, b, centre
-    t0 = math.atan2(ay - cy, ax - cx)
-    dt = math.remainder(math.atan2(by - cy, bx - cx) - t0, 2.0 * math.pi)
-    return math.hypot(ax - cx, ay - cy), t0, dt
-
-
-def arc_chords(r: float, dt: float, h: float | None) -> int:
-    """Chords that stand for an arc of radius r and sweep dt at cell size h (``None``: half-degree
-    steps, the resolution at which a domain is validated)."""
-    step = abs(dt) * MIN_CIRCLE_VERTICES / (2.0 * math.pi)
-    fine = abs(dt) / (math.pi / 360.0) if h is None else r * abs(dt) / h
-    return max(1, math.ceil(step - 1e-12), math.ceil(fine - 1e-12))
-
-
-def arc_points(a, b, centre, h: float | None) -> np.ndarray:
-    """The points strictly between corners a and b on their arc, in order from a (chords of about h)."""
-    r, t0, dt = arc_angles(a, b, centre)
-    m = arc_chords(r, dt, h)
-    t = t0 + dt * np.arange(1, m) / m
-    return np.stack([centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)], axis=1)
-
-
-def _arc_box(a, b, centre) -> tuple:
-    """(x0, y0, x1, y1) of an arc: its corners and the circle's axis extremes it passes."""
-    r, t0, dt = arc_angles(a, b, centre)
-    xs, ys = [a[0], b[0]], [a[1], b[1]]
-    for k in range(-4, 5):  # the angles k π/2 within the sweep
-        s = (k * 0.5 * math.pi - t0) / dt if dt else -1.0
-        if 0.0 < s < 1.0:
-            xs.append(centre[0] + r * round(math.cos(k * 0.5 * math.pi)))
-            ys.append(centre[1] + r * round(math.sin(k * 0.5 * math.pi)))
-    return min(xs), min(ys), max(xs), max(ys)
 
 
 class PolygonalDomain(NamedTuple):
@@ -153,13 +122,13 @@ class Domain:
         p = np.asarray(self.polygon)
         boxes = [(*p.min(axis=0).tolist(), *p.max(axis=0).tolist())]
         k = len(self.polygon)
-        boxes += [_arc_box(self.polygon[i], self.polygon[(i + 1) % k], c) for i, c in enumerate(self.arcs) if c]
+        boxes += [arc_box(self.polygon[i], self.polygon[(i + 1) % k], c) for i, c in enumerate(self.arcs) if c]
         lo, hi = np.min([b[:2] for b in boxes], axis=0), np.max([b[2:] for b in boxes], axis=0)
         return (*lo.tolist(), *hi.tolist())
 
     def outer_ring(self, h: float | None) -> tuple:
         """(points (P, 2), side of each edge point i -> i+1): the outer boundary counter-clockwise,
-        every arc replaced by chords of about h (``None``: half-degree steps, see ``arc_chords``)."""
+        every arc replaced by chords of about h (``None``: half-degree steps, see ``vemkit.config.domain_arcs.arc_chords``)."""
         corners = np.asarray(self.polygon, dtype=float)
         if not self.arcs:
             return corners, list(self.sides)
@@ -303,7 +272,7 @@ def domain_from_spec(spec=None) -> Domain:
             "domain.polygon is clockwise; list its corners counter-clockwise (reverse the list, and its sides)",
             key="domain.polygon",
         )
-    arcs = _arcs(spec.get("arcs"), outer)
+    arcs = arcs_from_spec(spec.get("arcs"), outer)
     body = Domain(tuple(outer), tuple(sides), (), arcs)
     if arcs:
         curved = shapely.LinearRing(body.outer_ring(None)[0])
@@ -330,49 +299,6 @@ def domain_from_spec(spec=None) -> Domain:
     return Domain(tuple(outer), tuple(sides), parsed, arcs)
 
 
-def _arcs(value, corners: list) -> tuple:
-    """The validated ``domain.arcs``: () when absent or all null, else one centre or None per edge."""
-    if value is None:
-        return ()
-    k = len(corners)
-    if not isinstance(value, (list, tuple)) or len(value) != k:
-        count = len(value) if isinstance(value, (list, tuple)) else "no list of"
-        raise InputError(
-            f"domain.arcs has {count} entries but the polygon has {k} edges; give one per edge i -> "
-            "i+1: null (straight) or the centre [cx, cy] of its arc",
-            key="domain.arcs",
-        )
-    centres = [
-        None if entry is None else _arc_centre(entry, corners[i], corners[(i + 1) % k], f"domain.arcs[{i}]")
-        for i, entry in enumerate(value)
-    ]
-    return tuple(centres) if any(c is not None for c in centres) else ()
-
-
-def _arc_centre(entry, a, b, key: str) -> tuple:
-    try:
-        cx, cy = (float(v) for v in entry)
-    except (TypeError, ValueError):
-        cx = cy = float("nan")
-    if not (math.isfinite(cx) and math.isfinite(cy)):
-        raise InputError(f"{key}: give null or the centre [cx, cy] (two finite numbers) of the edge's arc", key=key)
-    ra, rb = math.hypot(a[0] - cx, a[1] - cy), math.hypot(b[0] - cx, b[1] - cy)
-    if abs(ra - rb) > 1e-9 * max(ra, rb):
-        raise InputError(
-            f"{key}: the corners {_pt(a)} and {_pt(b)} are at distances {ra:.12g} and {rb:.12g} from "
-            f"the centre {_pt((cx, cy))}; give a centre equally far from both",
-            key=key,
-        )
-    mid = math.hypot(0.5 * (a[0] + b[0]) - cx, 0.5 * (a[1] + b[1]) - cy)
-    if mid <= 1e-9 * ra:
-        raise InputError(
-            f"{key}: the centre {_pt((cx, cy))} is the middle of the edge, so the arc would be a half "
-            "circle; split the edge at a corner on the circle (each arc less than a half circle)",
-            key=key,
-        )
-    return (cx, cy)
-
-
 def _corners(value, key: str) -> list:
     try:
         points = np.asarray(value, dtype=float)
@@ -391,7 +317,8 @@ def _corners(value, key: str) -> list:
         if np.array_equal(a, b):
             hint = " (do not repeat the first corner at the end)" if i == k - 1 else ""
             raise InputError(
-                f"{key}: edge {i} from {_pt(a)} to {_pt(b)} has zero length; remove the repeated corner{hint}", key=key
+                f"{key}: edge {i} from {point_words(a)} to {point_words(b)} has zero length; remove the repeated corner{hint}",
+                key=key,
             )
     return [(float(x), float(y)) for x, y in points]
 
@@ -469,7 +396,3 @@ def _check_placement(outer: shapely.Polygon, holes: tuple) -> None:
             other, s = shapes[j]
             if shape.distance(other) <= r + s:
                 raise InputError(f"{key} overlaps domain.holes[{j}]; holes must not touch", key=key)
-
-
-def _pt(p) -> str:
-    return f"({p[0]:g}, {p[1]:g})"

@@ -39,6 +39,9 @@ BOX_FAMILIES = ("hex", "tet", "octree", "voronoi")
 EXTRUDE_FAMILIES_3D = ("tet",)
 #: how the tet family makes its tetrahedra: gmsh's Delaunay mesher, or the Kuhn cut of the hex grid
 TET_KINDS = ("delaunay", "structured")
+PLANE = 2  # the dimension of a domain that is not a solid
+#: the dimension of the body a key of a ``domain`` mapping makes (any other key: a plane domain)
+DOMAIN_KEY_DIMENSION = {"box": 3, "extrude": 3}
 
 
 @dataclass(frozen=True)
@@ -74,19 +77,29 @@ def is_3d_domain(spec) -> bool:
     return isinstance(spec, (Box, Extruded)) or (isinstance(spec, dict) and ("box" in spec or "extrude" in spec))
 
 
+def domain_dimension(spec) -> int:
+    """The dimension of the body a scene's ``domain`` entry describes: 3 for a solid (a mapping with
+    ``box`` or ``extrude``, a :class:`Box`, an :class:`Extruded`), 2 for a plane body (``unit_square``,
+    a polygon, a :class:`~vemkit.config.domain.Domain`)."""
+    if isinstance(spec, dict):
+        return max((DOMAIN_KEY_DIMENSION.get(key, PLANE) for key in spec), default=PLANE)
+    return SOLID_DIMENSION.get(type(spec), PLANE)
+
+
 def domain3d_from_spec(spec):
     """The Box or Extruded of a docs/reference/files.md ``domain:`` mapping; SceneError naming the key otherwise."""
     if isinstance(spec, (Box, Extruded)):
         return spec
-    if not is_3d_domain(spec):
+    kinds = [key for key in _SOLIDS if key in spec] if isinstance(spec, dict) else []
+    if not kinds:
         raise SceneError(
             "domain: give a 3D body {box: [[x0, y0, z0], [x1, y1, z1]]} or {extrude: {depth: ...}, "
             "polygon: ..., sides: ...}",
             key="domain",
         )
-    if "box" in spec and "extrude" in spec:
+    if len(kinds) > 1:
         raise SceneError("domain: give either box or extrude, not both", key="domain")
-    return _box(spec) if "box" in spec else _extruded(spec)
+    return _SOLIDS[kinds[0]](spec)
 
 
 def _names(value, count: int, key: str, what: str) -> tuple:
@@ -156,6 +169,12 @@ def _extruded(spec: dict) -> Extruded:
     except InputError as error:
         raise SceneError(str(error), key=error.key) from None
     return Extruded(domain, depth, ends)
+
+
+#: the dimension of a parsed solid (any other body, a :class:`~vemkit.config.domain.Domain`: plane)
+SOLID_DIMENSION = {Box: 3, Extruded: 3}
+#: the parser of a solid ``domain`` mapping by its key
+_SOLIDS = {"box": _box, "extrude": _extruded}
 
 
 def cells_per_length3d(domain, n=None, h=None, cells=None, cells_per_cube: float = 1.0):

@@ -161,19 +161,17 @@ def _check_aspect(body, lower, upper) -> None:
     if extents.min() >= MIN_FEATURE * extents.max():
         return
     shape = " x ".join(f"{e:.3g}" for e in extents)
+    most = f"{1 / MIN_FEATURE:.0e}"
     if isinstance(body, Box):
-        raise SceneError(
-            f"domain.box: a box of {shape} is {extents.max() / extents.min():.1e} times longer than thick, "
-            f"beyond what a mesh resolves in double precision (at most {1 / MIN_FEATURE:.0e}); give sides "
-            f"within a factor {1 / MIN_FEATURE:.0e} of each other",
-            key="domain.box",
-        )
-    base = float(extents[:2].max())
+        key, where = "domain.box", f"domain.box: a box of {shape}"
+        fix = f"give sides within a factor {most} of each other"
+    else:
+        key, where = "domain.extrude.depth", f"domain.extrude.depth = {body.depth:g}: a body of {shape}"
+        fix = f"give a depth within a factor {most} of the base's size {float(extents[:2].max()):.3g}"
     raise SceneError(
-        f"domain.extrude.depth = {body.depth:g}: a body of {shape} is {extents.max() / extents.min():.1e} "
-        f"times longer than thick, beyond what a mesh resolves in double precision (at most "
-        f"{1 / MIN_FEATURE:.0e}); give a depth within a factor {1 / MIN_FEATURE:.0e} of the base's size {base:.3g}",
-        key="domain.extrude.depth",
+        f"{where} is {extents.max() / extents.min():.1e} times longer than thick, beyond what a mesh "
+        f"resolves in double precision (at most {most}); {fix}",
+        key=key,
     )
 
 

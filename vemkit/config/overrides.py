@@ -10,7 +10,7 @@ from __future__ import annotations
 import copy
 import re
 
-from vemkit.config.domain3d import is_3d_domain
+from vemkit.config.dimension import written_dimension
 from vemkit.config.safe_yaml import parse_yaml
 from vemkit.config.scene_schema import branch_names, key_name, resolve, schema_root, show, suggest
 from vemkit.exceptions import SceneError
@@ -116,8 +116,8 @@ def _default(node: dict, data: dict):
     """The schema's default of a key not in the scene; a vector's (body_force) has a 3D scene's three
     components (a 3D domain, or model 3d with a mesh file)."""
     value = copy.deepcopy(node.get("default", {}))
-    if (data.get("model") == "3d" or is_3d_domain(data.get("domain"))) and value == [0.0, 0.0]:
-        value.append(0.0)
+    if value == [0.0, 0.0]:  # the zero vector (body_force): one component per dimension of the body
+        value = [0.0] * written_dimension(data)
     return value
 
 

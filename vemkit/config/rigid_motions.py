@@ -35,14 +35,22 @@ EIGEN_ROUNDING = 1e3 * np.finfo(float).eps  # 3D: eigh's rounding of the smalles
 _AXES = "xyz"
 
 
-def _rotation_rows(c: np.ndarray, component: int) -> np.ndarray:
-    """ρ_i at the centred points ``c`` (N, d): (N, 1) in 2D, (N, 3) in 3D: (ω × c)_i = ρ_i · ω."""
-    if c.shape[1] == 2:
-        return (-c[:, 1:2]) if component == 0 else c[:, 0:1]
+def _plane_rows(c: np.ndarray, component: int) -> np.ndarray:
+    """ρ_i at the centred points ``c`` (N, 2): (N, 1), (ω × c)_i = ρ_i ω of the one rotation θ."""
+    return (-c[:, 1:2]) if component == 0 else c[:, 0:1]
+
+
+def _solid_rows(c: np.ndarray, component: int) -> np.ndarray:
+    """ρ_i at the centred points ``c`` (N, 3): (N, 3), (ω × c)_i = ρ_i · ω."""
     x, y, z = c.T
     zero = np.zeros_like(x)
     rows = ((zero, z, -y), (-z, zero, x), (y, -x, zero))[component]
     return np.stack(rows, axis=1)
+
+
+#: ρ_i by the dimension (the rounding of S in each is the one of before this table: a (N, 1) column
+#: in the plane, a (N, 3) table in space)
+_ROTATION_ROWS = {2: _plane_rows, 3: _solid_rows}
 
 
 def _schur(points: np.ndarray, prescribed: np.ndarray):
@@ -52,28 +60,41 @@ def _schur(points: np.ndarray, prescribed: np.ndarray):
     extent = float(np.ptp(points, axis=0).max())
     scale = extent if extent > 0 else 1.0
     d = points.shape[1]
-    S = np.zeros((1, 1) if d == 2 else (3, 3))
+    modes = d * (d - 1) // 2  # the rotations of R^d
+    S = np.zeros((modes, modes))
     means, counts = np.zeros((d, d)), np.zeros(d, dtype=np.int64)
     for i in range(d):
         held = (points[prescribed[:, i]] - shift) / scale  # exact zeros for points equal to the shift
         counts[i] = held.shape[0]
         centre = held.mean(axis=0)
-        rho = _rotation_rows(held - centre, i)
+        rho = _ROTATION_ROWS[d](held - centre, i)
         S += rho.T @ rho
         means[i] = shift + scale * centre
     return S, means, counts
 
 
-def _rotation_words(points, omega: np.ndarray, means: np.ndarray) -> str:
-    if points.shape[1] == 2:  # about (x̄_2, ȳ_1): every u1 point on y = ȳ_1, every u2 point on x = x̄_2
-        return f"a rotation about ({means[1][0]:.6g}, {means[0][1]:.6g})"
+def _about_point(omega: np.ndarray, means: np.ndarray) -> str:
+    """2D: about (x̄_2, ȳ_1): every u1 point on y = ȳ_1, every u2 point on x = x̄_2."""
+    return f"a rotation about ({means[1][0]:.6g}, {means[0][1]:.6g})"
+
+
+def _about_axis(omega: np.ndarray, means: np.ndarray) -> str:
+    """3D: about the axis along ω through the point where u_i = 0 at the mean of X_i."""
     omega = omega / np.linalg.norm(omega)
-    a = np.array([-np.cross(omega, means[i])[i] for i in range(3)])  # u_i = 0 at the mean of X_i
+    a = np.array([-np.cross(omega, means[i])[i] for i in range(3)])
     through = np.cross(omega, a)
     return (
         f"a rotation about the axis along ({omega[0]:.3g}, {omega[1]:.3g}, {omega[2]:.3g}) through "
         f"({through[0]:.6g}, {through[1]:.6g}, {through[2]:.6g})"
     )
+
+
+#: the words of a free rotation by the dimension: about a point in the plane, about an axis in space
+_ROTATION_WORDS = {2: _about_point, 3: _about_axis}
+
+
+def _rotation_words(points, omega: np.ndarray, means: np.ndarray) -> str:
+    return _ROTATION_WORDS[points.shape[1]](omega, means)
 
 
 def free_rigid_motion(coordinates: np.ndarray, prescribed: np.ndarray) -> str | None:

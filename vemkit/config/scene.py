@@ -27,9 +27,9 @@ from vemkit.config.boundary_conditions import (
     inside_points,
 )
 from vemkit.config.contact_laws import PowerLaw, TabulatedLaw, check_normal_compliance, normal_compliance
-from vemkit.config.dimension import fill_model, mesh_file_path
+from vemkit.config.dimension import MODEL_DIMENSION, default_model, fill_model, mesh_file_path
 from vemkit.config.domain import UNIT_SQUARE_SIDES, domain_from_spec
-from vemkit.config.domain3d import domain3d_from_spec, is_3d_domain
+from vemkit.config.domain3d import domain3d_from_spec, domain_dimension
 from vemkit.config.expressions import Expression
 from vemkit.config.loads import DEFAULT_BODY_FORCE_PROJECTION_K2
 from vemkit.config.material import lame_parameters
@@ -57,19 +57,27 @@ def _check_order_options(discretization: dict) -> None:
         )
 
 
-def _semantic_checks(data: dict, given: dict, dimension: int) -> dict:
-    """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
-    written (before the defaults were filled in); ``dimension``: the body's
-    (:mod:`vemkit.config.dimension`)."""
-    if "contact" in data:  # the law contact.normal names (2D and 3D), its keys and its table
-        check_normal_compliance(data["contact"]["normal"], max_slope=MAX_NORMAL_K_OVER_E * data["material"]["E"])
-    if dimension == 3:
-        return semantic_checks_3d(data, given)
+def _plane_sides(spec) -> tuple:
+    """The side names of a plane scene's ``domain`` entry (the unit square's in their scene order)."""
+    domain = domain_from_spec(spec)
+    return UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
+
+
+def _solid_sides(spec) -> tuple:
+    return domain3d_from_spec(spec).side_names
+
+
+#: the side names of a scene's body, by the body's dimension
+_SIDE_NAMES = {2: _plane_sides, 3: _solid_sides}
+
+
+def _plane_checks(data: dict, given: dict) -> dict:
+    """The checks of a plane scene beyond the schema (:func:`_semantic_checks`)."""
     check_mesh_size(data["discretization"]["mesh"])
     _check_order_options(data["discretization"])
     domain = domain_from_spec(data["domain"])  # one-line InputError naming the domain entry
     from_file = "file" in data["discretization"]["mesh"]
-    check_sides(data, None if from_file else (UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names))
+    check_sides(data, None if from_file else _plane_sides(domain))
     probed = None if from_file else domain
     check_mesh_resolution(data["discretization"]["mesh"], domain)
     compiled = boundary_expressions(data, probed)
@@ -80,6 +88,19 @@ def _semantic_checks(data: dict, given: dict, dimension: int) -> dict:
     if "contact" in data:
         check_contact(data, given.get("contact", {}), probed, compiled)
     return compiled
+
+
+#: the checks beyond the schema of a scene, by its body's dimension
+_CHECKS = {2: _plane_checks, 3: semantic_checks_3d}
+
+
+def _semantic_checks(data: dict, given: dict, dimension: int) -> dict:
+    """Checks beyond the schema; returns the compiled expressions by key. ``given``: the scene as
+    written (before the defaults were filled in); ``dimension``: the body's
+    (:mod:`vemkit.config.dimension`)."""
+    if "contact" in data:  # the law contact.normal names (2D and 3D), its keys and its table
+        check_normal_compliance(data["contact"]["normal"], max_slope=MAX_NORMAL_K_OVER_E * data["material"]["E"])
+    return _CHECKS[dimension](data, given)
 
 
 # -- the scene -----------------------------------------------------------------------------------
@@ -112,7 +133,7 @@ class Scene:
         object.__setattr__(self, "_expressions", expressions)
         object.__setattr__(self, "source", source)
         # the body's dimension (vemkit.config.dimension); a validated scene's model fits it
-        object.__setattr__(self, "_dimension", dimension or (3 if data["model"] == "3d" else 2))
+        object.__setattr__(self, "_dimension", dimension or MODEL_DIMENSION[data["model"]])
 
     def __setattr__(self, name, value):
         raise AttributeError("a Scene is immutable; use scene.with_overrides([...])")
@@ -190,10 +211,7 @@ class Scene:
     @property
     def sides(self) -> tuple:
         """All sides of the domain; sides not listed under boundary are traction-free."""
-        if self.dimension == 3:
-            return domain3d_from_spec(self.domain).side_names
-        domain = domain_from_spec(self.domain)
-        return UNIT_SQUARE_SIDES if domain.is_unit_square else domain.side_names
+        return _SIDE_NAMES[self.dimension](self.domain)
 
     def lame(self) -> tuple[float, float]:
         """``(lambda, mu)`` of C for the scene's model (``vemkit.config.material``; plane stress: the
@@ -271,7 +289,7 @@ def scene_from_dict(data, overrides=(), *, source: str | None = None) -> Scene:
     data = copy.deepcopy(data)
     for override in overrides:
         apply_override(data, override)
-    validate(data, model=data.get("model") or ("3d" if is_3d_domain(data.get("domain")) else None))
+    validate(data, model=data.get("model") or default_model(domain_dimension(data.get("domain"))))
     dimension = fill_model(data, source)  # the body's dimension; model checked against it, or its default
     filled = normalized(data, schema_root())
     contact = filled.get("contact")

@@ -25,6 +25,7 @@ from vemkit.config.boundary_conditions import (
     check_sides,
     compile_checked,
     evaluate_checked,
+    refuse_penetration,
     rigid_motion_error,
 )
 from vemkit.config.domain3d import BOX_FAMILIES, EXTRUDE_FAMILIES_3D, FAMILIES_2D, Box, domain3d_from_spec
@@ -217,11 +218,4 @@ def _check_plane(foundation: dict, sides, probes, s) -> None:
     for side in sides if probes is not None else ():
         x = np.stack(probes.side(side, s), axis=1)
         distance = (x - point) @ normal / np.linalg.norm(normal)
-        if distance.min() < -1e-12 * max(1.0, np.abs(distance).max()):
-            i = int(np.argmin(distance))
-            raise SceneError(
-                f"contact.foundation: {side} is {-distance[i]:.6g} beyond the foundation plane at "
-                f"x={x[i, 0]:.6g}, y={x[i, 1]:.6g}, z={x[i, 2]:.6g} (the body starts out penetrating "
-                "it); move contact.foundation.point or flip contact.foundation.normal",
-                key="contact.foundation",
-            )
+        refuse_penetration(side, distance, tuple(x.T))

@@ -28,6 +28,7 @@ import threading
 from contextlib import contextmanager
 from pathlib import Path
 
+from vemkit.config.safe_yaml import file_kind
 from vemkit.exceptions import OutputError
 from vemkit.io.temporary_names import temporary_name
 
@@ -40,17 +41,6 @@ WRITTEN: list[str] = []
 #: in a worker under ``vemkit.io.supervisor``: the pipe to the parent (see :func:`_report`)
 REPORT_FD: int | None = None
 HANDLED_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
-_KINDS = (
-    (stat.S_ISDIR, "a directory"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISSOCK, "a socket"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-)
-
-
-def _kind(mode: int) -> str:
-    return next((name for test, name in _KINDS if test(mode)), "not a regular file")
 
 
 def same_file(a, b) -> bool:
@@ -108,7 +98,7 @@ def output_target(path, option: str = "-o", inputs=()) -> Path:
     except OSError as error:  # a path under a file (ENOTDIR), a loop, no permission
         raise OutputError(f"{where}: cannot use this path ({error.strerror}); choose another", key=option) from None
     if mode is not None and not stat.S_ISREG(mode):
-        raise OutputError(f"{where}: exists and is {_kind(mode)}; give the path of a regular file", key=option)
+        raise OutputError(f"{where}: exists and is {file_kind(mode)}; give the path of a regular file", key=option)
     _check_directory(target.parent, where, option)
     if len(os.fsencode(str(target))) + longer >= path_max:  # its temporary file's path would be
         raise _too_long(where, option, path_max - 1 - longer, name_max)
