@@ -89,7 +89,9 @@ class WorkflowConfigError(InputError):
         super().__init__(message, key=text or "(top level)")
 
 
-#: why a solve failed (``SolveError.reason``); the robustness study classifies by these
+#: why a solve failed (``SolveError.reason``); the robustness study classifies by these. In the
+#: order of the solution file's status codes: ``vemkit.solvers.verification.FAILURE_CLASSES`` begins
+#: with them (then the failures that are no solve's: invalid input, an unexpected exception)
 SOLVE_FAILURE_REASONS = (
     "diverged",
     "stagnated",
@@ -97,8 +99,8 @@ SOLVE_FAILURE_REASONS = (
     "inaccurate_stop",
     "other",
     "time_budget",
-    "linear_solver_failed",
     "check_failed",
+    "linear_solver_failed",
 )
 
 
