@@ -114,7 +114,7 @@ class SharedMeshMembers:
     def __post_init__(self):
         for name, dtype in self.array_fields:
             object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=dtype))
-        parts = self.boundary.items()  # type: ignore[attr-defined]
+        parts = self.boundary.items()
         boundary = {str(k): np.asarray(v, dtype=np.int64).reshape(self.boundary_part_shape) for k, v in parts}
         object.__setattr__(self, "boundary", boundary)
 
