@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from contextlib import contextmanager
+from dataclasses import replace
 from itertools import count
 
 import numpy as np
@@ -231,9 +232,7 @@ def _collect(gmsh, surface_names: dict, meta: dict) -> PolyhedralMesh:
             key="discretization.mesh",
         )
     parts = {name: bf[label == k] for k, name in enumerate(names)}
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, meta
-    )
+    return replace(mesh, boundary=parts, meta=meta)
 
 
 def _match_rows(rows: np.ndarray, keys: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -289,9 +288,7 @@ def _box_snapped(mesh: PolyhedralMesh, lower, upper, sides) -> PolyhedralMesh:
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, k // 2] = (lower, upper)[k % 2][k // 2]
         parts[name] = np.sort(np.concatenate([parts[name], part]))
-    return PolyhedralMesh(
-        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
-    )
+    return replace(mesh, vertices=vertices, boundary=parts)
 
 
 def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
@@ -358,9 +355,7 @@ def _ends_snapped(mesh: PolyhedralMesh, depth: float, ends) -> PolyhedralMesh:
         part = mesh.boundary.get(name, np.zeros(0, np.int64))
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, 2] = z
-    return PolyhedralMesh(
-        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, mesh.boundary, mesh.meta
-    )
+    return replace(mesh, vertices=vertices)
 
 
 def surface_area(body) -> float:

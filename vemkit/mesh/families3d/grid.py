@@ -10,6 +10,8 @@ cells along an edge of length L (``n`` cells per unit length), or exactly ``shap
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from vemkit.mesh.polyhedral import PolyhedralMesh
@@ -101,6 +103,4 @@ def _grid_meta(n, shape, box, **family) -> dict:
 def _merge_repeated_names(mesh: PolyhedralMesh, sides) -> PolyhedralMesh:
     """from_face_soup with a name given twice already joins the parts; keep the sides' order."""
     parts = {name: mesh.boundary.get(name, np.zeros(0, np.int64)) for name in dict.fromkeys(sides)}
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
-    )
+    return replace(mesh, boundary=parts)
