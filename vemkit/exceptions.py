@@ -89,9 +89,8 @@ class WorkflowConfigError(InputError):
         super().__init__(message, key=text or "(top level)")
 
 
-#: why a solve failed (``SolveError.reason``); the robustness study classifies by these. In the
-#: order of the solution file's status codes: ``vemkit.solvers.verification.FAILURE_CLASSES`` begins
-#: with them (then the failures that are no solve's: invalid input, an unexpected exception)
+#: why a solve failed (``SolveError.reason``); the robustness study classifies by these, in this order
+#: (its status codes, ``vemkit.solvers.verification.FAILURE_CLASSES``)
 SOLVE_FAILURE_REASONS = (
     "diverged",
     "stagnated",
