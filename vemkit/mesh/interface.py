@@ -50,105 +50,42 @@ Each class keeps its own older names beside these (2D: ``edges``, ``edge_cells``
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Protocol, runtime_checkable
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 __all__ = ["INTERFACE_MEMBERS", "MeshInterface", "SharedMeshMembers"]
 
-#: every member of :class:`MeshInterface`, as the tests check them
-INTERFACE_MEMBERS = (
-    "dimension",
-    "vertices",
-    "n_vertices",
-    "n_cells",
-    "n_facets",
-    "cell_vertex_lists",
-    "cell_facet_lists",
-    "facets",
-    "facet_cells",
-    "facet_vector_areas",
-    "facet_normals",
-    "facet_areas",
-    "facet_centroids",
-    "cell_volumes",
-    "cell_centroids",
-    "cell_diameters",
-    "h",
-    "edges",
-    "exterior_facets",
-    "boundaries",
-    "boundary_facets",
-    "boundary_vertices",
-    "side_edges",
-    "meta",
-)
-
 
 @runtime_checkable
 class MeshInterface(Protocol):
-    """A mesh of any dimension (module doc: every member, its shape and its meaning).
+    """A mesh of any dimension (module doc: every member, its shape and its meaning). Every member
+    is read-only (the meshes are frozen; most are properties, computed on demand).
 
     ``isinstance(mesh, MeshInterface)`` checks that every member is there; on Python < 3.12 it
     evaluates them (cached properties are computed): a test's question, not a dispatch."""
 
     dimension: int
     vertices: np.ndarray
+    n_vertices: int
+    n_cells: int
+    n_facets: int
+    cell_vertex_lists: tuple[np.ndarray, np.ndarray]
+    cell_facet_lists: tuple[np.ndarray, np.ndarray]
+    facets: tuple[np.ndarray, np.ndarray]
+    facet_cells: np.ndarray
+    facet_vector_areas: np.ndarray
+    facet_normals: np.ndarray
+    facet_areas: np.ndarray
+    facet_centroids: np.ndarray
+    cell_volumes: np.ndarray
+    cell_centroids: np.ndarray
+    cell_diameters: np.ndarray
+    h: float
+    edges: np.ndarray
+    exterior_facets: np.ndarray
+    boundaries: dict
     meta: dict
-
-    @property
-    def n_vertices(self) -> int: ...
-
-    @property
-    def n_cells(self) -> int: ...
-
-    @property
-    def n_facets(self) -> int: ...
-
-    @property
-    def cell_vertex_lists(self) -> tuple[np.ndarray, np.ndarray]: ...
-
-    @property
-    def cell_facet_lists(self) -> tuple[np.ndarray, np.ndarray]: ...
-
-    @property
-    def facets(self) -> tuple[np.ndarray, np.ndarray]: ...
-
-    @property
-    def facet_cells(self) -> np.ndarray: ...
-
-    @property
-    def facet_vector_areas(self) -> np.ndarray: ...
-
-    @property
-    def facet_normals(self) -> np.ndarray: ...
-
-    @property
-    def facet_areas(self) -> np.ndarray: ...
-
-    @property
-    def facet_centroids(self) -> np.ndarray: ...
-
-    @property
-    def cell_volumes(self) -> np.ndarray: ...
-
-    @property
-    def cell_centroids(self) -> np.ndarray: ...
-
-    @property
-    def cell_diameters(self) -> np.ndarray: ...
-
-    @property
-    def h(self) -> float: ...
-
-    @property
-    def edges(self) -> np.ndarray: ...
-
-    @property
-    def exterior_facets(self) -> np.ndarray: ...
-
-    @property
-    def boundaries(self) -> dict: ...
 
     def boundary_facets(self, side: str | None = None) -> np.ndarray: ...
 
@@ -157,10 +94,29 @@ class MeshInterface(Protocol):
     def side_edges(self, name: str) -> np.ndarray: ...
 
 
+#: every member of :class:`MeshInterface` (its attributes, then its methods), as the tests check them
+INTERFACE_MEMBERS = tuple(MeshInterface.__annotations__) + tuple(
+    name for name, member in vars(MeshInterface).items() if callable(member) and not name.startswith("_")
+)
+
+
 class SharedMeshMembers:
     """The members of :class:`MeshInterface` that follow from the others, written once for both
     meshes (a mixin: a mesh class provides ``facets``, ``facet_cells``, ``facet_vector_areas`` and
-    ``boundaries``)."""
+    ``boundaries``), and the construction of both frozen dataclasses: their arrays (``array_fields``)
+    made contiguous of their dtypes, the named boundary parts int64 arrays of ``boundary_part_shape``."""
+
+    #: (field, dtype) of every array the mesh holds
+    array_fields: ClassVar[tuple] = ()
+    #: the shape of a named boundary part: (-1, 2) vertex pairs (2D), (-1,) face ids (3D)
+    boundary_part_shape: ClassVar[tuple] = (-1,)
+
+    def __post_init__(self):
+        for name, dtype in self.array_fields:
+            object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=dtype))
+        parts = self.boundary.items()
+        boundary = {str(k): np.asarray(v, dtype=np.int64).reshape(self.boundary_part_shape) for k, v in parts}
+        object.__setattr__(self, "boundary", boundary)
 
     @property
     def n_facets(self) -> int:

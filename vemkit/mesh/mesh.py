@@ -36,16 +36,8 @@ class Mesh(SharedMeshMembers):
     meta: dict = field(default_factory=dict)
 
     dimension = 2
-
-    def __post_init__(self):
-        object.__setattr__(self, "vertices", np.ascontiguousarray(self.vertices, dtype=np.float64))
-        object.__setattr__(self, "cell_offsets", np.ascontiguousarray(self.cell_offsets, dtype=np.int64))
-        object.__setattr__(self, "cell_vertices", np.ascontiguousarray(self.cell_vertices, dtype=np.int64))
-        object.__setattr__(
-            self,
-            "boundary",
-            {str(k): np.asarray(v, dtype=np.int64).reshape(-1, 2) for k, v in self.boundary.items()},
-        )
+    array_fields = (("vertices", np.float64), ("cell_offsets", np.int64), ("cell_vertices", np.int64))
+    boundary_part_shape = (-1, 2)  # vertex pairs
 
     # -- sizes -----------------------------------------------------------------------------
     @property

@@ -39,19 +39,14 @@ class PolyhedralMesh(SharedMeshMembers):
     meta: dict = field(default_factory=dict)
 
     dimension = 3
-
-    def __post_init__(self):
-        for name, dtype in (
-            ("vertices", np.float64),
-            ("face_offsets", np.int64),
-            ("face_vertices", np.int64),
-            ("cell_offsets", np.int64),
-            ("cell_faces", np.int64),
-        ):
-            object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=dtype))
-        object.__setattr__(
-            self, "boundary", {str(k): np.asarray(v, dtype=np.int64).ravel() for k, v in self.boundary.items()}
-        )
+    array_fields = (
+        ("vertices", np.float64),
+        ("face_offsets", np.int64),
+        ("face_vertices", np.int64),
+        ("cell_offsets", np.int64),
+        ("cell_faces", np.int64),
+    )
+    boundary_part_shape = (-1,)  # face ids
 
     # -- sizes -----------------------------------------------------------------------------
     n_vertices = property(lambda self: self.vertices.shape[0], doc="number of vertices")

@@ -11,6 +11,8 @@ appearances run the same way when the vertex after the smallest one is the same.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from vemkit.mesh.polyhedral import PolyhedralMesh
@@ -103,6 +105,4 @@ def tag_box_faces(mesh: PolyhedralMesh, lower, upper, sides, tol: float = 1e-10)
         faces = bf[on[bf]]
         parts[name] = np.concatenate([parts.get(name, np.zeros(0, np.int64)), faces])
     parts = {k: np.sort(v) for k, v in parts.items()}
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, dict(mesh.meta)
-    )
+    return replace(mesh, boundary=parts, meta=dict(mesh.meta))

@@ -78,8 +78,8 @@ class MeshTopology:
 
 
 def mesh_topology(mesh) -> MeshTopology:
-    """The UGRID description of ``mesh``, by the dimension the mesh says it has."""
-    return _polyhedron_topology(mesh) if mesh.dimension == 3 else _polygon_topology(mesh)
+    """The UGRID description of ``mesh``, by the dimension the mesh says it has (``TOPOLOGY_OF``)."""
+    return TOPOLOGY_OF[mesh.dimension](mesh)
 
 
 def topology_file(topology: MeshTopology) -> FileDescription:
@@ -226,3 +226,7 @@ def _polyhedron_topology(mesh) -> MeshTopology:
     }
     layout = ("node_coordinates", "connectivity", "boundary_parts", "topology")
     return MeshTopology(t, 3, attrs, coordinates, (faces, volumes), parts, layout, "volume", np.int32)
+
+
+#: the UGRID description of a mesh of each dimension
+TOPOLOGY_OF = {2: _polygon_topology, 3: _polyhedron_topology}

@@ -28,7 +28,7 @@ _VTK_TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64", np.d
 
 def write_vtu(mesh, path, point_data: dict | None = None, cell_data: dict | None = None) -> None:
     """Write ``mesh`` (2D or 3D) and its data as VTU (module docstring)."""
-    order, cells = polyhedron_cells(mesh) if mesh.dimension == 3 else polygon_cells(mesh)
+    order, cells = VTK_CELLS[mesh.dimension](mesh)
     point_arrays = _data_rows(point_data, mesh.n_vertices, "points")
     cell_arrays = {name: values[order] for name, values in _data_rows(cell_data, mesh.n_cells, "cells").items()}
     cell_arrays["cell_index"] = order
@@ -111,6 +111,10 @@ def polyhedron_streams(mesh):
     stream[face_pos] = sizes
     stream[np.repeat(face_pos + 1, sizes) + (np.arange(entry.size) - np.repeat(np.cumsum(sizes) - sizes, sizes))] = ids
     return conn, conn_offsets[1:], stream, ends
+
+
+#: the written cells of a mesh of each dimension: (their order, the ``<Cells>`` arrays)
+VTK_CELLS = {2: polygon_cells, 3: polyhedron_cells}
 
 
 def _data_rows(data: dict | None, count: int, where: str) -> dict[str, np.ndarray]:

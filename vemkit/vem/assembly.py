@@ -135,26 +135,12 @@ def add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data):
             add_block(data, q, stride, K, i, j, dim)
 
 
-def scatter_rows(
-    row_lo,
-    row_hi,
-    geometry,
-    offsets,
-    nodes,
-    free_index,
-    free_nodes,
-    nc_ptr,
-    nc,
-    indptr,
-    indices,
-    lam,
-    mu,
-    stab,
-    condense,
-    max_nodes,
-    data,
-):
-    """*Template.* Add the rows row_lo <= r < row_hi of every element stiffness touching them."""
+def scatter_rows(row_lo, row_hi, geometry, cells, pattern, material, max_nodes, data):
+    """*Template.* Add the rows row_lo <= r < row_hi of every element stiffness touching them (the
+    tuples ``cells``, ``pattern`` and ``material`` of ``stiffness_matrix``)."""
+    offsets, nodes = cells
+    free_index, free_nodes, nc_ptr, nc, indptr, indices = pattern
+    lam, mu, stab, condense = material
     work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
     rows = np.empty(max_nodes, dtype=np.int64)
     order = np.empty(max_nodes, dtype=np.int64)
@@ -169,32 +155,13 @@ def scatter_rows(
         add_rows(row_lo, row_hi, rows, size, order, K, indptr, indices, data)  # noqa: F821 (specialized)
 
 
-def scatter_stiffness(
-    geometry, offsets, nodes, free_index, free_nodes, nc_ptr, nc, indptr, indices, lam, mu, stab, condense, data
-):
+def scatter_stiffness(geometry, cells, pattern, material, data):
     """*Template* (parallel). Every element stiffness (3.9) added into the CSR ``data`` (zeroed)."""
-    max_nodes = largest_cell(offsets)
+    max_nodes = largest_cell(cells[0])
+    n_rows = pattern[1].shape[0]
     for chunk in numba.prange(ROW_CHUNKS):
-        lo, hi = chunk_rows(chunk, free_nodes.shape[0])
-        scatter_rows(
-            lo,
-            hi,
-            geometry,
-            offsets,
-            nodes,
-            free_index,
-            free_nodes,
-            nc_ptr,
-            nc,
-            indptr,
-            indices,  # noqa: F821
-            lam,
-            mu,
-            stab,
-            condense,
-            max_nodes,
-            data,
-        )
+        lo, hi = chunk_rows(chunk, n_rows)
+        scatter_rows(lo, hi, geometry, cells, pattern, material, max_nodes, data)
 
 
 def scatter_kernel(element: Element):
@@ -212,39 +179,34 @@ def sorted_csr(data, indices, indptr, n: int) -> sp.csr_matrix:
     return A
 
 
+def material_of(lam: float, mu: float, stabilization: str, dofs) -> tuple:
+    """The ``material`` argument of the templates: (lam, mu, stabilization code, whether ``dofs``
+    condense the interior nodes). Beside it they take ``element.geometry(mesh)`` and ``cells``, the
+    space's CSR (offsets, nodes) (``cell_matrix``'s arguments; a parallel loop takes no nested tuple)."""
+    return float(lam), float(mu), stabilization_code(stabilization), dofs.condensed
+
+
 def stiffness_matrix(space, lam: float, mu: float, stabilization: str, dofs=None) -> sp.csr_matrix:
     """The global VEM stiffness matrix of ``space`` (a :class:`~vemkit.vem.space.VirtualElementSpace`)
     on the free dofs of ``dofs`` (default: every node free, ``space.numbering()``), in their order;
     with ``dofs.condensed`` the Schur complement on the non-interior dofs. Symmetric positive
     definite when the constraints exclude the rigid motions."""
     dofs = space.numbering() if dofs is None else dofs
-    offsets, nodes = space.cell_nodes
+    offsets, nodes = cells = space.cell_nodes
     nc_ptr, nc = node_cells(offsets, nodes, dofs.n_nodes)
     dim = space.element.dimension
     indptr, indices = dof_pattern(offsets, nodes, nc_ptr, nc, dofs.free_nodes, dofs.free_index, dim)
     data = np.zeros(indices.shape[0])  # fresh zero pages from the system: no zeroing pass
+    pattern = (dofs.free_index, dofs.free_nodes, nc_ptr, nc, indptr, indices)
     geometry = space.element.geometry(space.mesh)
-    scatter_kernel(space.element)(
-        geometry,
-        offsets,
-        nodes,
-        dofs.free_index,
-        dofs.free_nodes,
-        nc_ptr,
-        nc,
-        indptr,
-        indices,
-        float(lam),
-        float(mu),
-        stabilization_code(stabilization),
-        dofs.condensed,
-        data,
-    )
+    scatter_kernel(space.element)(geometry, cells, pattern, material_of(lam, mu, stabilization, dofs), data)
     return sorted_csr(data, indices, indptr, dofs.n_free)
 
 
-def lift(geometry, offsets, nodes, free_index, values, lam, mu, stab, condense, out):
+def lift(geometry, cells, material, free_index, values, out):
     """*Template.* out[free] -= K_fc u_c over the cells that touch a clamped node with a non-zero value."""
+    offsets, nodes = cells
+    lam, mu, stab, condense = material
     work = workspace(largest_cell(offsets))  # noqa: F821
     for c in range(offsets.shape[0] - 1):
         start = offsets[c]
@@ -276,20 +238,10 @@ def lift(geometry, offsets, nodes, free_index, values, lam, mu, stab, condense, 
 def dirichlet_lift(space, lam: float, mu: float, stabilization: str, dofs, values) -> np.ndarray:
     """-K_fc u_c on the free dofs: add it to the load when the clamped nodes carry the values
     ``values`` (n_nodes, d) (e.g. ``space.interpolate`` of the prescribed displacement) instead of 0."""
-    offsets, nodes = space.cell_nodes
     out = np.zeros(dofs.n_free)
     vals = np.ascontiguousarray(values, dtype=float).reshape(dofs.n_nodes, space.element.dimension)
     geometry = space.element.geometry(space.mesh)
     specialized(lift, space.element)(
-        geometry,
-        offsets,
-        nodes,
-        dofs.free_index,
-        vals,
-        float(lam),
-        float(mu),
-        stabilization_code(stabilization),
-        dofs.condensed,
-        out,
+        geometry, space.cell_nodes, material_of(lam, mu, stabilization, dofs), dofs.free_index, vals, out
     )
     return out

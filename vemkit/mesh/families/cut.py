@@ -21,6 +21,8 @@ those touching the side ``contact_side`` or a random ``fraction`` of them (as on
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import shapely
 
@@ -38,7 +40,7 @@ def cut_squares(domain: Domain, n: float) -> Mesh:
     squares = _grid_squares(polygonal.shape, 1.0 / n, 1)
     mesh = cut_mesh(polygonal, squares, 1.0 / n)
     meta = {"family": "square", "n": n, "merge_ratio": MERGE_RATIO, "domain": domain.to_spec()}
-    return Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, mesh.boundary, meta)
+    return replace(mesh, meta=meta)
 
 
 def cut_hanging(
@@ -65,7 +67,7 @@ def cut_hanging(
     meta = {"family": "hanging", "n": n, "levels": levels, "rule": rule, "seed": int(seed)}
     meta.update({"fraction": float(fraction)} if rule == "random" else {"contact_side": contact_side})
     meta.update({"merge_ratio": MERGE_RATIO, "domain": domain.to_spec()})
-    return Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, mesh.boundary, meta)
+    return replace(mesh, meta=meta)
 
 
 def quadrisect(squares: np.ndarray, chosen: np.ndarray) -> np.ndarray:

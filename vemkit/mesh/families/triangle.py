@@ -45,14 +45,7 @@ def delaunay_triangle(n: float, seed: int = 0, min_angle: float = 28.0, domain=N
         target = int(round(2 * n * n))
         pslg = {"vertices": np.vstack([_SQUARE, _seed_points(n, seed)]), "segments": _SIDES}
         mesh, meta = _quality_triangles(pslg, target, min_angle)
-        meta = {
-            "family": "triangle",
-            "kind": "delaunay",
-            "n": n,
-            "seed": int(seed),
-            "min_angle": float(min_angle),
-            **meta,
-        }
+        meta = _delaunay_meta(n, seed, min_angle, meta)
         return tag_box_boundary(Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, {}, meta))
     if not n > 0:
         raise ValueError(f"mesh n = {n}: the number of cells per unit length must be > 0")
@@ -65,17 +58,23 @@ def delaunay_triangle(n: float, seed: int = 0, min_angle: float = 28.0, domain=N
     if polygonal.hole_points.size:
         pslg["holes"] = polygonal.hole_points
     mesh, meta = _quality_triangles(pslg, target, min_angle, polygonal.shape.area)
-    meta = {
+    meta = _delaunay_meta(n, seed, min_angle, meta, domain=domain.to_spec())
+    mesh = _drop_unused_vertices(mesh)
+    return tag_sides(Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, {}, meta), polygonal)
+
+
+def _delaunay_meta(n, seed, min_angle, triangle_meta: dict, **domain) -> dict:
+    """The mesh's ``meta``: the family's parameters, then Triangle's (``_quality_triangles``), then the
+    domain's spec where it is not the unit square."""
+    return {
         "family": "triangle",
         "kind": "delaunay",
         "n": n,
         "seed": int(seed),
         "min_angle": float(min_angle),
-        **meta,
-        "domain": domain.to_spec(),
+        **triangle_meta,
+        **domain,
     }
-    mesh = _drop_unused_vertices(mesh)
-    return tag_sides(Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, {}, meta), polygonal)
 
 
 def _quality_triangles(pslg: dict, target: int, min_angle: float, area: float = 1.0):

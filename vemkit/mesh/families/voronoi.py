@@ -34,6 +34,7 @@ bit for bit.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -90,7 +91,7 @@ def voronoi(
     else:
         meta["domain"] = shape.wkt
         mesh = mesh.with_boundary(boundary=mesh.boundary_edges)
-    return Mesh(mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, mesh.boundary, meta)
+    return replace(mesh, meta=meta)
 
 
 def _domain_shape(domain, n: float):

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from contextlib import contextmanager
+from dataclasses import replace
 from itertools import count
 
 import numpy as np
@@ -155,6 +156,14 @@ def edge_length(n: float) -> float:
     return EDGE_PER_N / float(n)
 
 
+def _delaunay_meta(n, optimize, **body) -> dict:
+    """The ``meta`` of a gmsh tet mesh of ``body`` (its own entries: the box, or the extruded body's):
+    ``n``, its edge length (``edge_length``) and the checked ``optimize`` flag."""
+    optimize = _flag(optimize)
+    edge = edge_length(n)
+    return {"family": "tet", "kind": "delaunay", "n": n, "edge": edge, **body, "mesher": "gmsh", "optimize": optimize}
+
+
 def tet_counts(n: float, volume: float, area: float) -> tuple:
     """(cells, vertices, faces) predicted for a body of ``volume`` and surface ``area`` (module doc)."""
     n = float(n)
@@ -223,9 +232,7 @@ def _collect(gmsh, surface_names: dict, meta: dict) -> PolyhedralMesh:
             key="discretization.mesh",
         )
     parts = {name: bf[label == k] for k, name in enumerate(names)}
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, meta
-    )
+    return replace(mesh, boundary=parts, meta=meta)
 
 
 def _match_rows(rows: np.ndarray, keys: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -251,18 +258,9 @@ def delaunay_tet(
     optimize: bool = True,
 ) -> PolyhedralMesh:
     """gmsh's quality Delaunay tetrahedra of the box, at edge length ``EDGE_PER_N / n`` (module doc)."""
-    optimize = _flag(optimize)
     lower, upper = (np.asarray(b, dtype=float) for b in box)
-    edge = edge_length(n)
-    meta = {
-        "family": "tet",
-        "kind": "delaunay",
-        "n": n,
-        "edge": edge,
-        "box": [lower.tolist(), upper.tolist()],
-        "mesher": "gmsh",
-        "optimize": optimize,
-    }
+    meta = _delaunay_meta(n, optimize, box=[lower.tolist(), upper.tolist()])
+    edge, optimize = meta["edge"], meta["optimize"]
     with gmsh_session("mesh family tet on the box", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         occ.addBox(*lower.tolist(), *(upper - lower).tolist())
@@ -290,29 +288,16 @@ def _box_snapped(mesh: PolyhedralMesh, lower, upper, sides) -> PolyhedralMesh:
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, k // 2] = (lower, upper)[k % 2][k // 2]
         parts[name] = np.sort(np.concatenate([parts[name], part]))
-    return PolyhedralMesh(
-        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
-    )
+    return replace(mesh, vertices=vertices, boundary=parts)
 
 
 def delaunay_tet_extruded(n, body, optimize: bool = True) -> PolyhedralMesh:
     """gmsh's quality Delaunay tetrahedra of an extruded 2D body (``Extruded``; module doc)."""
-    optimize = _flag(optimize)
     from vemkit.config.domain import CircleHole
 
     base, depth, ends = body.base, float(body.depth), tuple(body.ends)
-    edge = edge_length(n)
-    meta = {
-        "family": "tet",
-        "kind": "delaunay",
-        "n": n,
-        "edge": edge,
-        "depth": depth,
-        "ends": list(ends),
-        "base": base.to_spec(),
-        "mesher": "gmsh",
-        "optimize": optimize,
-    }
+    meta = _delaunay_meta(n, optimize, depth=depth, ends=list(ends), base=base.to_spec())
+    edge, optimize = meta["edge"], meta["optimize"]
     with gmsh_session("mesh family tet on the extruded domain", edge, optimize) as gmsh:
         occ = gmsh.model.occ
         curve_names = {}
@@ -370,9 +355,7 @@ def _ends_snapped(mesh: PolyhedralMesh, depth: float, ends) -> PolyhedralMesh:
         part = mesh.boundary.get(name, np.zeros(0, np.int64))
         ids = np.unique(mesh.face_vertices[(mesh.face_offsets[part][:, None] + np.arange(3)).ravel()])
         vertices[ids, 2] = z
-    return PolyhedralMesh(
-        vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, mesh.boundary, mesh.meta
-    )
+    return replace(mesh, vertices=vertices)
 
 
 def surface_area(body) -> float:

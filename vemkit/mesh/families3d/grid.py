@@ -10,6 +10,8 @@ cells along an edge of length L (``n`` cells per unit length), or exactly ``shap
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from vemkit.mesh.polyhedral import PolyhedralMesh
@@ -65,18 +67,8 @@ def hex(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     """The grid of hexahedra of the box (module doc)."""
     shape = grid_shape(n, box, shape)
     vertices, ids = lattice(shape, box)
-    faces = ids[:, HEX_FACES].reshape(-1, 4)
-    m = ids.shape[0]
-    labels = np.tile(np.arange(6), m)
-    mesh = from_face_soup(
-        vertices,
-        np.full(m, 6),
-        np.full(6 * m, 4),
-        faces.ravel(),
-        labels,
-        tuple(sides),
-        {"family": "hex", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()},
-    )
+    labels = np.tile(np.arange(6), ids.shape[0])
+    mesh = _cells_mesh(vertices, ids, HEX_FACES, labels, tuple(sides), _grid_meta(n, shape, box, family="hex"))
     return _merge_repeated_names(mesh, sides)
 
 
@@ -88,23 +80,27 @@ def tet(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     p = vertices[tets]
     det = np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]))
     tets[det < 0] = tets[det < 0][:, [0, 2, 1, 3]]
-    m = tets.shape[0]
-    faces = tets[:, TET_FACES].reshape(-1, 3)
-    mesh = from_face_soup(
-        vertices,
-        np.full(m, 4),
-        np.full(4 * m, 3),
-        faces.ravel(),
-        None,
-        (),
-        {"family": "tet", "kind": "structured", "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()},
+    meta = _grid_meta(n, shape, box, family="tet", kind="structured")
+    return tag_box_faces(_cells_mesh(vertices, tets, TET_FACES, None, (), meta), *check_box(box), sides)
+
+
+def _cells_mesh(vertices, cells, cell_faces, labels, sides, meta) -> PolyhedralMesh:
+    """``from_face_soup`` of cells given by their corners ``cells`` (m, c), each with the faces
+    ``cell_faces`` (f, k) (local corner numbers, outward); ``labels``, ``sides`` its boundary names."""
+    m = cells.shape[0]
+    n_faces, face_size = cell_faces.shape
+    faces = cells[:, cell_faces].reshape(-1, face_size)
+    return from_face_soup(
+        vertices, np.full(m, n_faces), np.full(n_faces * m, face_size), faces.ravel(), labels, sides, meta
     )
-    return tag_box_faces(mesh, *check_box(box), sides)
+
+
+def _grid_meta(n, shape, box, **family) -> dict:
+    """The ``meta`` of a grid mesh: the family (and kind), ``n``, the cell counts and the box."""
+    return {**family, "n": n, "shape": list(shape), "box": np.asarray(box, float).tolist()}
 
 
 def _merge_repeated_names(mesh: PolyhedralMesh, sides) -> PolyhedralMesh:
     """from_face_soup with a name given twice already joins the parts; keep the sides' order."""
     parts = {name: mesh.boundary.get(name, np.zeros(0, np.int64)) for name in dict.fromkeys(sides)}
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, parts, mesh.meta
-    )
+    return replace(mesh, boundary=parts)

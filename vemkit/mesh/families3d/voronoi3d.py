@@ -20,6 +20,7 @@ merged (Qhull may report a degenerate vertex twice).
 from __future__ import annotations
 
 import itertools
+from dataclasses import replace
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -92,9 +93,7 @@ def voronoi(
         "jitter": float(jitter),
         "lloyd_samples": int(lloyd_samples),
     }
-    return PolyhedralMesh(
-        mesh.vertices, mesh.face_offsets, mesh.face_vertices, mesh.cell_offsets, mesh.cell_faces, mesh.boundary, meta
-    )
+    return replace(mesh, meta=meta)
 
 
 def sample_grid(count: int, lower, upper, k: int) -> np.ndarray:

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from vemkit.vem.elements.k1_kernel import add_stabilization
+from vemkit.vem.elements.k1_kernel import add_stabilization, stiffness_workspace
 
 
 @numba.njit(cache=True)
@@ -282,16 +282,7 @@ def element_stiffness(p, face_ptr, face_local, f_lo, f_hi, lam, mu, stab, length
 @numba.njit(cache=True)
 def workspace(max_nodes):
     """(K, B, P, R, p, q, w): the work arrays of ``cell_matrix`` for cells of up to max_nodes vertices."""
-    m = 3 * max_nodes
-    return (
-        np.empty((m, m)),
-        np.empty((6, m)),
-        np.empty((12, m)),
-        np.empty((m, m)),
-        np.empty((max_nodes, 3)),
-        np.empty((max_nodes, 3)),
-        np.empty(max_nodes),
-    )
+    return stiffness_workspace(3, max_nodes) + (np.empty((max_nodes, 3)), np.empty((max_nodes, 3)), np.empty(max_nodes))
 
 
 @numba.njit(cache=True)

@@ -173,17 +173,19 @@ def add_stabilization(R, alpha, K):
 # the element's hooks for the one assembly of ``vemkit.vem.assembly`` (``vemkit.vem.elements``)
 # --------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
+def stiffness_workspace(dim, max_nodes):
+    """(K, B, P, R): the k = 1 element's matrices in dimension ``dim`` for cells of up to max_nodes
+    vertices (m = dim max_nodes scalars): the stiffness K and R = (I - Pi)^T (m x m), the strain
+    operator B (one row per Voigt strain, dim (dim + 1) / 2) and the projection's P (dim (dim + 1))."""
+    m = dim * max_nodes
+    strains = dim * (dim + 1) // 2
+    return np.empty((m, m)), np.empty((strains, m)), np.empty((2 * strains, m)), np.empty((m, m))
+
+
+@numba.njit(cache=True)
 def workspace(max_nodes):
     """(K, B, P, R, px, py): the work arrays of ``cell_matrix`` for cells of up to max_nodes vertices."""
-    m = 2 * max_nodes
-    return (
-        np.empty((m, m)),
-        np.empty((3, m)),
-        np.empty((6, m)),
-        np.empty((m, m)),
-        np.empty(max_nodes),
-        np.empty(max_nodes),
-    )
+    return stiffness_workspace(2, max_nodes) + (np.empty(max_nodes), np.empty(max_nodes))
 
 
 @numba.njit(cache=True)

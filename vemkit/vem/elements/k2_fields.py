@@ -121,29 +121,13 @@ def _frames(vertices, offsets, nodes, frame):
         frame[c, 0], frame[c, 1], frame[c, 2] = xc, yc, h
 
 
-@numba.njit(cache=True, parallel=True)
-def _projected_parts(vertices, offsets, nodes, lam, mu, moments, parts):
-    """parts[2 offsets[c] + j] = sum_b Pi[b, j] moments[c, b]: int_K g . Pi_2 phi_j dx given
-    int_K g . q_b dx, for the 2 (2n + 1) local dofs j of every cell (in parallel, CELL_CHUNKS shares)."""
-    n_cells = offsets.shape[0] - 1
-    nmax = largest_cell(offsets)
-    for chunk in numba.prange(CELL_CHUNKS):
-        Pi, rhs, G, sig = projection_workspace(nmax)
-        for c in range(chunk * n_cells // CELL_CHUNKS, (chunk + 1) * n_cells // CELL_CHUNKS):
-            start = offsets[c]
-            size = cell_projection(vertices, offsets, nodes, c, lam, mu, Pi, rhs, G, sig)[0]
-            for j in range(2 * size):
-                acc = 0.0
-                for b in range(N_BASIS):
-                    acc += Pi[b, j] * moments[c, b]
-                parts[2 * start + j] = acc
-
-
 def _scatter_projected(vertices, offsets, nodes, lam, mu, moments, out):
-    """out[node_j] += sum_b Pi[b, j] moments[c, b] over the cells in order (``_projected_parts``, then
+    """out[node_j] += sum_b Pi[b, j] moments[c, b] over the cells in order (``_cell_projections``, then
     one ordered np.add.at: the sums of a serial loop over the cells)."""
     parts = np.empty(2 * offsets[-1])
-    _projected_parts(vertices, offsets, nodes, lam, mu, moments, parts)
+    frame = np.empty((offsets.shape[0] - 1, 3))
+    no_values, no_coef = np.empty((0, 2)), np.empty((0, N_BASIS))
+    _cell_projections(vertices, offsets, nodes, lam, mu, no_values, moments, no_coef, frame, parts)
     np.add.at(out, (np.repeat(nodes, 2), np.tile(np.arange(2), nodes.size)), parts)
 
 
@@ -219,8 +203,11 @@ def body_force_p1_k2(mesh: Mesh, body_force, lam: float, mu: float) -> np.ndarra
 
 
 @numba.njit(cache=True, parallel=True)
-def _cell_projections(vertices, offsets, nodes, u, lam, mu, coef, frame):
-    """coef[c] = Pi_2 of u on cell c, frame[c] = (x_K, y_K, h_K) (in parallel, CELL_CHUNKS shares)."""
+def _cell_projections(vertices, offsets, nodes, lam, mu, u, moments, coef, frame, parts):
+    """Pi_2 of every cell c (in parallel, CELL_CHUNKS shares), applied both ways: frame[c] = (x_K, y_K,
+    h_K); where ``coef`` has rows, coef[c] = Pi_2 of the node values u on c; where ``parts`` has
+    entries, parts[2 offsets[c] + j] = sum_b Pi[b, j] moments[c, b] (int_K g . Pi_2 phi_j dx given
+    int_K g . q_b dx) for the 2 (2n + 1) local dofs j."""
     n_cells = offsets.shape[0] - 1
     nmax = largest_cell(offsets)
     for chunk in numba.prange(CELL_CHUNKS):
@@ -233,11 +220,18 @@ def _cell_projections(vertices, offsets, nodes, u, lam, mu, coef, frame):
             frame[c, 0] = xc
             frame[c, 1] = yc
             frame[c, 2] = h
-            for b in range(N_BASIS):
-                acc = 0.0
-                for i in range(size):
-                    acc += Pi[b, 2 * i] * u[nodes[start + i], 0] + Pi[b, 2 * i + 1] * u[nodes[start + i], 1]
-                coef[c, b] = acc
+            if coef.shape[0] > 0:
+                for b in range(N_BASIS):
+                    acc = 0.0
+                    for i in range(size):
+                        acc += Pi[b, 2 * i] * u[nodes[start + i], 0] + Pi[b, 2 * i + 1] * u[nodes[start + i], 1]
+                    coef[c, b] = acc
+            if parts.shape[0] > 0:
+                for j in range(2 * size):
+                    acc = 0.0
+                    for b in range(N_BASIS):
+                        acc += Pi[b, j] * moments[c, b]
+                    parts[2 * start + j] = acc
 
 
 @dataclass(frozen=True)
@@ -283,7 +277,8 @@ def projected_solution_k2(mesh: Mesh, u_nodes: np.ndarray, lam: float, mu: float
     u = np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, 2)
     coef = np.empty((mesh.n_cells, N_BASIS))
     frame = np.empty((mesh.n_cells, 3))
-    _cell_projections(mesh.vertices, offsets, nodes, u, float(lam), float(mu), coef, frame)
+    no_moments, no_parts = np.empty((0, N_BASIS)), np.empty(0)
+    _cell_projections(mesh.vertices, offsets, nodes, float(lam), float(mu), u, no_moments, coef, frame, no_parts)
     return ProjectedSolutionK2(coef, frame)
 
 
