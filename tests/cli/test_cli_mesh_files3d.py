@@ -4,12 +4,8 @@ in well under a gigabyte. Each run has its address space limited (RLIMIT_AS), so
 the test instead of taking the machine's memory."""
 
 import json
-import os
 import re
-import resource
-import subprocess
 import sys
-import threading
 from pathlib import Path
 
 import netCDF4
@@ -17,6 +13,7 @@ import numpy as np
 import pytest
 
 sys.path[:0] = [str(Path(__file__).resolve().parents[1] / d) for d in ("mesh3d", "mesh", "")]
+from measured_process import run_vemkit  # noqa: E402
 from test_files3d import boundary_cycles, gmsh_file, grid_cells  # noqa: E402
 from test_gmsh_files import QUADS, gmsh_v2  # noqa: E402
 
@@ -172,24 +169,9 @@ CASES = {
 
 def _run(args, cwd: Path, timeout: float = 300.0):
     """(exit status, stdout, stderr, peak resident bytes) of one vemkit process whose address space
-    is limited to ``ADDRESS_SPACE`` (its own peak: os.wait4's resource usage)."""
-    out, err = cwd / ".out", cwd / ".err"
-
-    def limit():
-        resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
-
-    with open(out, "w") as stdout, open(err, "w") as stderr:
-        process = subprocess.Popen(
-            [sys.executable, "-m", "vemkit.cli", *args], cwd=cwd, stdout=stdout, stderr=stderr, preexec_fn=limit
-        )
-    timer = threading.Timer(timeout, process.kill)
-    timer.start()
-    try:
-        _, status, usage = os.wait4(process.pid, 0)
-    finally:
-        timer.cancel()
-    process.returncode = os.waitstatus_to_exitcode(status)
-    return process.returncode, out.read_text(), err.read_text(), usage.ru_maxrss * 1024
+    is limited to ``ADDRESS_SPACE`` (its own peak: tests/measured_process.py)."""
+    status, out, err, _, peak = run_vemkit(args, cwd, address_space=ADDRESS_SPACE, timeout=timeout)
+    return status, out, err, peak
 
 
 @pytest.fixture(scope="module")

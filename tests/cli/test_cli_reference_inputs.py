@@ -3,9 +3,7 @@ its mesh validated like a mesh file, its scene attribute read by the safe YAML l
 reference refused, and only the variables it needs read. Every refusal is one line, exit status 2,
 nothing written; a reference with a large extra variable costs nothing more."""
 
-import os
 import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -15,17 +13,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 PAPER = ROOT / "config" / "scenes" / "paper.yaml"
+sys.path.insert(0, str(ROOT / "tests"))
+from measured_process import run_vemkit  # noqa: E402
 
 
 def vemkit(*args, cwd: Path):
-    """(exit status, stdout, stderr, peak resident bytes) of one vemkit process (wait4: its own usage)."""
-    with open(cwd / "out.txt", "w") as out, open(cwd / "err.txt", "w") as err:
-        process = subprocess.Popen(
-            [sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, stdout=out, stderr=err
-        )
-    _, status, usage = os.wait4(process.pid, 0)
-    process.returncode = os.waitstatus_to_exitcode(status)
-    return process.returncode, (cwd / "out.txt").read_text(), (cwd / "err.txt").read_text(), usage.ru_maxrss * 1024
+    """(exit status, stdout, stderr, peak resident bytes) of one vemkit process (tests/measured_process.py)."""
+    status, out, err, _, peak = run_vemkit(args, cwd)
+    return status, out, err, peak
 
 
 @pytest.fixture(scope="module")

@@ -7,10 +7,7 @@ is linear in it or predicted and refused before it is spent.
 """
 
 import json
-import os
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,27 +15,17 @@ import xarray as xr
 
 from vemkit.cli import main
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from measured_process import run_vemkit  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 PAPER = ROOT / "config" / "scenes" / "paper.yaml"
 
 
 def run_measured(args, cwd: Path, timeout: float = 300.0):
-    """(exit status, stderr, seconds, peak resident bytes) of one vemkit process (wait4: its own rusage)."""
-    start = time.perf_counter()
-    with open(cwd / "stderr.txt", "w") as err:
-        process = subprocess.Popen(
-            [sys.executable, "-m", "vemkit.cli", *map(str, args)], cwd=cwd, stdout=subprocess.DEVNULL, stderr=err
-        )
-    try:
-        _, status, usage = os.wait4(process.pid, 0)
-    finally:
-        process.returncode = 0 if process.poll() is None else process.returncode
-    return (
-        os.waitstatus_to_exitcode(status),
-        (cwd / "stderr.txt").read_text(),
-        time.perf_counter() - start,
-        usage.ru_maxrss * 1024,
-    )
+    """(exit status, stderr, seconds, peak resident bytes) of one vemkit process (tests/measured_process.py)."""
+    status, _, stderr, seconds, peak = run_vemkit(args, cwd, timeout=timeout)
+    return status, stderr, seconds, peak
 
 
 def test_a_polygon_of_3000_clamped_corners_is_solved_in_linear_memory(tmp_path):
