@@ -142,3 +142,20 @@ def test_cook_triangles_lock_with_the_cell_form_and_not_with_nodal_averaging():
     assert abs(cook_tip(1.0, "nodal_average") - 1.0) < 0.02
     # auto: nodal_average for k = 1 in plane strain above nu = 0.45
     assert cook_tip(1.0, "auto") == cook_tip(1.0, "nodal_average")
+
+
+@pytest.mark.parametrize("stabilization", ["dofi-2mu", "trace"])
+def test_the_estimators_energy_is_the_formulations(stabilization):
+    """error_indicators with nodal_average: sum_K a_h^K(u, u) = u^T K u of the nodal stiffness, and the
+    stabilization term is the element's (the same as with the cell form)."""
+    from vemkit.vem.estimator import error_indicators
+
+    space = VirtualElementSpace(mesh_2d("voronoi", n=4), 1)
+    u = np.random.default_rng(4).normal(size=(space.n_nodes, 2))
+    K = stiffness_matrix(space, LAM, MU, stabilization, space.numbering(natural=True), "nodal_average")
+    nodal = error_indicators(space, u, LAM, MU, stabilization, volumetric_strain="nodal_average")
+    cell = error_indicators(space, u, LAM, MU, stabilization)
+    assert np.isclose(nodal["energy"], u.ravel() @ (K @ u.ravel()), rtol=1e-10)
+    assert np.allclose(
+        nodal["stabilization"], cell["stabilization"], rtol=1e-8, atol=1e-9 * cell["stabilization"].max()
+    )
