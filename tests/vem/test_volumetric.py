@@ -4,6 +4,8 @@ keeps the convergence order at nu = 0.3 and removes the locking of triangles on 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from manufactured import elasticity_solution
@@ -18,6 +20,7 @@ from vemkit.vem.projection import stress
 from vemkit.vem.space import VirtualElementSpace
 from vemkit.vem.volumetric import NodalAverage, cell_stress, stiffness_matrix
 
+COOK_SCENE = Path(__file__).resolve().parents[2] / "config" / "scenes" / "cook.yaml"
 FAMILIES_2D = {
     "triangle": dict(family="triangle", kind="delaunay", seed=1),
     "square": dict(family="square"),
@@ -159,3 +162,52 @@ def test_the_estimators_energy_is_the_formulations(stabilization):
     assert np.allclose(
         nodal["stabilization"], cell["stabilization"], rtol=1e-8, atol=1e-9 * cell["stabilization"].max()
     )
+
+
+def divergence_weights_numpy(mesh):
+    """The numpy twin of ``k1_divergence.divergence_table_2d``: q_i = (y_{i+1} - y_{i-1}, x_{i-1} -
+    x_{i+1}) / (2 |K|) (the k = 1 kernel's docstring), cell after cell, interleaved (q_i1, q_i2)."""
+    offsets, ids = mesh.cell_offsets, mesh.cell_vertices
+    weights, areas = [], []
+    for c in range(mesh.n_cells):
+        p = mesh.vertices[ids[offsets[c] : offsets[c + 1]]]
+        nxt, prv = np.roll(p, -1, axis=0), np.roll(p, 1, axis=0)
+        area = 0.5 * np.sum(p[:, 0] * nxt[:, 1] - nxt[:, 0] * p[:, 1])
+        q = np.stack([nxt[:, 1] - prv[:, 1], prv[:, 0] - nxt[:, 0]], axis=1) / (2.0 * area)
+        weights.append(q.ravel())
+        areas.append(area)
+    return np.concatenate(weights), np.array(areas)
+
+
+@pytest.mark.parametrize("case", list(FAMILIES_2D))
+def test_the_divergence_kernel_matches_its_numpy_twin(case):
+    from vemkit.vem.elements.k1_divergence import divergence_2d
+
+    mesh = mesh_2d(case)
+    weights, areas = divergence_2d(mesh)
+    twin_weights, twin_areas = divergence_weights_numpy(mesh)
+    assert np.allclose(weights, twin_weights, rtol=1e-13, atol=1e-13 * np.abs(twin_weights).max())
+    assert np.allclose(areas, twin_areas, rtol=1e-13)
+
+
+def test_plane_stress_takes_the_effective_lambda_and_stays_valid():
+    """nodal_average named in plane stress (it does not lock there: auto keeps cell) uses lambda* and
+    gives the cell form's answer to the discretization error: Cook, E = 1, nu = 1/3, triangles h = 2."""
+    from vemkit.config.scene import load_scene
+
+    tips = {}
+    for treatment in ("cell", "nodal_average"):
+        scene = load_scene(
+            COOK_SCENE,
+            [
+                "discretization.mesh.family=triangle",
+                "discretization.mesh.h=2",
+                f"discretization.volumetric_strain={treatment}",
+            ],
+        )
+        problem = scene_problem(scene)
+        assert problem.volumetric_strain == treatment and problem.model == "plane_stress"
+        u = problem.dofs.expand(solve(problem, {**scene.solver_options, "linear": "direct"}).u)
+        corner = np.flatnonzero(np.all(np.isclose(problem.mesh.vertices, [48.0, 60.0]), axis=1))
+        tips[treatment] = float(u[corner[0], 1])
+    assert abs(tips["nodal_average"] / tips["cell"] - 1.0) < 0.02
