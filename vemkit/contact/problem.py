@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from vemkit.config.boundary_conditions import check_expressions_on_mesh, free_rigid_motion, rigid_motion_error
 from vemkit.config.expressions import vector_field
+from vemkit.config.volumetric import resolved_volumetric_strain
 from vemkit.contact.boundary import ContactBoundary, FoundationLine, check_quadrature, contact_boundary
 from vemkit.contact.laws import ContactLaw, FoundationLaw, contact_law
 from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
@@ -192,7 +193,7 @@ def discrete_problem(
     contact_gauss_points: int = 3,
     body_force_projection: str | None = None,
     model: str = "plane_stress",
-    volumetric_strain: str = "cell",
+    volumetric_strain: str = "auto",
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -204,12 +205,14 @@ def discrete_problem(
     or "p0", the paper's P_0 f1; None: the element's default). contact_quadrature: nodal or gauss
     (with contact_gauss_points per edge).
     model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
-    volumetric_strain: cell (the paper's) or nodal_average (k = 1, ``vemkit.vem.volumetric``).
+    volumetric_strain: cell (the paper's), nodal_average (k = 1, ``vemkit.vem.volumetric``) or auto
+    (the scene key's default: nodal_average for k = 1, plane strain or 3D, nu > 0.45; ``vemkit.config.volumetric``).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     space = VirtualElementSpace(mesh, order)
     check_quadrature(space, contact_quadrature)
     lam, mu = lame_parameters(E, nu, model)
+    volumetric_strain = resolved_volumetric_strain(volumetric_strain, space.order, model, nu)
     dofs = constrained(space, dirichlet)
     K = stiffness_matrix(space, lam, mu, stabilization, dofs, volumetric_strain)
     projection = body_force_projection or space.element.default_body_force_projection
