@@ -211,3 +211,14 @@ def test_plane_stress_takes_the_effective_lambda_and_stays_valid():
         corner = np.flatnonzero(np.all(np.isclose(problem.mesh.vertices, [48.0, 60.0]), axis=1))
         tips[treatment] = float(u[corner[0], 1])
     assert abs(tips["nodal_average"] / tips["cell"] - 1.0) < 0.02
+
+
+def test_the_api_refuses_nodal_average_at_order_2_and_unknown_treatments():
+    from vemkit.exceptions import InputError
+
+    space = VirtualElementSpace(mesh_2d("square", n=2), 2)
+    with pytest.raises(InputError, match="does not lock") as caught:
+        stiffness_matrix(space, LAM, MU, "dofi-2mu", space.numbering(), "nodal_average")
+    assert caught.value.key == "discretization.volumetric_strain"
+    with pytest.raises(InputError, match="unknown"):
+        stiffness_matrix(space, LAM, MU, "dofi-2mu", space.numbering(), "nodal")

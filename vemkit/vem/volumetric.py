@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from vemkit.exceptions import InputError
 from vemkit.vem.projection import stress
 
 #: the treatments of the volumetric part (``discretization.volumetric_strain`` resolved)
@@ -146,12 +147,15 @@ def symmetric(A) -> sp.csr_matrix:
 
 
 def check_treatment(space, treatment: str) -> None:
+    """An InputError naming ``discretization.volumetric_strain`` unless ``treatment`` fits the space."""
+    key = "discretization.volumetric_strain"
     if treatment not in TREATMENTS:
-        raise ValueError(f"volumetric strain {treatment!r} is unknown; use one of {', '.join(TREATMENTS)}")
+        raise InputError(f"{key} = {treatment!r} is unknown; use one of {', '.join(TREATMENTS)}", key=key)
     if treatment == "nodal_average" and space.element.stress_degree != 0:
-        raise ValueError(
-            f"volumetric strain nodal_average needs a constant strain per cell (k = 1); the {space.element.name} "
-            "element does not lock: use cell"
+        raise InputError(
+            f"{key} = nodal_average needs a constant strain per cell (k = 1); the {space.element.name} element "
+            f"does not lock: use cell",
+            key=key,
         )
 
 
