@@ -59,3 +59,14 @@ def test_nodal_average_at_order_2_is_refused_naming_the_key_and_the_fix():
     with pytest.raises(SceneError, match="does not lock.*volumetric_strain=cell") as caught:
         _scene(order=2, treatment="nodal_average")
     assert caught.value.key == "discretization.volumetric_strain"
+
+
+def test_the_resource_prediction_counts_the_wider_stencil():
+    """nodal_average's stiffness holds up to 3 (2D) times the entries: the predicted memory beyond
+    the fixed base grows as much, before any mesh is built."""
+    from vemkit.config.limits import BASE_BYTES, check_scene_resources
+
+    cell = check_scene_resources(_scene(treatment="cell"), None)
+    nodal = check_scene_resources(_scene(treatment="nodal_average"), None)
+    assert (cell.cells, cell.dofs) == (nodal.cells, nodal.dofs)
+    assert nodal.peak_bytes - BASE_BYTES == pytest.approx(3.0 * (cell.peak_bytes - BASE_BYTES), rel=1e-9)
