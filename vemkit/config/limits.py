@@ -14,6 +14,7 @@ a cgroup limit, RLIMIT_AS, whichever is smallest) — that one always.
 A mesh file's counts are the ones it declares (:mod:`vemkit.config.mesh_file_header`); a triangle
 mesh adds the triangles of the body's parts thinner than h (:mod:`vemkit.config.mesh_resolution`).
 :func:`memory_budget` bounds what a third-party reader of a user's file may allocate.
+With the nodal volumetric strain the memory is scaled by its wider stencil (:func:`nodal_average_estimate`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from vemkit.config.boundary_conditions import check_file_sides
 from vemkit.config.domain import domain_from_spec
 from vemkit.config.mesh_file_header import mesh_file_header
 from vemkit.config.mesh_resolution import scene_cells_per_length, thin_part_triangles
+from vemkit.config.volumetric import NODAL_AVERAGE_ENTRIES
 from vemkit.exceptions import ResourceLimitError
 
 __all__ = [
@@ -264,6 +266,8 @@ def check_scene_resources(
 def check_scene_estimate(scene, estimate: Resources, max_dofs: int | None, dimension: int = 2) -> Resources:
     """ResourceLimitError if the scene's predicted ``estimate`` is beyond ``max_dofs`` or the machine's
     memory; a mesh file's sides checked against the scene (its header, ``dimension`` 3: a 3D file)."""
+    if scene.volumetric_strain == "nodal_average":
+        estimate = nodal_average_estimate(estimate, dimension)
     options = scene.mesh_options
     if "file" in options:
         check_resources(
@@ -279,6 +283,14 @@ def check_scene_estimate(scene, estimate: Resources, max_dofs: int | None, dimen
         estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})", fix="a coarser discretization.mesh"
     )
     return estimate
+
+
+def nodal_average_estimate(estimate: Resources, dimension: int) -> Resources:
+    """The prediction with the nodal volumetric strain (``vemkit.config.volumetric``): its stiffness
+    holds up to ``NODAL_AVERAGE_ENTRIES[dimension]`` times the entries, and the memory beyond
+    BASE_BYTES (mostly per entry: the matrix and the AMG hierarchy) grows as much (an upper bound)."""
+    factor = NODAL_AVERAGE_ENTRIES[dimension]
+    return estimate._replace(peak_bytes=int(BASE_BYTES + factor * (estimate.peak_bytes - BASE_BYTES)))
 
 
 def _address_space() -> int | None:

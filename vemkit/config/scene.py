@@ -39,6 +39,7 @@ from vemkit.config.safe_yaml import SceneDumper, read_user_file
 from vemkit.config.safe_yaml import parse_yaml as _parse_yaml
 from vemkit.config.scene3d import semantic_checks_3d
 from vemkit.config.scene_schema import normalized, scene_schema, schema_root, show, validate
+from vemkit.config.volumetric import check_volumetric_strain, resolved_volumetric_strain
 from vemkit.exceptions import SceneError
 
 __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "scene_from_yaml", "scene_schema"]
@@ -46,6 +47,7 @@ __all__ = ["PowerLaw", "Scene", "SceneError", "load_scene", "scene_from_dict", "
 
 def _check_order_options(discretization: dict) -> None:
     """Options that exist for one order k only are refused at the other; the k = 2 load's default."""
+    check_volumetric_strain(discretization)
     if discretization["order"] >= 2:  # the cell moments of k >= 2 carry the body force
         discretization.setdefault("body_force_projection", DEFAULT_BODY_FORCE_PROJECTION_K2)
     elif discretization.get("body_force_projection", "p0") != "p0":
@@ -169,6 +171,13 @@ class Scene:
     has_contact = _field("boundary", "contact", convert=bool, doc="True if a side is in contact")
     stabilization = _field("discretization", "stabilization")
     contact_quadrature = _field("discretization", "contact_quadrature")
+    volumetric_strain = property(
+        lambda self: resolved_volumetric_strain(
+            self._data["discretization"]["volumetric_strain"], self.order, self.model, self.nu
+        ),
+        doc="the treatment of the volumetric part, cell or nodal_average: discretization.volumetric_strain "
+        "with auto resolved (vemkit.config.volumetric)",
+    )
     contact_gauss_points = _field(
         "discretization",
         "contact_gauss_points",

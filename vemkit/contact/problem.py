@@ -4,7 +4,8 @@
 and callables for the data), so it knows nothing of scene files; ``scene_problem`` builds it from a
 scene. The ingredients come from the space (``vemkit.vem.space.VirtualElementSpace``):
 
-- stiffness: the element (3.9), clamped nodes eliminated, interior nodes (the k = 2 cell means)
+- stiffness: the element (3.9), its volumetric part per cell or averaged at the nodes
+  (``volumetric_strain``, ``vemkit.vem.volumetric``), clamped nodes eliminated, interior nodes (the k = 2 cell means)
   condensed out cell by cell, other Dirichlet components held by symmetric elimination;
 - load: tractions and pressures integrated exactly on the traces, the body force through the
   element's projection of the data (Section 3.3);
@@ -23,6 +24,7 @@ import scipy.sparse as sp
 
 from vemkit.config.boundary_conditions import check_expressions_on_mesh, free_rigid_motion, rigid_motion_error
 from vemkit.config.expressions import vector_field
+from vemkit.config.volumetric import resolved_volumetric_strain
 from vemkit.contact.boundary import ContactBoundary, FoundationLine, check_quadrature, contact_boundary
 from vemkit.contact.laws import ContactLaw, FoundationLaw, contact_law
 from vemkit.contact.trace_nodes import change_variables, midpoint_change, midpoint_edges
@@ -34,6 +36,7 @@ from vemkit.vem.condensation import condense_load, interior_load, recover_interi
 from vemkit.vem.dofs import DofMap, apply_fixed_dofs
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes
 from vemkit.vem.space import VirtualElementSpace
+from vemkit.vem.volumetric import cell_stress, stiffness_matrix
 
 
 @dataclass
@@ -50,6 +53,7 @@ class DiscreteProblem:
     interior_load: np.ndarray | None = None  # (M, 2) the load on condensed interior nodes (their recovery)
     info: dict = field(default_factory=dict)
     model: str = "plane_stress"  # the material law (vemkit.config.material)
+    volumetric_strain: str = "cell"  # the treatment of the lambda part (vemkit.vem.volumetric)
 
     @property
     def mesh(self) -> Mesh:
@@ -90,6 +94,13 @@ class DiscreteProblem:
     def projected(self, u):
         """Pi u_h (3.8) on every cell."""
         return self.space.project(self.node_values(u), self.lam, self.mu)
+
+    def cell_strain_stress(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """(strain, stress) per cell: the cell mean of eps(Pi u_h) and the formulation's stress
+        (C eps; with ``nodal_average`` 2 mu eps + lambda theta_K I, ``vemkit.vem.volumetric``)."""
+        values = self.node_values(u)
+        strain = self.space.project(values, self.lam, self.mu).cell_mean_strain()
+        return strain, cell_stress(self.space, values, strain, self.lam, self.mu, self.volumetric_strain)
 
 
 def check_parts(mesh: Mesh, names) -> None:
@@ -182,6 +193,7 @@ def discrete_problem(
     contact_gauss_points: int = 3,
     body_force_projection: str | None = None,
     model: str = "plane_stress",
+    volumetric_strain: str = "auto",
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -193,13 +205,16 @@ def discrete_problem(
     or "p0", the paper's P_0 f1; None: the element's default). contact_quadrature: nodal or gauss
     (with contact_gauss_points per edge).
     model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
+    volumetric_strain: cell (the paper's), nodal_average (k = 1, ``vemkit.vem.volumetric``) or auto
+    (the scene key's default: nodal_average for k = 1, plane strain or 3D, nu > 0.45; ``vemkit.config.volumetric``).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     space = VirtualElementSpace(mesh, order)
     check_quadrature(space, contact_quadrature)
     lam, mu = lame_parameters(E, nu, model)
+    volumetric_strain = resolved_volumetric_strain(volumetric_strain, space.order, model, nu)
     dofs = constrained(space, dirichlet)
-    K = space.stiffness_matrix(lam, mu, stabilization, dofs)
+    K = stiffness_matrix(space, lam, mu, stabilization, dofs, volumetric_strain)
     projection = body_force_projection or space.element.default_body_force_projection
     full_load = problem_load(space, neumann, pressure, body_force, projection, lam, mu)
     if dofs.condensed:
@@ -212,8 +227,9 @@ def discrete_problem(
     K, f = change_variables(K, f, dofs.change)
     K, f = apply_fixed_dofs(K, f, dofs)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
+    law = law or ContactLaw(0.0, 1.0, 0.0, 0.0)
     return DiscreteProblem(
-        space, dofs, K, f, cb, law or ContactLaw(0.0, 1.0, 0.0, 0.0), lam, mu, stabilization, interior, model=model
+        space, dofs, K, f, cb, law, lam, mu, stabilization, interior, model=model, volumetric_strain=volumetric_strain
     )
 
 
@@ -249,6 +265,7 @@ def scene_problem_data(scene) -> dict:
         contact_gauss_points=scene.contact_gauss_points,
         body_force_projection=scene.body_force_projection,
         model=scene.model,
+        volumetric_strain=scene.volumetric_strain,
     )
 
 

@@ -8,7 +8,8 @@ per-vertex tangent basis t1 = e x nu / |e x nu|, e the axis least aligned with n
 
 - nodes (``<mesh>_nNodes``): ``u1``, ``u2`` (, ``u3``);
 - cells (``mesh2d_nFaces`` / ``mesh3d_nVolumes``): ``strain_IJ``, ``stress_IJ`` (cell means of
-  eps(Pi u_h), constant per cell for k = 1, and sigma = C eps), then the cell scalar;
+  eps(Pi u_h), constant per cell for k = 1, and sigma = C eps; with the nodal volumetric strain
+  2 mu eps + lambda theta_K I, ``DiscreteProblem.cell_strain_stress``), then the cell scalar;
 - contact (``contact_node``, sorted by x, then y (, then z)): the coordinates ``contact_x`` ...,
   ``contact_vertex``, ``contact_weight``, the pressures, bounds and displacements of
   :func:`vemkit.solvers.solution.contact_state`, ``contact_state`` (0 separated, 1 stick, 2 slip);
@@ -29,7 +30,7 @@ import numpy as np
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.ugrid import MeshTopology
 from vemkit.solvers.solution import contact_state
-from vemkit.vem.projection import COMPONENTS_3D, shear_energy_density, stress, von_mises
+from vemkit.vem.projection import COMPONENTS_3D, shear_energy_density, von_mises
 
 STATE_MEANINGS = "separated stick slip"
 TANGENT_BASIS = (
@@ -117,8 +118,7 @@ def add_displacement(ds: FileDescription, topology: MeshTopology, problem, solut
 def add_cell_fields(ds: FileDescription, topology: MeshTopology, problem, solution) -> None:
     """``strain_IJ``, ``stress_IJ`` and the cell scalar, one value per cell."""
     names = FIELD_NAMES[topology.dimension]
-    strain = problem.projected(solution.u).cell_mean_strain()
-    sigma = stress(strain, problem.lam, problem.mu)
+    strain, sigma = problem.cell_strain_stress(solution.u)
     cell = {
         "mesh": topology.name,
         "location": topology.cell_location,

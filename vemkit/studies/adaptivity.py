@@ -122,6 +122,7 @@ def scene_indicators(scene, problem, solution) -> dict:
         body_force=body,
         neumann=neumann,
         contact=contact,
+        volumetric_strain=problem.volumetric_strain,
     )
 
 

@@ -12,6 +12,7 @@
 - ``quadrature`` (rules, data sampled on edges and cells), ``elasticity`` (the material law of the
   paper's C, rigid-body modes), ``projection`` (stress, shear energy density), ``norms`` (error
   measures), ``interpolation`` (generalized barycentric coordinates, the paper's measure),
-  ``estimator`` (a posteriori indicators, docs/reference/files.md).
+  ``estimator`` (a posteriori indicators, docs/reference/files.md), ``volumetric`` (the lambda part
+  of the k = 1 stiffness per cell or averaged at the nodes, ``discretization.volumetric_strain``).
 Imports from vemkit: ``exceptions``, ``config``, ``mesh``.
 """

@@ -44,6 +44,7 @@ from vemkit.vem.elements.k1_kernel import cell_coordinates, element_stiffness
 from vemkit.vem.projection import strain_of, stress
 from vemkit.vem.quadrature import reference_quadrature
 from vemkit.vem.space import VirtualElementSpace
+from vemkit.vem.volumetric import NodalAverage, cell_stress, kept_lambda
 
 GAUSS3 = (np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)]), np.array([5.0, 8.0, 5.0]) / 18.0)
 
@@ -232,7 +233,16 @@ def _boundary_terms(mesh: Mesh, sig: _Stress, edges: np.ndarray, datum) -> np.nd
 
 
 def error_indicators(
-    space, u_nodes, lam: float, mu: float, stabilization: str, *, body_force=None, neumann=None, contact=None
+    space,
+    u_nodes,
+    lam: float,
+    mu: float,
+    stabilization: str,
+    *,
+    body_force=None,
+    neumann=None,
+    contact=None,
+    volumetric_strain: str = "cell",
 ) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
@@ -241,13 +251,22 @@ def error_indicators(
     traction(x, y) -> (t1, t2)}; contact: {side: (n_nodes, 2) contact traction t_C at every node
     (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
     "contact", "stabilization" (M,) the squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
+    volumetric_strain: the stiffness's treatment of λ (``vemkit.vem.volumetric``): with
+    ``nodal_average`` σ_K = 2μ ε_K + λ θ_K I and a_h^K holds the cell's share of the nodal term.
     """
     space = VirtualElementSpace(space, 1) if isinstance(space, Mesh) else space
     mesh = space.mesh
     u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, 2)
     projection = space.project(u, lam, mu)
     sig = _Stress(space, projection, lam, mu)
-    total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
+    if volumetric_strain == "cell":
+        total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
+    else:  # the formulation's stress and energies (vemkit.vem.volumetric)
+        sig.constant = cell_stress(space, u, projection.cell_mean_strain(), lam, mu, volumetric_strain)
+        kept = kept_lambda(lam, stabilization)
+        total, consistency = space_energies(space, u, kept, mu, stabilization, projection)
+        change = NodalAverage.of(space).cell_energy_change(u, lam, kept)
+        total, consistency = total + change, consistency + change
     terms = {
         "volume": _volume_terms(mesh, sig, body_force),
         "jump": _jump_terms(mesh, sig),

@@ -35,6 +35,10 @@ vertices, edges, cells (``layout``). Each element module provides:
 ``edge_trace(s)``
     (P, k + 1) the weights of the trace on an edge at parameters s in [0, 1] on the edge's nodes
     (its two vertices, then its edge nodes).
+``divergence_table(mesh)``
+    k = 1 only: (weights, measures), the divergence of Pi v on every cell as a linear form of its
+    vertex values and the cells' measures (``k1_divergence``): what the nodal averaging of the
+    volumetric strain reads (``vemkit.vem.volumetric``). Other elements refuse it.
 ``contact_rule``
     the nodal quadrature on Gamma_C: (parameter, weight) per trace node of an edge -- the
     trapezoid for k = 1, Simpson's rule for k = 2 (``vemkit.contact.boundary``).
@@ -102,6 +106,10 @@ class Element:
     @property
     def fields(self):
         return import_module(self.fields_module)
+
+    def divergence_table(self, mesh):
+        """(weights, measures) of ``k1_divergence``; only elements with a constant strain per cell have it."""
+        raise ValueError(f"the {self.name} element has no constant divergence per cell: no nodal averaging")
 
     def geometry(self, mesh):
         """The first argument of ``cell_matrix`` (module docstring): the vertex coordinates."""

@@ -45,6 +45,11 @@ class FirstOrder(Element):
     def project(self, mesh, node_values, lam=None, mu=None):
         return self.fields.projected_solution(mesh, node_values)
 
+    def divergence_table(self, mesh):
+        from vemkit.vem.elements.k1_divergence import divergence_2d
+
+        return divergence_2d(mesh)
+
     def interpolate(self, mesh, field) -> np.ndarray:
         f1, f2 = field(mesh.vertices[:, 0], mesh.vertices[:, 1])
         return np.stack(np.broadcast_arrays(f1, f2), axis=1).astype(float)

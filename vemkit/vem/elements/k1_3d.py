@@ -130,6 +130,11 @@ class FirstOrder3D(Element):
     def project(self, mesh, node_values, lam=None, mu=None):
         return k1_3d_fields.projected_solution(mesh, self.geometry(mesh), node_values)
 
+    def divergence_table(self, mesh):
+        from vemkit.vem.elements.k1_divergence import divergence_3d
+
+        return divergence_3d(mesh, self.geometry(mesh))
+
     def dirichlet_components(self, mesh, dirichlet):
         return k1_3d_fields.dirichlet_components(mesh, dirichlet)
 
