@@ -100,6 +100,8 @@ NORMAL_STIFFNESS_CAP = 1e8  # for m_nu < 1: w p_nu' <= this times the stiffness 
 GAMMA_FACTOR = {2: 0.5, 3: 0.1}
 ETA_MAX = 1e-3  # loosest relative CG tolerance of an inexact Newton step
 INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that starts the iteration
+STALL_STEPS = 3  # damped steps in a row on settled active sets: the coupled law's gamma rescaled ...
+GAMMA_RESCALE = 10.0  # ... if it grows by this factor at a vertex at least
 SHORT_STEP = 1e-2  # two accepted steps shorter than this with AMG: switch the Newton solves to direct
 DIRECT_FALLBACK_LIMIT = 500_000  # ... if there are at most this many dofs
 AMG_CONTRAST_LIMIT = 1e6  # w p_nu' / (stiffness diagonal) above which the Newton solves are direct
@@ -127,6 +129,7 @@ class _Newton:
     records: list = field(default_factory=list)  # history, one dict per iteration
     previous_state: np.ndarray | None = None  # contact/stick/slip codes of the last step
     short_steps: int = 0
+    settled_damped: int = 0  # damped steps in a row that left the active sets as they were
     eta: float = ETA_MAX  # relative tolerance of the last inexact step
     theta_previous: float = 0.0
     slip_reference: np.ndarray | None = None  # u_tau^ref: the slip is u_tau - u_tau^ref (a load step)
@@ -323,6 +326,7 @@ def _newton_iteration(newton, point, k) -> Point:
     if newton.short_steps >= 2 and n <= DIRECT_FALLBACK_LIMIT:
         # inexact CG steps of a badly conditioned K + J (k_nu w >> K) stall the line search
         _fall_back(newton)
+    new = _rescaled_at_a_stall(newton, new, alpha, changes)
     record = {
         "residual": np.sqrt(new.theta) / new.scale,
         "du": float(alpha * np.linalg.norm(du) / max(np.linalg.norm(new.u), np.finfo(float).tiny)),
@@ -335,6 +339,29 @@ def _newton_iteration(newton, point, k) -> Point:
         record["eta"] = newton.eta
     newton.records.append(record)
     return new
+
+
+def _rescaled_at_a_stall(newton, point, alpha, changes) -> Point:
+    """``point`` as it is, or re-evaluated with the coupled law's gamma_c taken at its friction bounds
+    when STALL_STEPS damped steps in a row left the active sets as they were.
+
+    gamma_c = kd / (w b_c) is set once from the bounds at the start (ssn_point.coupled_gamma); at a
+    vertex that ends barely in contact its bound falls by orders (measured on the GetFEM box at
+    k_nu = 1e5 E, n = 20: b_c from 1e5 to 2, t ~ 1e-8), so gamma_c |u_tau| ~ 1e-6, q = lambda + gamma_c
+    u_tau hardly sees the slip direction, and Newton's step, exact or not, was cut to 1/16 ... 1/64
+    for 40 iterations at a merit of 2e-9. The new gamma_c keeps the solution (C = 0 for any gamma > 0)
+    and restores the scale of q. Counted in info["gamma_rescaled"] (the solution file's attributes)."""
+    newton.settled_damped = newton.settled_damped + 1 if alpha < 1.0 and changes == 0 else 0
+    cb, law = newton.problem.contact, newton.problem.law
+    if newton.settled_damped < STALL_STEPS or law.reduced or cb.ball.direction_from_projection:
+        return point
+    newton.settled_damped = 0
+    gamma = coupled_gamma(newton.kd_tau, cb.weight, law.friction_bound(point.t), newton.b_ref)
+    if not np.max(gamma / newton.gamma) >= GAMMA_RESCALE:  # the bounds have not fallen: nothing to restore
+        return point
+    newton.gamma = gamma
+    newton.info["gamma_rescaled"] = newton.info.get("gamma_rescaled", 0) + 1
+    return evaluate(newton, point.u, point.lam)
 
 
 def _active_sets(newton, point):

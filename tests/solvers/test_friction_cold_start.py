@@ -1,0 +1,62 @@
+"""Coulomb friction from a cold start, in one step (issue 35 item 3): ssn with the AMG backend, as a
+user runs it, converges and passes the independent check on the two cases the issue names.
+
+- The Hertz half sphere x >= 0 (a gmsh tetrahedral mesh, vemkit.studies.hertz; R = 1, nu = 0.3,
+  k_nu = 1e3 E/R) pressed by 0.01 and sheared by 0.003 along z in one step, Coulomb m_tau = m_nu = 1,
+  k_tau = 0.3 k_nu (no frictionless normal step, no load steps). Measured (tol 1e-6, AMG): h = 0.03,
+  0.015, 0.01, 0.0075: 9, 12, 11, 13 Newton iterations (1 485 ... 24 435 DOFs); at nu = 0.49: 20, 14
+  at h = 0.015, 0.01.
+- The GetFEM friction box of benchmarks/peers3d.py with mu = 0.3 (k_tau = 0.3 k_nu, m_tau = 1) on
+  Kuhn tetrahedra at n = 16 (14 739 DOFs): 14 iterations, the check 6.8e-14 at tol 1e-12.
+"""
+
+import copy
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from vemkit.solvers.dispatch import solve
+from vemkit.solvers.verification import verify_solution
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_coupled_coulomb3d import friction_box  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+HERTZ = ROOT / "benchmarks" / "hertz_sphere.yaml"
+MAX_ITERATIONS = 25  # bounded: at most 14 measured on these cases
+
+
+@pytest.fixture(scope="module")
+def half_sphere_mesh(tmp_path_factory):
+    pytest.importorskip("gmsh")
+    from vemkit.studies.hertz import sphere_msh
+
+    path = tmp_path_factory.mktemp("half") / "half.msh"
+    sphere_msh(path, 0.03, 0.25, half=True)
+    return path
+
+
+def test_the_half_sphere_pressed_and_sheared_in_one_step_converges_from_a_cold_start(half_sphere_mesh):
+    from vemkit.studies.hertz import R, sphere_problem
+
+    data = copy.deepcopy(yaml.safe_load(HERTZ.read_text()))
+    data["material"]["nu"] = 0.3
+    data["contact"]["normal"]["m"] = 1.0
+    data["contact"]["friction"] = {"k": 0.3 * 1e3 * data["material"]["E"] / R, "m": 1.0}
+    data["boundary"]["dirichlet"] = {"top": [None, -0.01, 0.003], "sym_x": [0.0, None, None]}
+    problem = sphere_problem(data, half_sphere_mesh, 1e3)
+    solver = {"method": "ssn", "tol": 1e-6, "linear": "amg", "max_iterations": 60}
+    solution = solve(problem, solver)
+    check = verify_solution(problem, solution.u, solution.multiplier, 10 * solver["tol"])
+    assert check["passed"], check
+    assert solution.iterations <= MAX_ITERATIONS
+
+
+def test_the_getfem_box_with_mu_03_converges_from_a_cold_start_at_14739_dofs():
+    problem = friction_box("tet", 16, 0.3)
+    assert problem.n_dofs == 14739
+    solution = solve(problem, {"method": "ssn", "tol": 1e-12, "linear": "amg", "max_iterations": 50})
+    assert verify_solution(problem, solution.u, solution.multiplier, tol=1e-10)["passed"]
+    assert solution.iterations <= MAX_ITERATIONS
