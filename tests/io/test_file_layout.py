@@ -38,7 +38,15 @@ COMMANDS = {
     "mesh_3d": ("mesh", "--scene", SHEARED, *N2),
 }
 #: global attributes whose values are results or the run's own (timings, checks, the scene text)
-ATTRIBUTE_NAMES_ONLY = ("scene", "vemkit_version", "solver", "iterations", "linear_iterations", "n_dofs")
+ATTRIBUTE_NAMES_ONLY = (
+    "scene",
+    "vemkit_version",
+    "solver",
+    "iterations",
+    "linear_iterations",
+    "solver_globalization",
+    "n_dofs",
+)
 RESULT_PREFIXES = ("check_", "error_", "adapt_estimate")
 SIZES_OF_RESULTS = ("iteration", "step")  # solver iterations, adaptive steps
 

@@ -18,6 +18,7 @@ import pytest
 import yaml
 
 from vemkit.solvers.dispatch import solve
+from vemkit.solvers.solution import globalization
 from vemkit.solvers.verification import verify_solution
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -60,3 +61,24 @@ def test_the_getfem_box_with_mu_03_converges_from_a_cold_start_at_14739_dofs():
     solution = solve(problem, {"method": "ssn", "tol": 1e-12, "linear": "amg", "max_iterations": 50})
     assert verify_solution(problem, solution.u, solution.multiplier, tol=1e-10)["passed"]
     assert solution.iterations <= MAX_ITERATIONS
+    assert "steps damped by the line search" in globalization(solution)  # 4 of 14 measured
+
+
+def test_what_the_globalization_did_is_said_in_one_line():
+    """The solution file's ``solver_globalization`` (vemkit.solvers.solution.globalization)."""
+    import numpy as np
+
+    from vemkit.solvers.solution import ContactSolution
+
+    def solution(steps, method="ssn", **info):
+        return ContactSolution(
+            np.zeros(1), np.zeros((1, 1)), len(steps), True, method, {"step": np.array(steps)}, info=info
+        )
+
+    assert globalization(solution([1.0, 1.0])) == "full steps"
+    assert globalization(solution([], method="uzawa")) == "fixed point"
+    text = globalization(solution([1.0, 0.25, 0.0625, 1.0], fallback="direct", gamma_rescaled=1))
+    assert text == (
+        "2 of 4 steps damped by the line search (shortest 0.0625); the Newton systems fell back to direct; "
+        "gamma rescaled 1 time(s) at a stall"
+    )

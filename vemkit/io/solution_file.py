@@ -27,6 +27,7 @@ from vemkit.io.solution_fields import FIELD_NAMES, add_cell_fields, add_contact,
 from vemkit.mesh.file_description import FileDescription
 from vemkit.mesh.files import read_ugrid
 from vemkit.mesh.ugrid import mesh_topology, topology_dimension, topology_file
+from vemkit.solvers.solution import globalization
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -63,6 +64,7 @@ def with_solver_record(ds: FileDescription, problem, solution, scene_yaml: str, 
             "solver": solution.method,
             "iterations": int(solution.iterations),
             "linear_iterations": int(solution.linear_iterations),
+            "solver_globalization": globalization(solution),
             "wall_time": float(solution.wall_time),
             "n_dofs": int(problem.n_dofs),
             "stabilization": problem.stabilization,

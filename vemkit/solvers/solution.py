@@ -43,6 +43,27 @@ def history_arrays(records: list[dict]) -> dict:
     return {k: np.array([r.get(k, np.nan) for r in records], dtype=float) for k in keys}
 
 
+def globalization(solution: ContactSolution) -> str:
+    """What the solver did beyond full Newton steps, in one line (the solution file's
+    ``solver_globalization``): the damped steps of ssn's line search (``history["step"]`` < 1) and the
+    shortest, a fallback of its linear solver, the coupled law's gamma rescaled at a stall, a warm start
+    taken; "full steps" when none of these happened; "fixed point" for uzawa (no step length)."""
+    steps = np.asarray(solution.history.get("step", []), dtype=float)
+    if solution.method != "ssn":
+        return "fixed point"
+    parts = []
+    damped = steps[steps < 1.0]
+    if damped.size:
+        parts.append(f"{damped.size} of {steps.size} steps damped by the line search (shortest {damped.min():.3g})")
+    if solution.info.get("fallback"):
+        parts.append(f"the Newton systems fell back to {solution.info['fallback']}")
+    if solution.info.get("gamma_rescaled"):
+        parts.append(f"gamma rescaled {solution.info['gamma_rescaled']} time(s) at a stall")
+    if solution.info.get("warm_start"):
+        parts.append("warm start taken")
+    return "; ".join(parts) or "full steps"
+
+
 def young_modulus(problem) -> float:
     """E recovered from the Lamé parameters of the paper's plane-stress C (for error messages)."""
     nu = problem.lam / (problem.lam + 2.0 * problem.mu)
