@@ -123,7 +123,7 @@ def disk_alignment(newton, point) -> float:
     return float(np.linalg.norm(complementarity_weight(newton, point.t)[sliding] * miss)) / point.scale
 
 
-def coupled_gamma(kd_tau, weight, bound, b_ref):
+def coupled_gamma(kd_tau, weight, bound, b_ref, floor: float = BOUND_FLOOR):
     """gamma_c = kd_c / (w_c b_c) for Coulomb's coupled law (m_tau > 0): b_c the vertex's friction
     bound p_tau(t_c) at the start (at least BOUND_FLOOR b_ref; b_ref where it is 0), so gamma |u_tau|
     is the local trial ratio kd |u_tau| / (w b), the natural size of q - lambda at a sliding vertex.
@@ -134,7 +134,7 @@ def coupled_gamma(kd_tau, weight, bound, b_ref):
     resolved only by re-aligning lambda, which cycled at h = 0.015 and 0.01 (measured: residual
     4e-6 <-> 1e-8 for 60 iterations). With this gamma: 6 Newton iterations per load step at h = 0.015
     and 0.01, and on the GetFEM box (m_tau = 1) 9-12 instead of 11-27 at 2 187 and 14 739 DOFs."""
-    bound = np.where(bound > 0.0, np.maximum(bound, BOUND_FLOOR * b_ref), b_ref)
+    bound = np.where(bound > 0.0, np.maximum(bound, floor * b_ref), b_ref)
     return kd_tau / (weight * bound)
 
 
