@@ -31,8 +31,9 @@ GROWTH = 4
 KN = 1000.0
 
 
-def friction_box(family: str, n: int, mu: float):
-    """The friction box of benchmarks/peers3d.py (module docstring) with k_tau = mu k_nu, m_tau = 1."""
+def friction_box(family: str, n: int, mu: float, k_normal: float = KN):
+    """The friction box of benchmarks/peers3d.py (module docstring) with k_nu = ``k_normal``,
+    k_tau = mu k_nu, m_tau = 1."""
     mesh = {"family": family, "n": n} | ({"kind": "structured"} if family == "tet" else {})
     data = {
         "model": "3d",
@@ -41,8 +42,8 @@ def friction_box(family: str, n: int, mu: float):
         "boundary": {"dirichlet": {"top": [0.001, 0.0005, -0.01]}, "contact": ["bottom"]},
         "contact": {
             "gap": "0.02*((x - 0.4)**2 + (y - 0.55)**2)",
-            "normal": {"k": KN, "m": 1.0},
-            "friction": {"k": mu * KN, "m": 1.0},
+            "normal": {"k": k_normal, "m": 1.0},
+            "friction": {"k": mu * k_normal, "m": 1.0},
         },
         "discretization": {"mesh": mesh, "contact_quadrature": "nodal"},
     }
