@@ -15,6 +15,8 @@ with logged(smk):
     part = int(smk.wildcards.part)
     mine = [cases[i] for i in np.array_split(np.arange(len(cases)), s["parts"])[part]]
     scene = load_scene(s["scene"], s["overrides"])
+    needed = {case["scene"] for case in mine if "scene" in case}
+    scenes = robustness.load_case_scenes({k: v for k, v in s["scenes"].items() if k in needed}, s["overrides"])
 
     def progress(result):
         for method, o in result["outcomes"].items():
@@ -25,6 +27,13 @@ with logged(smk):
             )
 
     results = robustness.run_matrix(
-        scene, mine, s["solvers"], s["n"], time_budget=s["time_budget"], check_tol=s["check_tol"], progress=progress
+        scene,
+        mine,
+        s["solvers"],
+        s["n"],
+        time_budget=s["time_budget"],
+        check_tol=s["check_tol"],
+        progress=progress,
+        scenes=scenes,
     )
     write_dataset(robustness.stability_dataset(results, scene_yaml=scene.to_yaml(), settings=s), smk.output[0])
