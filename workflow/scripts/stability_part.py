@@ -4,8 +4,6 @@ from _helpers import logged
 
 smk = snakemake  # noqa: F821 - the snakemake object of the job
 with logged(smk):
-    import numpy as np
-
     from vemkit.config.scene import load_scene
     from vemkit.studies import robustness
     from vemkit.studies.sweeps import write_dataset
@@ -13,7 +11,7 @@ with logged(smk):
     s = smk.params.settings
     cases = robustness.select_cases(None if s["cases"] == "all" else s["cases"])
     part = int(smk.wildcards.part)
-    mine = [cases[i] for i in np.array_split(np.arange(len(cases)), s["parts"])[part]]
+    mine = cases[part :: s["parts"]]  # every parts-th case: the slow 3D cases spread over the jobs
     scene = load_scene(s["scene"], s["overrides"])
     needed = {case["scene"] for case in mine if "scene" in case}
     scenes = robustness.load_case_scenes({k: v for k, v in s["scenes"].items() if k in needed}, s["overrides"])
