@@ -46,24 +46,23 @@ _GAP, _E, _NU, _MESH = "contact.gap", "material.E", "material.nu", "discretizati
 _VOLUMETRIC = "discretization.volumetric_strain"
 
 
-def _incompressible(dimension: int, family: str, mesh: dict, nu: float, volumetric: str) -> dict:
-    settings = {_NU: nu, _VOLUMETRIC: volumetric, _MESH: mesh}
-    if dimension == 2:  # the paper's scene is plane stress, which cannot lock
-        return _case(
-            f"plane strain,{family},kappa={nu:g},{volumetric}", "incompressible 2D", model="plane_strain", **settings
-        )
-    return _case(f"3d,{family},kappa={nu:g},{volumetric}", "incompressible 3D", scene="box3d", **settings)
-
-
 def _box(name: str, **settings) -> dict:
     """A 3D extreme: the box3d scene on its hexahedra at n = BOX_N (a case's own mesh wins)."""
     return _case(name, "3D extremes", scene="box3d", **{_MESH: FAMILIES_3D["hex"], **settings})
 
 
+#: (name prefix, group, families, base) of the nu -> 1/2 cases: plane strain on the paper's scene
+#: (its plane stress cannot lock: lambda* <= 2 mu), and the box3d scene
+INCOMPRESSIBLE_BASES = (
+    ("plane strain", "incompressible 2D", FAMILIES_2D, {"model": "plane_strain"}),
+    ("3d", "incompressible 3D", FAMILIES_3D, {"scene": "box3d"}),
+)
 #: nu -> 1/2 on every family, the paper's cell form and the nodal average
 INCOMPRESSIBLE_CASES = [
-    _incompressible(dimension, family, mesh, nu, volumetric)
-    for dimension, families in ((2, FAMILIES_2D), (3, FAMILIES_3D))
+    _case(
+        f"{prefix},{family},kappa={nu:g},{volumetric}", group, **base, **{_NU: nu, _VOLUMETRIC: volumetric, _MESH: mesh}
+    )
+    for prefix, group, families, base in INCOMPRESSIBLE_BASES
     for family, mesh in families.items()
     for nu in INCOMPRESSIBLE_NU
     for volumetric in VOLUMETRIC_STRAINS
