@@ -19,8 +19,12 @@ from vemkit.solvers.verification import (
     verify_solution,
 )
 from vemkit.studies.robustness import (
+    CASE_FAMILIES,
     CASES,
+    case_base_scene,
     case_overrides,
+    load_case_scenes,
+    nodal_average_ratio,
     run_matrix,
     select_cases,
     stability_dataset,
@@ -68,8 +72,12 @@ def test_the_matrix_has_at_least_fifty_valid_cases(scene):
     assert 0.4999 in {c["set"].get("material.nu") for c in CASES}
     assert {2e-3, 2e9} <= {c["set"].get("material.E") for c in CASES}
     assert {0.0, 10.0} <= {c["set"].get("contact.gap") for c in CASES}
-    for case in CASES:  # every case is a valid scene
-        scene.with_overrides(case_overrides(case, 8))
+    scenes = load_case_scenes(root=ROOT)
+    for case in CASES:  # every case is a valid scene, on its own base scene where it names one
+        base = case_base_scene(scene, case, scenes)
+        base.with_overrides(case_overrides(case, 8, CASE_FAMILIES[base.dimension] or "hex"))
+    with pytest.raises(ValueError, match="box3d"):
+        case_base_scene(scene, next(c for c in CASES if c.get("scene") == "box3d"), {})
     with pytest.raises(ValueError, match="unknown"):
         select_cases(["no such case"])
 
@@ -187,3 +195,48 @@ def test_dataset_table_and_plot(matrix, tmp_path):
     fig = stability_figure(ds)
     fig.savefig(tmp_path / "stability.png")
     assert (tmp_path / "stability.png").stat().st_size > 10_000
+
+
+def test_nu_to_one_half_on_every_family_with_and_without_the_nodal_average(scene):
+    """Every 2D family in plane strain and every 3D family on the box, nu in (0.49, 0.499, 0.4999),
+    volumetric_strain cell and nodal_average; the 3D foundations reach 1e7 E, the friction mu = 1e3."""
+    scenes = load_case_scenes(root=ROOT)
+    declared = {
+        (case.get("scene"), case["set"]["discretization.mesh"]["family"], case["set"]["material.nu"], volumetric)
+        for case in CASES
+        if (volumetric := case["set"].get("discretization.volumetric_strain")) and case["group"].startswith("incompr")
+    }
+    families = {None: ("square", "triangle", "voronoi", "hanging"), "box3d": ("hex", "tet", "voronoi", "octree")}
+    wanted = {
+        (where, family, nu, volumetric)
+        for where, names in families.items()
+        for family in names
+        for nu in (0.49, 0.499, 0.4999)
+        for volumetric in ("cell", "nodal_average")
+    }
+    assert declared == wanted
+    assert all(c["set"]["model"] == "plane_strain" for c in CASES if c["group"] == "incompressible 2D")
+    box = [c for c in CASES if c.get("scene") == "box3d"]
+    box_e = scenes["box3d"].data["material"]["E"]
+    assert max(c["set"].get("contact.normal.k", 0.0) for c in box) == pytest.approx(1e7 * box_e)
+    coupled = [c["set"] for c in box if c["set"].get("contact.friction.m") == 1.0]
+    assert max(s["contact.friction.k"] / s.get("contact.normal.k", 10.0) for s in coupled) == pytest.approx(1e3)
+
+
+def test_plane_strain_triangles_lock_with_the_cell_form_and_not_with_the_nodal_average(scene):
+    """nu = 0.4999 on 16 x 16 triangles (the matrix's mesh): the recorded u_max of the cell form
+    misses the squares' by > 3 % (5.5 %), the nodal average's is within 0.5 % (0.03 %)."""
+    names = [f"plane strain,{f},kappa=0.4999,{v}" for f, v in (("triangle", "cell"), ("triangle", "nodal_average"))]
+    names.append("plane strain,square,kappa=0.4999,nodal_average")
+    results = run_matrix(scene, select_cases(names), {"ssn": {}}, 16)
+    cell, nodal, square = (r["u_max"]["ssn"] for r in results)
+    assert all(r["outcomes"]["ssn"].converged for r in results)
+    assert abs(cell / square - 1) > 0.03 and abs(nodal / square - 1) < 0.005, (cell, nodal, square)
+    ds = stability_dataset(results)
+    assert ds["u_max"].dims == ("case", "solver") and "largest displacement" in ds["u_max"].attrs["long_name"]
+    assert list(ds["volumetric_strain"].values) == ["cell", "nodal_average", "nodal_average"]
+    assert set(ds["model"].values) == {"plane_strain"}
+    ratio = nodal_average_ratio(ds)  # the table's (×r) and the figure's right panel
+    assert ratio[0] == pytest.approx(cell / nodal) and ratio[1] == ratio[2] == 1.0
+    text = stability_markdown(ds)
+    assert "| max \\|u\\| |" in text and f"(×{cell / nodal:.4f})" in text

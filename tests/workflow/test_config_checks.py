@@ -136,6 +136,12 @@ BROKEN = {
         "stability.cases[1]",
         ["robustness"],
     ),
+    "stability-scene": (
+        {"stability": {"scenes": {"box3d": "config/scenes/3d/no-such.yaml"}}},
+        "extras",
+        "stability.scenes.box3d",
+        ["no-such.yaml"],
+    ),
     "sweep-figure-select": (
         {"sweeps": {"exponent-gap": {"figures": {"map": {"select": {"k_nu": 11.0}}}}}},
         "extras",

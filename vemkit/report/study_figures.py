@@ -231,15 +231,16 @@ def pareto_figure(ds, error: str = "error_h1", targets=(0.01,)) -> Figure:
 
 
 def stability_figure(ds) -> Figure:
-    """Left: the outcome class of every case and solver (iterations written in); right: worst check."""
+    """Left: the outcome class of every case and solver (iterations written in); middle: worst check;
+    right: the accuracy quantity's ratio cell / nodal_average (locking: away from 1)."""
     from vemkit.solvers.verification import STATUS_MEANINGS
 
     status = ds["status"].values.astype(int)
     cases = [str(c) for c in ds["case"].values]
     solvers = [str(s) for s in ds["solver"].values]
     height = max(4.0, 0.19 * len(cases) + 1.2)
-    fig = Figure(figsize=(12.0, height), layout="constrained")
-    left, right = fig.subplots(1, 2, width_ratios=(1.0, 1.4))
+    fig = Figure(figsize=(14.0, height), layout="constrained")
+    left, right, locking = fig.subplots(1, 3, width_ratios=(1.0, 1.4, 0.8))
     palette = [
         "#4daf4a",
         "#e41a1c",
@@ -286,4 +287,21 @@ def stability_figure(ds) -> Figure:
     right.set_xlabel("worst independent check (converged solves)")
     right.grid(alpha=0.3, which="both")
     right.legend(fontsize=7)
+    _locking_panel(locking, ds)
     return fig
+
+
+def _locking_panel(ax, ds) -> None:
+    """The accuracy quantity where a case has a nodal_average twin: u_max(cell) / u_max(nodal_average)."""
+    from vemkit.studies.robustness import nodal_average_ratio
+
+    ratio = nodal_average_ratio(ds)
+    rows = np.arange(len(ratio))
+    cell = np.isfinite(ratio) & (ratio != 1.0)
+    ax.plot(ratio[cell], rows[cell], "o", color=COLORS[1], ms=4, label="cell / nodal_average")
+    ax.axvline(1.0, color="grey", ls=":")
+    ax.set_yticks(range(len(ratio)), [""] * len(ratio))
+    ax.set_ylim(len(ratio) - 0.5, -0.5)
+    ax.set_xlabel("max |u|: volumetric_strain cell / nodal_average")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)

@@ -1,9 +1,11 @@
 """The solver-robustness matrix: every contact solver on cases at the extremes of the parameters.
 
-:data:`CASES` (>= 50 cases, declared as data: scene overrides on the paper scene), run with every
-solver by :func:`run_matrix` through the guarded solve (``vemkit.solvers.verification``), gathered
-by :func:`robustness_dataset` (dims ``case`` x ``solver``) and tabulated by
-:func:`robustness_markdown`.
+:data:`CASES` (``vemkit.studies.robustness_cases``: declared as data, scene overrides on the paper
+scene or on a case's own scene), run with every solver by :func:`run_matrix` through the guarded
+solve (``vemkit.solvers.verification``), gathered by :func:`stability_dataset` (dims ``case`` x
+``solver``) and tabulated by :func:`stability_markdown`. Besides the outcome and the independent
+check, every converged solve records one accuracy quantity, ``u_max`` (the largest displacement
+component): locking shows as cell and nodal_average disagreeing on it.
 """
 
 from __future__ import annotations
@@ -20,6 +22,13 @@ from vemkit.solvers.verification import (
     guarded_solve,
     prebuilt_linear_supported,
 )
+from vemkit.studies.robustness_cases import (  # noqa: F401 - the cases are part of this module's API
+    CASE_FAMILIES,
+    CASE_SCENES,
+    CASES,
+    case_overrides,
+    select_cases,
+)
 
 
 def status_attributes(long_name: str, dtype=np.int8) -> dict:
@@ -28,103 +37,53 @@ def status_attributes(long_name: str, dtype=np.int8) -> dict:
     return {"long_name": long_name, "flag_values": flags, "flag_meanings": " ".join(STATUS_MEANINGS)}
 
 
-# -- the stability matrix ---------------------------------------------------------------------------
-def _case(name, group, **settings):
-    return {"name": name, "group": group, "set": settings}
+def load_case_scenes(paths=None, overrides=(), root=".") -> dict:
+    """{name: Scene} of the cases' own scenes (``paths``: {name: file}, :data:`CASE_SCENES` for None)."""
+    from pathlib import Path
+
+    from vemkit.config.scene import load_scene
+
+    return {
+        name: load_scene(Path(root) / path, overrides)
+        for name, path in (CASE_SCENES if paths is None else paths).items()
+    }
 
 
-_K_NU, _K_TAU, _M_NU, _M_TAU = "contact.normal.k", "contact.friction.k", "contact.normal.m", "contact.friction.m"
-_GAP, _E, _NU, _MESH = "contact.gap", "material.E", "material.nu", "discretization.mesh"
-#: the cases: overrides of the base scene (the paper's, E = 2000, kappa = 0.4, g_a = 0.1, k_nu = 10,
-#: m_nu = 1, k_tau = 450, m_tau = 0) at the matrix's mesh (``discretization.mesh.n`` of run_matrix)
-CASES = [
-    _case("paper", "baseline"),
-    *(
-        _case(f"k_nu={k:g}", "normal stiffness", **{_K_NU: k})
-        for k in (1e-3, 1e-1, 1.0, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8)
-    ),
-    *(_case(f"k_tau={k:g}", "friction bound", **{_K_TAU: k}) for k in (0.0, 1.0, 10.0, 1e3, 1e4, 1e5, 1e6)),
-    *(
-        _case(f"m_nu={m:g},k_nu={k:g}", "normal exponent", **{_M_NU: m, _K_NU: k})
-        for m in (2.0, 3.0)
-        for k in (10.0, 1e4, 1e8)
-    ),
-    *(_case(f"m_tau=1,k_tau={k:g}", "friction exponent", **{_M_TAU: 1.0, _K_TAU: k}) for k in (450.0, 1e4, 1e6)),
-    _case("m_tau=1,m_nu=3,k_nu=1e4", "friction exponent", **{_M_TAU: 1.0, _M_NU: 3.0, _K_NU: 1e4}),
-    *(_case(f"kappa={nu:g}", "Poisson ratio", **{_NU: nu}) for nu in (0.0, 0.3, 0.45, 0.49, 0.499, 0.4999)),
-    _case("kappa=0.4999,k_nu=1e6", "Poisson ratio", **{_NU: 0.4999, _K_NU: 1e6}),
-    _case("kappa=0.4999,voronoi", "Poisson ratio", **{_NU: 0.4999, _MESH: {"family": "voronoi", "seed": 1}}),
-    *(_case(f"E={E:g}", "Young modulus", **{_E: E}) for E in (2e-3, 2e9)),
-    _case("E=2e-3,k_nu=1e-3", "Young modulus", **{_E: 2e-3, _K_NU: 1e-3}),
-    _case("E=2e9,k_nu=1e8", "Young modulus", **{_E: 2e9, _K_NU: 1e8}),
-    _case("E=2e9,k_tau=1e6", "Young modulus", **{_E: 2e9, _K_TAU: 1e6}),
-    _case("E=2e-3,g_a=10", "Young modulus", **{_E: 2e-3, _GAP: 10.0}),
-    *(_case(f"g_a={g:g}", "gap", **{_GAP: g}) for g in (0.0, 10.0)),
-    _case("g_a=0,k_nu=1e8", "gap", **{_GAP: 0.0, _K_NU: 1e8}),
-    _case("g_a=10,k_tau=0", "gap", **{_GAP: 10.0, _K_TAU: 0.0}),
-    *(
-        _case(f"voronoi,anisotropy={a:g}", "mesh", **{_MESH: {"family": "voronoi", "seed": 1, "anisotropy": a}})
-        for a in (4.0, 10.0)
-    ),
-    _case(
-        "voronoi,tiny edges",
-        "mesh",
-        **{_MESH: {"family": "voronoi", "seed": 2, "lloyd_iterations": 0, "merge_tol": 0.0}},
-    ),
-    _case(
-        "voronoi,tiny edges,anisotropy=10",
-        "mesh",
-        **{_MESH: {"family": "voronoi", "seed": 3, "lloyd_iterations": 0, "merge_tol": 0.0, "anisotropy": 10.0}},
-    ),
-    *(
-        _case(f"hanging,levels={L}", "mesh", **{_MESH: {"family": "hanging", "levels": L, "rule": "contact"}})
-        for L in (3, 5)
-    ),
-    _case(
-        "hanging,random,levels=4",
-        "mesh",
-        **{_MESH: {"family": "hanging", "levels": 4, "rule": "random", "seed": 1, "fraction": 0.3}},
-    ),
-    _case("triangle,delaunay", "mesh", **{_MESH: {"family": "triangle", "kind": "delaunay", "seed": 1}}),
-    _case("k_nu=1e8,m_nu=3,k_tau=1e6", "combined", **{_K_NU: 1e8, _M_NU: 3.0, _K_TAU: 1e6}),
-    _case(
-        "hanging,levels=4,k_nu=1e8",
-        "combined",
-        **{_K_NU: 1e8, _MESH: {"family": "hanging", "levels": 4, "rule": "contact"}},
-    ),
-    _case(
-        "tiny edges,kappa=0.4999,k_nu=1e6",
-        "combined",
-        **{_NU: 0.4999, _K_NU: 1e6, _MESH: {"family": "voronoi", "seed": 2, "lloyd_iterations": 0, "merge_tol": 0.0}},
-    ),
-    _case("m_nu=3,k_nu=1e-3,g_a=0", "combined", **{_M_NU: 3.0, _K_NU: 1e-3, _GAP: 0.0}),
-    _case("E=2e9,kappa=0.4999,k_nu=1e-3", "combined", **{_E: 2e9, _NU: 0.4999, _K_NU: 1e-3}),
-]
+def case_base_scene(scene, case: dict, scenes=None):
+    """The scene a case's overrides go on: its own (``scenes[case["scene"]]``) or ``scene``."""
+    name = case.get("scene")
+    if name is None:
+        return scene
+    if name not in (scenes or {}):
+        raise ValueError(
+            f"stability case {case['name']!r} needs the scene {name!r}: name it in stability.scenes "
+            f"(config/sweeps.yaml), e.g. {name}: {CASE_SCENES.get(name, 'a scene file')}"
+        )
+    return scenes[name]
 
 
-#: dimension -> the mesh family of a case that names none (None: the scene's own, hex by default)
-CASE_FAMILIES = {2: "square", 3: None}
+def largest_displacement(outcome) -> float:
+    """The accuracy quantity of a solve: max |u_i| over the free unknowns (NaN unless converged)."""
+    if not outcome.converged:
+        return float("nan")
+    return float(np.max(np.abs(outcome.solution.u))) if np.size(outcome.solution.u) else 0.0
 
 
-def case_overrides(case: dict, n: int, family: str = "square") -> list[str]:
-    """Scene overrides of a case at n cells per unit length (a mesh entry replaces the whole mesh
-    section; ``family`` where the case names none: squares in 2D, the scene's own family in 3D)."""
-    settings = dict(case["set"])
-    mesh = {"family": family, **settings.pop(_MESH, {}), "n": int(n)}
-    return [f"{_MESH}={json.dumps(mesh)}"] + [f"{k}={json.dumps(v)}" for k, v in settings.items()]
+def run_case(
+    scene, case: dict, solvers: dict, n: int, *, time_budget=None, check_tol=DEFAULT_CHECK_TOL, scenes=None
+) -> dict:
+    """Every solver on one case: {"case", "n_dofs", "outcomes": {method: Outcome}, "u_max": {method: float}}.
 
-
-def run_case(scene, case: dict, solvers: dict, n: int, *, time_budget=None, check_tol=DEFAULT_CHECK_TOL) -> dict:
-    """Every solver on one case: {"case", "n_dofs", "outcomes": {method: Outcome}}.
-
-    ``solvers``: {method: extra solver options}. The problem (and one linear solver, when the solver
-    takes it) is built once for all solvers.
+    ``solvers``: {method: extra solver options}; ``scenes``: {name: Scene} of the cases that name
+    their own base scene (:func:`load_case_scenes`). The problem (and one linear solver, when the
+    solver takes it) is built once for all solvers.
     """
     from vemkit.contact.problem import scene_problem
     from vemkit.solvers.linear import linear_solver
 
-    result = {"case": case, "n_dofs": -1, "parameters": {}, "outcomes": {}}
+    result = {"case": case, "n_dofs": -1, "parameters": {}, "outcomes": {}, "u_max": {}}
     try:
+        scene = case_base_scene(scene, case, scenes)
         family = CASE_FAMILIES[scene.dimension] or scene.mesh_options.get("family", "hex")
         case_scene = scene.with_overrides(case_overrides(case, n, family))
         result["parameters"] = case_parameters(case_scene)
@@ -140,6 +99,7 @@ def run_case(scene, case: dict, solvers: dict, n: int, *, time_budget=None, chec
             )
     except Exception as exc:  # noqa: BLE001 - an invalid case is a classified failure of every solver
         result["outcomes"] = {m: failed(m, exc, "setup") for m in solvers}
+        result["u_max"] = {m: float("nan") for m in solvers}
         return result
     result["n_dofs"] = int(problem.n_dofs)
     for method, extra in solvers.items():
@@ -147,6 +107,7 @@ def run_case(scene, case: dict, solvers: dict, n: int, *, time_budget=None, chec
         result["outcomes"][method] = guarded_solve(
             problem, options, linear=linear, time_budget=time_budget, check_tol=check_tol
         )
+        result["u_max"][method] = largest_displacement(result["outcomes"][method])
     return result
 
 
@@ -161,6 +122,12 @@ PARAMETERS = {  # variable name: (scene path, long name)
 }
 
 
+CASE_STRINGS = {  # variable name: long name (strings per case)
+    "model": "the case scene's model (empty: plane stress)",
+    "volumetric_strain": "discretization.volumetric_strain of the case (auto: vemkit.config.volumetric)",
+}
+
+
 def case_parameters(scene) -> dict:
     """The physical parameters of a case scene (NaN where not a number, e.g. a gap expression)."""
     data = scene.data
@@ -171,27 +138,18 @@ def case_parameters(scene) -> dict:
             value = value.get(part, {}) if isinstance(value, dict) else {}
         out[name] = float(value) if isinstance(value, (int, float)) else float("nan")
     out["mesh"] = json.dumps(data["discretization"]["mesh"], sort_keys=True)
+    out["model"] = str(data.get("model", ""))
+    out["volumetric_strain"] = str(data["discretization"].get("volumetric_strain", "auto"))
     return out
 
 
-def select_cases(names=None) -> list[dict]:
-    """The cases named (all of :data:`CASES` for None); an unknown name is an error."""
-    if names is None:
-        return list(CASES)
-    index = {c["name"]: c for c in CASES}
-    unknown = [name for name in names if name not in index]
-    if unknown:
-        raise ValueError(f"stability case {unknown[0]!r} is unknown; cases: {', '.join(index)}")
-    return [index[name] for name in names]
-
-
 def run_matrix(
-    scene, cases, solvers: dict, n: int, *, time_budget=None, check_tol=DEFAULT_CHECK_TOL, progress=None
+    scene, cases, solvers: dict, n: int, *, time_budget=None, check_tol=DEFAULT_CHECK_TOL, progress=None, scenes=None
 ) -> list[dict]:
-    """run_case for every case; progress(result) after each."""
+    """run_case for every case (``scenes``: the cases' own base scenes); progress(result) after each."""
     results = []
     for case in cases:
-        results.append(run_case(scene, case, solvers, n, time_budget=time_budget, check_tol=check_tol))
+        results.append(run_case(scene, case, solvers, n, time_budget=time_budget, check_tol=check_tol, scenes=scenes))
         if progress is not None:
             progress(results[-1])
     return results
@@ -242,6 +200,12 @@ def stability_dataset(results, *, scene_yaml: str = "", settings=None):
         np.array([r["parameters"].get("mesh", "") for r in results], dtype=object),
         {"long_name": "discretization.mesh of the case (JSON)"},
     )
+    for name, long_name in CASE_STRINGS.items():
+        ds[name] = (
+            "case",
+            np.array([r["parameters"].get(name, "") for r in results], dtype=object),
+            {"long_name": long_name},
+        )
     ds["n_dofs"] = (
         "case",
         np.array([r["n_dofs"] for r in results], np.int64),
@@ -256,6 +220,15 @@ def stability_dataset(results, *, scene_yaml: str = "", settings=None):
             values,
             {"long_name": f"independent check: {k} (dimensionless, see vemkit.studies.robustness)"},
         )
+    ds["u_max"] = (
+        dims,
+        np.array([[r.get("u_max", {}).get(m, np.nan) for m in methods] for r in results], float).reshape(shape),
+        {
+            "long_name": "largest displacement component max |u_i| over the free unknowns (NaN: not converged)",
+            "units": "length unit of the scene",
+            "comment": "the accuracy quantity: locking shows as volumetric_strain cell and nodal_average disagreeing",
+        },
+    )
     ds["message"] = (dims, messages, {"long_name": "failure message (empty when converged)"})
     ds.attrs.update(
         {
@@ -297,6 +270,32 @@ def _cell(ds, i, j) -> str:
     )
 
 
+def case_u_max(ds) -> np.ndarray:
+    """(case,) the accuracy quantity of every case: its first converged solver's u_max (NaN: none)."""
+    values = ds["u_max"].values if "u_max" in ds else np.full((ds.sizes["case"], 1), np.nan)
+    return np.array([next((v for v in row if np.isfinite(v)), np.nan) for row in values], float)
+
+
+def nodal_average_ratio(ds) -> np.ndarray:
+    """(case,) u_max over u_max of the case's nodal_average twin (the same name ending in
+    nodal_average instead of cell; 1 for the twin itself); NaN for a case without one."""
+    u_max = case_u_max(ds)
+    index = {str(name): i for i, name in enumerate(ds["case"].values)}
+    ratio = np.full(len(u_max), np.nan)
+    for name, i in index.items():
+        twin = name[: -len(",cell")] + ",nodal_average" if name.endswith(",cell") else name
+        if twin.endswith(",nodal_average") and twin in index:
+            ratio[i] = u_max[i] / u_max[index[twin]]
+    return ratio
+
+
+def _u_max(u_max: float, ratio: float) -> str:
+    """A case's accuracy quantity, with its ratio to the nodal_average twin's for a cell case."""
+    if not np.isfinite(u_max):
+        return "-"
+    return f"{u_max:.5g}" + (f" (×{ratio:.4f})" if np.isfinite(ratio) and ratio != 1.0 else "")
+
+
 def stability_markdown(ds) -> str:
     """A Markdown report: summary per solver, one row per case, then every failure message."""
     methods = [str(m) for m in ds["solver"].values]
@@ -304,17 +303,24 @@ def stability_markdown(ds) -> str:
         "# Stability matrix",
         "",
         f"{ds.attrs.get('cases', ds.sizes['case'])} cases; each cell: outcome, iterations, worst "
-        "independent check (dimensionless), wall time.",
+        "independent check (dimensionless), wall time; max |u|: the largest displacement component of the "
+        "first converged solver, (×r): r = its ratio to the same case with nodal_average (locking: r != 1).",
         "",
     ]
     for j, m in enumerate(methods):
         codes = ds["status"].values[:, j]
         counts = {STATUS_MEANINGS[c]: int(np.sum(codes == c)) for c in np.unique(codes)}
         lines.append(f"- **{m}**: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])))
-    lines += ["", "| case | group | dofs | " + " | ".join(methods) + " |", "|---|---|---:|" + "---|" * len(methods)]
+    lines += [
+        "",
+        "| case | group | dofs | max \\|u\\| | " + " | ".join(methods) + " |",
+        "|---|---|---:|---:|" + "---|" * len(methods),
+    ]
+    u_max, ratio = case_u_max(ds), nodal_average_ratio(ds)
     for i, name in enumerate(ds["case"].values):
         cells = " | ".join(_cell(ds, i, j) for j in range(len(methods)))
-        lines.append(f"| {name} | {ds['group'].values[i]} | {int(ds['n_dofs'].values[i])} | {cells} |")
+        accuracy = _u_max(u_max[i], ratio[i])
+        lines.append(f"| {name} | {ds['group'].values[i]} | {int(ds['n_dofs'].values[i])} | {accuracy} | {cells} |")
     failures = [
         (str(ds["case"].values[i]), methods[j], str(ds["message"].values[i, j]))
         for i in range(ds.sizes["case"])

@@ -252,22 +252,34 @@ def _check_sweeps(config, scenes: _Scenes) -> None:
                     "the grid changes the mesh, so the contact nodes differ between points; drop the profiles figure",
                     path=("sweeps", name, "figures", kind),
                 )
-    cases = config["stability"]["cases"]
-    if cases != "all":
-        from vemkit.studies.robustness import CASES
-
-        names = [case["name"] for case in CASES]
-        for i, name in enumerate(cases):
-            if name not in names:
-                raise WorkflowConfigError(
-                    f"{name!r} is not a case of the robustness matrix; use all or names of "
-                    f"vemkit.studies.robustness.CASES, e.g. {', '.join(names[:4])}",
-                    path=("stability", "cases", i),
-                )
+    _check_stability_cases(config["stability"], scenes)
     for method, solver in config["stability"]["solvers"].items():
         steps = [(("stability", "solvers", method), f"solver.method={method}")]
         steps += _solver_steps(("stability", "solvers", method), solver)
         scenes.check(("studies_scene",), scene, steps, base_overrides)
+
+
+def _check_stability_cases(stability: dict, scenes: _Scenes) -> None:
+    """The cases are names of the matrix; the base scene a selected case names is in ``scenes`` and readable."""
+    from vemkit.studies.robustness import CASES
+
+    cases = stability["cases"]
+    names = [case["name"] for case in CASES]
+    for i, name in enumerate([] if cases == "all" else cases):
+        if name not in names:
+            raise WorkflowConfigError(
+                f"{name!r} is not a case of the robustness matrix; use all or names of "
+                f"vemkit.studies.robustness.CASES, e.g. {', '.join(names[:4])}",
+                path=("stability", "cases", i),
+            )
+    chosen = CASES if cases == "all" else [case for case in CASES if case["name"] in cases]
+    for needed in dict.fromkeys(case["scene"] for case in chosen if "scene" in case):
+        if needed not in stability["scenes"]:
+            raise WorkflowConfigError(
+                f"a case of the matrix needs the scene {needed!r}: name its file under stability.scenes",
+                path=("stability", "scenes"),
+            )
+        scenes.data(("stability", "scenes", needed), stability["scenes"][needed])
 
 
 def _check_tradeoff(config, scenes: _Scenes) -> None:

@@ -17,7 +17,8 @@ with logged(smk):
         if len(parts) > 1
         else parts[0]
     )
-    ds = robustness.summarize(ds)
+    cases = robustness.select_cases(None if smk.params.settings["cases"] == "all" else smk.params.settings["cases"])
+    ds = robustness.summarize(ds.sel(case=[c["name"] for c in cases]))  # the parts interleave the cases
     write_dataset(ds, smk.output.nc)
     text = robustness.stability_markdown(ds)
     with open(smk.output.md, "w", encoding="utf-8") as stream:
