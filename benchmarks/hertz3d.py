@@ -66,9 +66,11 @@ def run(h: float, H: float, k: float, folder: Path) -> dict:
 SOLVER_MINDLIN = {"method": "ssn", "tol": 1e-6, "linear": "amg", "max_iterations": 60}
 MU = 0.3  # Coulomb coefficient of the Cattaneo-Mindlin runs
 #: (h, H, k_nu R/E, Poisson's ratio): nu -> 0.5 removes the normal-tangential coupling of an elastic
-#: sphere on a rigid plane (Dundurs' beta) that Mindlin ignores, but k = 1 tetrahedra lock there (at
-#: nu = 0.49 the frictionless step's p0 is +4 to +10 % off Hertz, docs/tutorials/three-d.md); the
-#: sizes of config/three_d.yaml mindlin: that reach c within 5 % at nu = 0.3 (h = 0.03 does not)
+#: sphere on a rigid plane (Dundurs' beta) that Mindlin ignores, but k = 1 tetrahedra lock there with
+#: the per-cell volumetric term (at nu = 0.49 the frictionless step's p0 +4 to +10 % off Hertz, the last
+#: step's c -11 % at h = 0.0075); the default nodal average brings c within 5 % at every step for
+#: h <= 0.0075 (docs/tutorials/three-d.md); the sizes of config/three_d.yaml mindlin: that reach c
+#: within 5 % at nu = 0.3 (h = 0.03 does not)
 MINDLIN = [(h, 0.25, 1e3, nu) for h in (0.015, 0.0075, 0.005) for nu in (0.3, 0.49)]
 MINDLIN_QUICK = [(0.015, 0.25, 1e3, 0.3)]
 #: the platen's sideways displacements (along z) of the tangential steps, each from the previous one
