@@ -41,13 +41,11 @@ from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly import largest_cell, specialized
 from vemkit.vem.elements import stabilization_code
 from vemkit.vem.elements.k1_kernel import cell_coordinates, element_stiffness
-from vemkit.vem.projection import strain_of, stress
+from vemkit.vem.estimator_facets import BOUNDARY_RESIDUALS, ProjectedStress, jump_terms, stress_at
+from vemkit.vem.projection import VOIGT_PAIRS, strain_of, stress
 from vemkit.vem.quadrature import reference_quadrature
 from vemkit.vem.space import VirtualElementSpace
 from vemkit.vem.volumetric import NodalAverage, cell_stress, kept_lambda
-
-GAUSS3 = (np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)]), np.array([5.0, 8.0, 5.0]) / 18.0)
-
 
 ENERGY_CHUNKS = 64  # cell chunks of the parallel energy loops (one workspace each)
 
@@ -90,47 +88,69 @@ def local_energies(vertices, offsets, cell_vertices, u, lam, mu, stab):
     return total, consistency
 
 
-def cell_energies(vertices, offsets, nodes, u, lam, mu, stab, total):
-    """*Template* (parallel). total[c] = a_h^K(u, u) (3.9) from the element's local stiffness;
-    chunks of cells in parallel, one workspace each."""
+def cell_energies(geometry, offsets, nodes, u, lam, mu, stab, total):
+    """*Template* (parallel). total[c] = a_h^K(u, u) (3.9) from the element's local stiffness (its
+    ``geometry``, d = DIM components per node); chunks of cells in parallel, one workspace each."""
     n_cells = offsets.shape[0] - 1
     size = largest_cell(offsets)
     for chunk in numba.prange(ENERGY_CHUNKS):
         work = workspace(size)  # noqa: F821 (bound by ``specialized``)
         for c in range(chunk * n_cells // ENERGY_CHUNKS, (chunk + 1) * n_cells // ENERGY_CHUNKS):
-            K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+            K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
             start = offsets[c]
-            m = 2 * (offsets[c + 1] - start)
+            m = DIM * (offsets[c + 1] - start)  # noqa: F821
             energy = 0.0
             for i in range(m):
-                ui = u[nodes[start + i // 2], i % 2]
+                ui = u[nodes[start + i // DIM], i % DIM]  # noqa: F821
                 for j in range(m):
-                    energy += ui * K[i, j] * u[nodes[start + j // 2], j % 2]
+                    energy += ui * K[i, j] * u[nodes[start + j // DIM], j % DIM]  # noqa: F821
             total[c] = energy
+
+
+#: element name -> its closed-form energy kernel (exact products; the 2D k = 1 element)
+ENERGY_KERNELS = {"k1": local_energies}
 
 
 def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, stabilization: str, projection):
     """(a_h^K(u, u), a_K(Π u, Π u)) per cell, for any element (module docstring)."""
-    mesh, u = space.mesh, np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, 2)
-    if space.element.stress_degree == 0:  # constant strain: the k = 1 kernel (exact products)
-        return local_energies(
+    mesh, element = space.mesh, space.element
+    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, element.dimension)
+    if element.name in ENERGY_KERNELS:
+        return ENERGY_KERNELS[element.name](
             mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu, stabilization_code(stabilization)
         )
     offsets, nodes = space.cell_nodes
     total = np.zeros(mesh.n_cells)
-    specialized(cell_energies, space.element, parallel=True)(
-        mesh.vertices, offsets, nodes, u, float(lam), float(mu), stabilization_code(stabilization), total
+    specialized(cell_energies, element, parallel=True)(
+        element.geometry(mesh), offsets, nodes, u, float(lam), float(mu), stabilization_code(stabilization), total
     )
+    return total, consistency_energies(space, projection, lam, mu)
+
+
+#: the number of Voigt components -> their (i, j)
+PAIRS_OF_WIDTH = {len(pairs): pairs for pairs in VOIGT_PAIRS.values()}
+
+
+def energy_density(sig: np.ndarray, strain: np.ndarray) -> np.ndarray:
+    """σ : ε from Voigt rows (the shear components count twice), summed in Voigt order."""
+    pairs = PAIRS_OF_WIDTH[strain.shape[1]]
+    density = sig[:, 0] * strain[:, 0]
+    for k in range(1, len(pairs)):
+        i, j = pairs[k]
+        density = density + (sig[:, k] * strain[:, k] if i == j else 2.0 * sig[:, k] * strain[:, k])
+    return density
+
+
+def consistency_energies(space: VirtualElementSpace, projection, lam: float, mu: float) -> np.ndarray:
+    """(M,) a_K(Π u, Π u) = ∫_K σ(Π u) : ε(Π u): |K| σ_K : ε_K for a constant strain, else a degree-2
+    rule on the cell's triangles (exact: linear σ, k = 2)."""
+    mesh = space.mesh
+    if space.element.stress_degree == 0:
+        strain = projection.cell_mean_strain()
+        return mesh.cell_volumes * energy_density(stress(strain, lam, mu), strain)
     points, weights, cells = reference_quadrature(mesh, degree=2)
     strain = strain_of(projection.gradient_at(cells, points))
-    sig = stress(strain, lam, mu)
-    density = sig[:, 0] * strain[:, 0] + sig[:, 1] * strain[:, 1] + 2.0 * sig[:, 2] * strain[:, 2]
-    return total, np.bincount(cells, weights * density, mesh.n_cells)
-
-
-def stress_at(projection, cells, points, lam, mu) -> np.ndarray:
-    """(P, 3) σ11, σ22, σ12 of C ε(Π u) at points, each in the given cell."""
-    return stress(strain_of(projection.gradient_at(cells, points)), lam, mu)
+    return np.bincount(cells, weights * energy_density(stress(strain, lam, mu), strain), mesh.n_cells)
 
 
 def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarray:
@@ -148,88 +168,6 @@ def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarr
             - stress_at(projection, cells, centre - shift, lam, mu)
         ) / (2.0 * step)
     return np.stack([d[0][:, 0] + d[1][:, 2], d[0][:, 2] + d[1][:, 1]], axis=1)
-
-
-def _edge_normals(points_a, points_b):
-    """Outward unit normals (for a counter-clockwise cell) and lengths of the edges a -> b."""
-    d = points_b - points_a
-    length = np.linalg.norm(d, axis=1)
-    return np.stack([d[:, 1], -d[:, 0]], axis=1) / length[:, None], length
-
-
-def _traction(sig: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """σ n for Voigt rows (σ11, σ22, σ12) and unit normals, both (E, ...)."""
-    return np.stack(
-        [sig[:, 0] * normal[:, 0] + sig[:, 2] * normal[:, 1], sig[:, 2] * normal[:, 0] + sig[:, 1] * normal[:, 1]],
-        axis=1,
-    )
-
-
-class _Stress:
-    """σ(Π u_h) per cell: ``constant`` (M, 3) when the element's stress is constant per cell (k = 1),
-    else evaluated at points from the projection."""
-
-    def __init__(self, space, projection, lam, mu):
-        self.projection, self.lam, self.mu = projection, lam, mu
-        self.constant = stress(projection.strain, lam, mu) if space.element.stress_degree == 0 else None
-
-    def at(self, cells, points):
-        if self.constant is not None:
-            return self.constant[cells]
-        return stress_at(self.projection, cells, points, self.lam, self.mu)
-
-
-def _jump_terms(mesh: Mesh, sig: _Stress) -> np.ndarray:
-    """½ |e|² ∫_e |[σ n]|² / |e| added to each of the two cells of every interior edge (the jump is
-    constant along the edge for k = 1: no quadrature)."""
-    edges, cells = mesh.edges, mesh.edge_cells
-    inner = cells[:, 1] >= 0
-    e, c = edges[inner], cells[inner]
-    normal, length = _edge_normals(mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]])
-    if sig.constant is not None:
-        jump = _traction(sig.constant[c[:, 0]] - sig.constant[c[:, 1]], normal)
-        term = 0.5 * length**2 * np.sum(jump**2, axis=1)
-    else:
-        t, w = GAUSS3
-        a, b = mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]]
-        term = np.zeros(e.shape[0])
-        for tq, wq in zip(t, w):
-            p = a + tq * (b - a)
-            jump = _traction(sig.at(c[:, 0], p) - sig.at(c[:, 1], p), normal)
-            term += wq * 0.5 * length**2 * np.sum(jump**2, axis=1)
-    out = np.zeros(mesh.n_cells)
-    np.add.at(out, c[:, 0], term)
-    np.add.at(out, c[:, 1], term)
-    return out
-
-
-def _boundary_cells(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
-    """The cell of every boundary edge (a, b) (as stored in ``mesh.boundary``)."""
-    key = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * mesh.n_vertices + np.maximum(
-        mesh.edges[:, 0], mesh.edges[:, 1]
-    )
-    order = np.argsort(key)
-    wanted = np.minimum(edges[:, 0], edges[:, 1]) * mesh.n_vertices + np.maximum(edges[:, 0], edges[:, 1])
-    return mesh.edge_cells[order[np.searchsorted(key[order], wanted)], 0]
-
-
-def _boundary_terms(mesh: Mesh, sig: _Stress, edges: np.ndarray, datum) -> np.ndarray:
-    """|e| ∫_e |datum − σ_K n|² per cell, ``datum(points (Q, E, 2), t (Q,)) -> (Q, E, 2)``."""
-    out = np.zeros(mesh.n_cells)
-    if edges.size == 0:
-        return out
-    cells = _boundary_cells(mesh, edges)
-    a, b = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
-    normal, length = _edge_normals(a, b)
-    t, w = GAUSS3
-    points = a[None] + t[:, None, None] * (b - a)[None]
-    if sig.constant is not None:
-        own = _traction(sig.constant[cells], normal)[None]
-    else:
-        own = np.stack([_traction(sig.at(cells, p), normal) for p in points])
-    misfit = datum(points, t) - own
-    np.add.at(out, cells, length**2 * np.einsum("q,qe->e", w, np.sum(misfit**2, axis=2)))
-    return out
 
 
 def error_indicators(
@@ -256,9 +194,9 @@ def error_indicators(
     """
     space = VirtualElementSpace(space, 1) if isinstance(space, Mesh) else space
     mesh = space.mesh
-    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, 2)
+    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, space.element.dimension)
     projection = space.project(u, lam, mu)
-    sig = _Stress(space, projection, lam, mu)
+    sig = ProjectedStress(space, projection, lam, mu)
     if volumetric_strain == "cell":
         total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
     else:  # the formulation's stress and energies (vemkit.vem.volumetric)
@@ -269,15 +207,15 @@ def error_indicators(
         total, consistency = total + change, consistency + change
     terms = {
         "volume": _volume_terms(mesh, sig, body_force),
-        "jump": _jump_terms(mesh, sig),
+        "jump": jump_terms(mesh, sig),
         "neumann": np.zeros(mesh.n_cells),
         "contact": np.zeros(mesh.n_cells),
     }
+    facets = BOUNDARY_RESIDUALS[mesh.dimension]
     for side, traction in (neumann or {}).items():
-        terms["neumann"] += _boundary_terms(mesh, sig, mesh.boundary[side], _sampled(traction))
+        terms["neumann"] += facets.neumann(space, sig, side, traction)
     for side, at_nodes in (contact or {}).items():
-        edges = mesh.boundary[side]
-        terms["contact"] += _boundary_terms(mesh, sig, edges, _trace_along(space, np.asarray(at_nodes), edges))
+        terms["contact"] += facets.contact(space, sig, side, at_nodes)
     residual = sum(terms.values()) / (2.0 * mu)
     terms["stabilization"] = np.maximum(total - consistency, 0.0)
     squared = residual + terms["stabilization"]
@@ -290,7 +228,7 @@ def error_indicators(
     }
 
 
-def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
+def _volume_terms(mesh, sig: ProjectedStress, body_force) -> np.ndarray:
     """h_K² |f_K + div σ_K|² |K| (div σ_K = 0 for a constant stress)."""
     residual = None if body_force is None else np.asarray(body_force, dtype=float)
     if sig.constant is None:
@@ -298,34 +236,7 @@ def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
         residual = divergence if residual is None else residual + divergence
     if residual is None:
         return np.zeros(mesh.n_cells)
-    return mesh.cell_diameters**2 * np.sum(residual**2, axis=1) * mesh.cell_areas
-
-
-def _sampled(traction):
-    def datum(points, _t):
-        t1, t2 = traction(points[..., 0], points[..., 1])
-        return np.stack(np.broadcast_arrays(t1, t2), axis=-1)
-
-    return datum
-
-
-def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
-    """The datum of values at the trace nodes of ``edges``, interpolated as the space's trace
-    (linear between the ends for k = 1)."""
-    nodes = space.edge_nodes(edges)
-    if space.element.order == 1:  # two trace nodes per edge
-        ta, tb = at_nodes[nodes[:, 0]], at_nodes[nodes[:, 1]]
-
-        def datum(_points, t):
-            return ta[None] + t[:, None, None] * (tb - ta)[None]
-
-        return datum
-    values = at_nodes[nodes]  # (E, k + 1, 2)
-
-    def datum(_points, t):
-        return np.einsum("qn,enc->qec", space.element.edge_trace(t), values)
-
-    return datum
+    return mesh.cell_diameters**2 * np.sum(residual**2, axis=1) * mesh.cell_volumes
 
 
 def dorfler_marking(indicator: np.ndarray, theta: float) -> np.ndarray:
