@@ -1,20 +1,22 @@
 """A posteriori error indicators η_K of the VEM solution of the contact problem, for any element (docs/reference/files.md).
 
-Computable from u_h and the data only. With σ_K = C ε(Π u_h) on cell K (constant for k = 1, so
-div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of the body force, and n_e
-the outward unit normal of edge e:
+Computable from u_h and the data only, in d = 2 or 3 dimensions. With σ_K = C ε(Π u_h) on cell K
+(constant for k = 1, so div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of
+the body force, and n_F the outward unit normal of facet F (an edge in 2D, a face in 3D; h_F its
+diameter, |e| for an edge):
 
     η_K² = (1 / 2μ) [ h_K² |f_K + div σ_K|² |K|                         volume residual
-                    + ½ Σ_{e ⊂ ∂K interior} |e| ‖[σ n_e]‖²_e           jumps of the projected traction
-                    + Σ_{e ⊂ ∂K ∩ Γ_F} |e| ‖f2 − σ_K n_e‖²_e           mismatch on Neumann sides
-                    + Σ_{e ⊂ ∂K ∩ Γ_C} |e| ‖t_C − σ_K n_e‖²_e ]        mismatch with the contact traction
+                    + ½ Σ_{F ⊂ ∂K interior} h_F ‖[σ n_F]‖²_F           jumps of the projected traction
+                    + Σ_{F ⊂ ∂K ∩ Γ_F} h_F ‖f2 − σ_K n_F‖²_F           mismatch on Neumann sides
+                    + Σ_{F ⊂ ∂K ∩ Γ_C} h_F ‖t_C − σ_K n_F‖²_F ]        mismatch with the contact traction
            + α_K S_K((I − Π) u_h, (I − Π) u_h)                            the VEM stabilization term (3.9)
 
-where [σ n_e] = (σ_K − σ_K') n_e (constant on an interior edge for k = 1: the closed form; linear for
-k = 2: 3-point Gauss, exact), and t_C = −p_ν(u_ν − g) ν + σ_τ τ is the contact traction of
-(2.6)–(2.9) at the contact points (Γ_C vertices; and edge midpoints for k = 2), interpolated along
-the edge as the space's trace (σ_τ = −p_τ λ with the friction multiplier λ); the edge integrals use
-3-point Gauss rules. The
+where [σ n_F] = (σ_K − σ_K') n_F (constant on an interior facet for k = 1: the closed form; linear
+for k = 2: 3-point Gauss, exact), and t_C = −p_ν(u_ν − g) ν + Σ σ_τ,k τ_k is the contact traction
+of (2.6)–(2.9) at the contact points (Γ_C vertices; and edge midpoints for k = 2), interpolated
+along the facet as the space's trace (σ_τ = −p_τ λ with the friction multiplier λ). The facet terms
+and their rules (3-point Gauss on edges, the edge-midpoint rule on a face's fan of triangles) are
+``vemkit.vem.estimator_facets``. The
 residual terms are those of the residual estimator for the VEM of Beirão da Veiga & Manzini
 (IMA J. Numer. Anal. 35, 2015) and Cangiani, Georgoulis, Pryer & Sutton (Numer. Math. 137, 2017),
 with the boundary residual of the contact problem taking the contact traction as its Neumann datum
@@ -24,9 +26,10 @@ so that η² estimates the energy norm a(u − u_h, u − u_h) of the error. The
 
     η = (Σ_K η_K²)^½ / a_h(u_h, u_h)^½.
 
-The energies per cell come from the element: for k = 1 the kernel ``local_energies`` (which pins
-the consistency part |K| ε:Cε); otherwise a_h^K(u, u) from the element's local stiffness and the
-consistency part ∫_K σ(Π u):ε(Π u) by a degree-2 rule on the cell's triangles (exact: linear σ).
+The energies per cell come from the element: for the 2D k = 1 element the kernel ``local_energies``
+(which pins the consistency part |K| ε:Cε); otherwise a_h^K(u, u) from the element's local stiffness
+and the consistency part |K| σ_K:ε_K for a constant strain (k = 1 on polyhedra), ∫_K σ(Π u):ε(Π u)
+by a degree-2 rule on the cell's triangles for k = 2 (exact: linear σ).
 
 Imports from vemkit: ``mesh`` and this layer; the caller (``vemkit.studies.adaptivity``) turns the
 scene's data and the contact solution into the plain arrays and callables taken here.
@@ -184,10 +187,10 @@ def error_indicators(
 ) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
-    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a Mesh: k = 1); u_nodes its degrees
-    of freedom (n_nodes, 2). body_force: (M, 2) cell averages f_K or None; neumann: {side:
-    traction(x, y) -> (t1, t2)}; contact: {side: (n_nodes, 2) contact traction t_C at every node
-    (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
+    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a 2D Mesh: k = 1); u_nodes its
+    degrees of freedom (n_nodes, d). body_force: (M, d) cell averages f_K or None; neumann: {side:
+    traction(x, y[, z]) -> its d components}; contact: {side: (n_nodes, d) contact traction t_C at
+    every node (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
     "contact", "stabilization" (M,) the squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
     volumetric_strain: the stiffness's treatment of λ (``vemkit.vem.volumetric``): with
     ``nodal_average`` σ_K = 2μ ε_K + λ θ_K I and a_h^K holds the cell's share of the nodal term.
