@@ -187,7 +187,7 @@ def error_indicators(
 ) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
-    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a 2D Mesh: k = 1); u_nodes its
+    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a mesh of either dimension: k = 1); u_nodes its
     degrees of freedom (n_nodes, d). body_force: (M, d) cell averages f_K or None; neumann: {side:
     traction(x, y[, z]) -> its d components}; contact: {side: (n_nodes, d) contact traction t_C at
     every node (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
@@ -195,7 +195,7 @@ def error_indicators(
     volumetric_strain: the stiffness's treatment of λ (``vemkit.vem.volumetric``): with
     ``nodal_average`` σ_K = 2μ ε_K + λ θ_K I and a_h^K holds the cell's share of the nodal term.
     """
-    space = VirtualElementSpace(space, 1) if isinstance(space, Mesh) else space
+    space = space if isinstance(space, VirtualElementSpace) else VirtualElementSpace(space, 1)
     mesh = space.mesh
     u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, space.element.dimension)
     projection = space.project(u, lam, mu)
