@@ -89,13 +89,17 @@ class AdaptiveRun:
 
 
 def contact_tractions(problem, solution) -> dict:
-    """{side: (n_nodes, 2) contact traction t_C = −p_ν ν + σ_τ τ at the contact points} (2.6)–(2.9)."""
+    """{side: (n_nodes, d) contact traction t_C = −p_ν ν + Σ_k σ_τ,k τ_k at the contact points}
+    (2.6)–(2.9), τ_k the d − 1 tangents of the contact boundary."""
     cb = problem.contact
     if cb.size == 0:
         return {}
     state = contact_state(problem, solution.u, solution.multiplier)
-    at_nodes = np.zeros((problem.space.n_nodes, 2))
-    at_nodes[cb.vertices] = -state.normal_pressure[:, None] * cb.normal + state.tangential_stress[:, :1] * cb.tangent
+    traction = -state.normal_pressure[:, None] * cb.normal
+    for k, tangent in enumerate(cb.tangents):
+        traction = traction + state.tangential_stress[:, k : k + 1] * tangent
+    at_nodes = np.zeros((problem.space.n_nodes, cb.dimension))
+    at_nodes[cb.vertices] = traction
     return {side: at_nodes for side in problem.info.get("contact_sides", ())}
 
 

@@ -1,20 +1,22 @@
 """A posteriori error indicators η_K of the VEM solution of the contact problem, for any element (docs/reference/files.md).
 
-Computable from u_h and the data only. With σ_K = C ε(Π u_h) on cell K (constant for k = 1, so
-div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of the body force, and n_e
-the outward unit normal of edge e:
+Computable from u_h and the data only, in d = 2 or 3 dimensions. With σ_K = C ε(Π u_h) on cell K
+(constant for k = 1, so div σ_K = 0; linear for k = 2, div σ_K constant), f_K the cell average of
+the body force, and n_F the outward unit normal of facet F (an edge in 2D, a face in 3D; h_F its
+diameter, |e| for an edge):
 
     η_K² = (1 / 2μ) [ h_K² |f_K + div σ_K|² |K|                         volume residual
-                    + ½ Σ_{e ⊂ ∂K interior} |e| ‖[σ n_e]‖²_e           jumps of the projected traction
-                    + Σ_{e ⊂ ∂K ∩ Γ_F} |e| ‖f2 − σ_K n_e‖²_e           mismatch on Neumann sides
-                    + Σ_{e ⊂ ∂K ∩ Γ_C} |e| ‖t_C − σ_K n_e‖²_e ]        mismatch with the contact traction
+                    + ½ Σ_{F ⊂ ∂K interior} h_F ‖[σ n_F]‖²_F           jumps of the projected traction
+                    + Σ_{F ⊂ ∂K ∩ Γ_F} h_F ‖f2 − σ_K n_F‖²_F           mismatch on Neumann sides
+                    + Σ_{F ⊂ ∂K ∩ Γ_C} h_F ‖t_C − σ_K n_F‖²_F ]        mismatch with the contact traction
            + α_K S_K((I − Π) u_h, (I − Π) u_h)                            the VEM stabilization term (3.9)
 
-where [σ n_e] = (σ_K − σ_K') n_e (constant on an interior edge for k = 1: the closed form; linear for
-k = 2: 3-point Gauss, exact), and t_C = −p_ν(u_ν − g) ν + σ_τ τ is the contact traction of
-(2.6)–(2.9) at the contact points (Γ_C vertices; and edge midpoints for k = 2), interpolated along
-the edge as the space's trace (σ_τ = −p_τ λ with the friction multiplier λ); the edge integrals use
-3-point Gauss rules. The
+where [σ n_F] = (σ_K − σ_K') n_F (constant on an interior facet for k = 1: the closed form; linear
+for k = 2: 3-point Gauss, exact), and t_C = −p_ν(u_ν − g) ν + Σ σ_τ,k τ_k is the contact traction
+of (2.6)–(2.9) at the contact points (Γ_C vertices; and edge midpoints for k = 2), interpolated
+along the facet as the space's trace (σ_τ = −p_τ λ with the friction multiplier λ). The facet terms
+and their rules (3-point Gauss on edges, the edge-midpoint rule on a face's fan of triangles) are
+``vemkit.vem.estimator_facets``. The
 residual terms are those of the residual estimator for the VEM of Beirão da Veiga & Manzini
 (IMA J. Numer. Anal. 35, 2015) and Cangiani, Georgoulis, Pryer & Sutton (Numer. Math. 137, 2017),
 with the boundary residual of the contact problem taking the contact traction as its Neumann datum
@@ -24,9 +26,10 @@ so that η² estimates the energy norm a(u − u_h, u − u_h) of the error. The
 
     η = (Σ_K η_K²)^½ / a_h(u_h, u_h)^½.
 
-The energies per cell come from the element: for k = 1 the kernel ``local_energies`` (which pins
-the consistency part |K| ε:Cε); otherwise a_h^K(u, u) from the element's local stiffness and the
-consistency part ∫_K σ(Π u):ε(Π u) by a degree-2 rule on the cell's triangles (exact: linear σ).
+The energies per cell come from the element: for the 2D k = 1 element the kernel ``local_energies``
+(which pins the consistency part |K| ε:Cε); otherwise a_h^K(u, u) from the element's local stiffness
+and the consistency part |K| σ_K:ε_K for a constant strain (k = 1 on polyhedra), ∫_K σ(Π u):ε(Π u)
+by a degree-2 rule on the cell's triangles for k = 2 (exact: linear σ).
 
 Imports from vemkit: ``mesh`` and this layer; the caller (``vemkit.studies.adaptivity``) turns the
 scene's data and the contact solution into the plain arrays and callables taken here.
@@ -41,13 +44,11 @@ from vemkit.mesh.mesh import Mesh
 from vemkit.vem.assembly import largest_cell, specialized
 from vemkit.vem.elements import stabilization_code
 from vemkit.vem.elements.k1_kernel import cell_coordinates, element_stiffness
-from vemkit.vem.projection import strain_of, stress
+from vemkit.vem.estimator_facets import BOUNDARY_RESIDUALS, ProjectedStress, jump_terms, stress_at
+from vemkit.vem.projection import VOIGT_PAIRS, strain_of, stress
 from vemkit.vem.quadrature import reference_quadrature
 from vemkit.vem.space import VirtualElementSpace
 from vemkit.vem.volumetric import NodalAverage, cell_stress, kept_lambda
-
-GAUSS3 = (np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)]), np.array([5.0, 8.0, 5.0]) / 18.0)
-
 
 ENERGY_CHUNKS = 64  # cell chunks of the parallel energy loops (one workspace each)
 
@@ -90,47 +91,69 @@ def local_energies(vertices, offsets, cell_vertices, u, lam, mu, stab):
     return total, consistency
 
 
-def cell_energies(vertices, offsets, nodes, u, lam, mu, stab, total):
-    """*Template* (parallel). total[c] = a_h^K(u, u) (3.9) from the element's local stiffness;
-    chunks of cells in parallel, one workspace each."""
+def cell_energies(geometry, offsets, nodes, u, lam, mu, stab, total):
+    """*Template* (parallel). total[c] = a_h^K(u, u) (3.9) from the element's local stiffness (its
+    ``geometry``, d = DIM components per node); chunks of cells in parallel, one workspace each."""
     n_cells = offsets.shape[0] - 1
     size = largest_cell(offsets)
     for chunk in numba.prange(ENERGY_CHUNKS):
         work = workspace(size)  # noqa: F821 (bound by ``specialized``)
         for c in range(chunk * n_cells // ENERGY_CHUNKS, (chunk + 1) * n_cells // ENERGY_CHUNKS):
-            K = cell_matrix(c, vertices, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+            K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
             start = offsets[c]
-            m = 2 * (offsets[c + 1] - start)
+            m = DIM * (offsets[c + 1] - start)  # noqa: F821
             energy = 0.0
             for i in range(m):
-                ui = u[nodes[start + i // 2], i % 2]
+                ui = u[nodes[start + i // DIM], i % DIM]  # noqa: F821
                 for j in range(m):
-                    energy += ui * K[i, j] * u[nodes[start + j // 2], j % 2]
+                    energy += ui * K[i, j] * u[nodes[start + j // DIM], j % DIM]  # noqa: F821
             total[c] = energy
+
+
+#: element name -> its closed-form energy kernel (exact products; the 2D k = 1 element)
+ENERGY_KERNELS = {"k1": local_energies}
 
 
 def space_energies(space: VirtualElementSpace, u_nodes, lam: float, mu: float, stabilization: str, projection):
     """(a_h^K(u, u), a_K(Π u, Π u)) per cell, for any element (module docstring)."""
-    mesh, u = space.mesh, np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, 2)
-    if space.element.stress_degree == 0:  # constant strain: the k = 1 kernel (exact products)
-        return local_energies(
+    mesh, element = space.mesh, space.element
+    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(-1, element.dimension)
+    if element.name in ENERGY_KERNELS:
+        return ENERGY_KERNELS[element.name](
             mesh.vertices, mesh.cell_offsets, mesh.cell_vertices, u, lam, mu, stabilization_code(stabilization)
         )
     offsets, nodes = space.cell_nodes
     total = np.zeros(mesh.n_cells)
-    specialized(cell_energies, space.element, parallel=True)(
-        mesh.vertices, offsets, nodes, u, float(lam), float(mu), stabilization_code(stabilization), total
+    specialized(cell_energies, element, parallel=True)(
+        element.geometry(mesh), offsets, nodes, u, float(lam), float(mu), stabilization_code(stabilization), total
     )
+    return total, consistency_energies(space, projection, lam, mu)
+
+
+#: the number of Voigt components -> their (i, j)
+PAIRS_OF_WIDTH = {len(pairs): pairs for pairs in VOIGT_PAIRS.values()}
+
+
+def energy_density(sig: np.ndarray, strain: np.ndarray) -> np.ndarray:
+    """σ : ε from Voigt rows (the shear components count twice), summed in Voigt order."""
+    pairs = PAIRS_OF_WIDTH[strain.shape[1]]
+    density = sig[:, 0] * strain[:, 0]
+    for k in range(1, len(pairs)):
+        i, j = pairs[k]
+        density = density + (sig[:, k] * strain[:, k] if i == j else 2.0 * sig[:, k] * strain[:, k])
+    return density
+
+
+def consistency_energies(space: VirtualElementSpace, projection, lam: float, mu: float) -> np.ndarray:
+    """(M,) a_K(Π u, Π u) = ∫_K σ(Π u) : ε(Π u): |K| σ_K : ε_K for a constant strain, else a degree-2
+    rule on the cell's triangles (exact: linear σ, k = 2)."""
+    mesh = space.mesh
+    if space.element.stress_degree == 0:
+        strain = projection.cell_mean_strain()
+        return mesh.cell_volumes * energy_density(stress(strain, lam, mu), strain)
     points, weights, cells = reference_quadrature(mesh, degree=2)
     strain = strain_of(projection.gradient_at(cells, points))
-    sig = stress(strain, lam, mu)
-    density = sig[:, 0] * strain[:, 0] + sig[:, 1] * strain[:, 1] + 2.0 * sig[:, 2] * strain[:, 2]
-    return total, np.bincount(cells, weights * density, mesh.n_cells)
-
-
-def stress_at(projection, cells, points, lam, mu) -> np.ndarray:
-    """(P, 3) σ11, σ22, σ12 of C ε(Π u) at points, each in the given cell."""
-    return stress(strain_of(projection.gradient_at(cells, points)), lam, mu)
+    return np.bincount(cells, weights * energy_density(stress(strain, lam, mu), strain), mesh.n_cells)
 
 
 def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarray:
@@ -150,88 +173,6 @@ def stress_divergence(projection, mesh: Mesh, lam: float, mu: float) -> np.ndarr
     return np.stack([d[0][:, 0] + d[1][:, 2], d[0][:, 2] + d[1][:, 1]], axis=1)
 
 
-def _edge_normals(points_a, points_b):
-    """Outward unit normals (for a counter-clockwise cell) and lengths of the edges a -> b."""
-    d = points_b - points_a
-    length = np.linalg.norm(d, axis=1)
-    return np.stack([d[:, 1], -d[:, 0]], axis=1) / length[:, None], length
-
-
-def _traction(sig: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """σ n for Voigt rows (σ11, σ22, σ12) and unit normals, both (E, ...)."""
-    return np.stack(
-        [sig[:, 0] * normal[:, 0] + sig[:, 2] * normal[:, 1], sig[:, 2] * normal[:, 0] + sig[:, 1] * normal[:, 1]],
-        axis=1,
-    )
-
-
-class _Stress:
-    """σ(Π u_h) per cell: ``constant`` (M, 3) when the element's stress is constant per cell (k = 1),
-    else evaluated at points from the projection."""
-
-    def __init__(self, space, projection, lam, mu):
-        self.projection, self.lam, self.mu = projection, lam, mu
-        self.constant = stress(projection.strain, lam, mu) if space.element.stress_degree == 0 else None
-
-    def at(self, cells, points):
-        if self.constant is not None:
-            return self.constant[cells]
-        return stress_at(self.projection, cells, points, self.lam, self.mu)
-
-
-def _jump_terms(mesh: Mesh, sig: _Stress) -> np.ndarray:
-    """½ |e|² ∫_e |[σ n]|² / |e| added to each of the two cells of every interior edge (the jump is
-    constant along the edge for k = 1: no quadrature)."""
-    edges, cells = mesh.edges, mesh.edge_cells
-    inner = cells[:, 1] >= 0
-    e, c = edges[inner], cells[inner]
-    normal, length = _edge_normals(mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]])
-    if sig.constant is not None:
-        jump = _traction(sig.constant[c[:, 0]] - sig.constant[c[:, 1]], normal)
-        term = 0.5 * length**2 * np.sum(jump**2, axis=1)
-    else:
-        t, w = GAUSS3
-        a, b = mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]]
-        term = np.zeros(e.shape[0])
-        for tq, wq in zip(t, w):
-            p = a + tq * (b - a)
-            jump = _traction(sig.at(c[:, 0], p) - sig.at(c[:, 1], p), normal)
-            term += wq * 0.5 * length**2 * np.sum(jump**2, axis=1)
-    out = np.zeros(mesh.n_cells)
-    np.add.at(out, c[:, 0], term)
-    np.add.at(out, c[:, 1], term)
-    return out
-
-
-def _boundary_cells(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
-    """The cell of every boundary edge (a, b) (as stored in ``mesh.boundary``)."""
-    key = np.minimum(mesh.edges[:, 0], mesh.edges[:, 1]) * mesh.n_vertices + np.maximum(
-        mesh.edges[:, 0], mesh.edges[:, 1]
-    )
-    order = np.argsort(key)
-    wanted = np.minimum(edges[:, 0], edges[:, 1]) * mesh.n_vertices + np.maximum(edges[:, 0], edges[:, 1])
-    return mesh.edge_cells[order[np.searchsorted(key[order], wanted)], 0]
-
-
-def _boundary_terms(mesh: Mesh, sig: _Stress, edges: np.ndarray, datum) -> np.ndarray:
-    """|e| ∫_e |datum − σ_K n|² per cell, ``datum(points (Q, E, 2), t (Q,)) -> (Q, E, 2)``."""
-    out = np.zeros(mesh.n_cells)
-    if edges.size == 0:
-        return out
-    cells = _boundary_cells(mesh, edges)
-    a, b = mesh.vertices[edges[:, 0]], mesh.vertices[edges[:, 1]]
-    normal, length = _edge_normals(a, b)
-    t, w = GAUSS3
-    points = a[None] + t[:, None, None] * (b - a)[None]
-    if sig.constant is not None:
-        own = _traction(sig.constant[cells], normal)[None]
-    else:
-        own = np.stack([_traction(sig.at(cells, p), normal) for p in points])
-    misfit = datum(points, t) - own
-    np.add.at(out, cells, length**2 * np.einsum("q,qe->e", w, np.sum(misfit**2, axis=2)))
-    return out
-
-
 def error_indicators(
     space,
     u_nodes,
@@ -246,19 +187,19 @@ def error_indicators(
 ) -> dict:
     """η_K² by term and in total, and the relative estimate η (module docstring).
 
-    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a Mesh: k = 1); u_nodes its degrees
-    of freedom (n_nodes, 2). body_force: (M, 2) cell averages f_K or None; neumann: {side:
-    traction(x, y) -> (t1, t2)}; contact: {side: (n_nodes, 2) contact traction t_C at every node
-    (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
+    space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a mesh of either dimension: k = 1); u_nodes its
+    degrees of freedom (n_nodes, d). body_force: (M, d) cell averages f_K or None; neumann: {side:
+    traction(x, y[, z]) -> its d components}; contact: {side: (n_nodes, d) contact traction t_C at
+    every node (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
     "contact", "stabilization" (M,) the squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
     volumetric_strain: the stiffness's treatment of λ (``vemkit.vem.volumetric``): with
     ``nodal_average`` σ_K = 2μ ε_K + λ θ_K I and a_h^K holds the cell's share of the nodal term.
     """
-    space = VirtualElementSpace(space, 1) if isinstance(space, Mesh) else space
+    space = space if isinstance(space, VirtualElementSpace) else VirtualElementSpace(space, 1)
     mesh = space.mesh
-    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, 2)
+    u = np.ascontiguousarray(u_nodes, dtype=float).reshape(space.n_nodes, space.element.dimension)
     projection = space.project(u, lam, mu)
-    sig = _Stress(space, projection, lam, mu)
+    sig = ProjectedStress(space, projection, lam, mu)
     if volumetric_strain == "cell":
         total, consistency = space_energies(space, u, lam, mu, stabilization, projection)
     else:  # the formulation's stress and energies (vemkit.vem.volumetric)
@@ -269,15 +210,15 @@ def error_indicators(
         total, consistency = total + change, consistency + change
     terms = {
         "volume": _volume_terms(mesh, sig, body_force),
-        "jump": _jump_terms(mesh, sig),
+        "jump": jump_terms(mesh, sig),
         "neumann": np.zeros(mesh.n_cells),
         "contact": np.zeros(mesh.n_cells),
     }
+    facets = BOUNDARY_RESIDUALS[mesh.dimension]
     for side, traction in (neumann or {}).items():
-        terms["neumann"] += _boundary_terms(mesh, sig, mesh.boundary[side], _sampled(traction))
+        terms["neumann"] += facets.neumann(space, sig, side, traction)
     for side, at_nodes in (contact or {}).items():
-        edges = mesh.boundary[side]
-        terms["contact"] += _boundary_terms(mesh, sig, edges, _trace_along(space, np.asarray(at_nodes), edges))
+        terms["contact"] += facets.contact(space, sig, side, at_nodes)
     residual = sum(terms.values()) / (2.0 * mu)
     terms["stabilization"] = np.maximum(total - consistency, 0.0)
     squared = residual + terms["stabilization"]
@@ -290,7 +231,7 @@ def error_indicators(
     }
 
 
-def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
+def _volume_terms(mesh, sig: ProjectedStress, body_force) -> np.ndarray:
     """h_K² |f_K + div σ_K|² |K| (div σ_K = 0 for a constant stress)."""
     residual = None if body_force is None else np.asarray(body_force, dtype=float)
     if sig.constant is None:
@@ -298,34 +239,7 @@ def _volume_terms(mesh: Mesh, sig: _Stress, body_force) -> np.ndarray:
         residual = divergence if residual is None else residual + divergence
     if residual is None:
         return np.zeros(mesh.n_cells)
-    return mesh.cell_diameters**2 * np.sum(residual**2, axis=1) * mesh.cell_areas
-
-
-def _sampled(traction):
-    def datum(points, _t):
-        t1, t2 = traction(points[..., 0], points[..., 1])
-        return np.stack(np.broadcast_arrays(t1, t2), axis=-1)
-
-    return datum
-
-
-def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
-    """The datum of values at the trace nodes of ``edges``, interpolated as the space's trace
-    (linear between the ends for k = 1)."""
-    nodes = space.edge_nodes(edges)
-    if space.element.order == 1:  # two trace nodes per edge
-        ta, tb = at_nodes[nodes[:, 0]], at_nodes[nodes[:, 1]]
-
-        def datum(_points, t):
-            return ta[None] + t[:, None, None] * (tb - ta)[None]
-
-        return datum
-    values = at_nodes[nodes]  # (E, k + 1, 2)
-
-    def datum(_points, t):
-        return np.einsum("qn,enc->qec", space.element.edge_trace(t), values)
-
-    return datum
+    return mesh.cell_diameters**2 * np.sum(residual**2, axis=1) * mesh.cell_volumes
 
 
 def dorfler_marking(indicator: np.ndarray, theta: float) -> np.ndarray:
