@@ -102,7 +102,7 @@ ETA_MAX = 1e-3  # loosest relative CG tolerance of an inexact Newton step
 INITIAL_TOL = 1e-2  # relative CG tolerance of the plain linear solve that starts the iteration
 STALL_STEPS = 3  # damped steps in a row on settled active sets: the coupled law's gamma rescaled ...
 GAMMA_RESCALE = 10.0  # ... if it grows by this factor at a vertex at least
-RESCALED_FLOOR = 1e-9  # ... its bounds counted as at least this times b_ref (1e-3 at the start)
+RESCALED_FLOOR = 1e-6  # ... its bounds counted as at least this times b_ref (1e-3 at the start)
 SHORT_STEP = 1e-2  # two accepted steps shorter than this with AMG: switch the Newton solves to direct
 DIRECT_FALLBACK_LIMIT = 500_000  # ... if there are at most this many dofs
 AMG_CONTRAST_LIMIT = 1e6  # w p_nu' / (stiffness diagonal) above which the Newton solves are direct
@@ -353,8 +353,11 @@ def _rescaled_at_a_stall(newton, point, alpha, changes) -> Point:
     for 40 iterations at a merit of 2e-9. The new gamma_c keeps the solution (C = 0 for any gamma > 0)
     and restores the scale of q. Its bounds are floored at RESCALED_FLOOR b_ref, not at the start's
     1e-3 b_ref: at k_nu = 1e7 E (n = 12) the stalled vertices had t ~ 1e-10, bounds 1e-7 b_ref, and
-    the start's floor left gamma_c as it was (stalled at 3e-9; converged in 21 iterations with this
-    floor). Counted in info["gamma_rescaled"] (the solution file's ``solver_globalization``)."""
+    the start's floor left gamma_c as it was (stalled at 3e-9). Measured floors 1e-3 / 1e-6 / 1e-7 /
+    1e-9: that box 50+ (failed) / 22 / 21 / 21 iterations, the box at 1e12 E (n = 8) 29 / 27 / 26 / -,
+    the stability study's 3D hexahedra at k_nu = 1e5 E, mu = 0.3: 53 / 43 / 45 / 100+ (failed: a
+    gamma_c too large at vertices with no bound left makes q follow the slip's noise). Counted in
+    info["gamma_rescaled"] (the solution file's ``solver_globalization``)."""
     newton.settled_damped = newton.settled_damped + 1 if alpha < 1.0 and changes == 0 else 0
     cb, law = newton.problem.contact, newton.problem.law
     if newton.settled_damped < STALL_STEPS or law.reduced or cb.ball.direction_from_projection:
