@@ -1,0 +1,142 @@
+"""Refinement of polyhedral meshes (vemkit.mesh.refine_polyhedra): boxes split into 8 with hanging
+vertices stay valid polyhedra (validate_mesh3d), the hanging vertices are conforming (every interior
+face shared by two cells in opposite orientations, the children's outer faces tile the parent's
+surface, volume and boundary parts kept), the predicted counts are the built ones, and the k = 1
+patch test holds on the refined meshes."""
+
+import numpy as np
+import pytest
+import scipy.sparse.linalg as spla
+
+from vemkit.exceptions import MeshError
+from vemkit.mesh.checks3d import validate_mesh3d
+from vemkit.mesh.families3d.grid import hex
+from vemkit.mesh.families3d.octree import octree
+from vemkit.mesh.meshing import ADAPTIVE_DIMENSIONS, of_dimension
+from vemkit.mesh.refine_polyhedra import predict_refinement, refine_cells
+
+MESHES = {
+    "hex": lambda: hex(n=3),
+    "octree-contact": lambda: octree(n=2),
+    "octree-random": lambda: octree(n=3, rule="random", fraction=0.4, seed=3),
+}
+
+
+def _random_marking(mesh, rng):
+    return rng.choice(mesh.n_cells, max(1, mesh.n_cells // 5), replace=False)
+
+
+def _graded_marking(mesh, rng):
+    """The cells nearest the corner (0, 0, 0): a graded refinement towards it."""
+    return np.argsort(np.linalg.norm(mesh.cell_centroids, axis=1))[: max(1, mesh.n_cells // 8)]
+
+
+def _area_by_part(mesh):
+    return {name: np.linalg.norm(mesh.face_vector_areas[faces], axis=1).sum() for name, faces in mesh.boundary.items()}
+
+
+def _check_conforming(old, refined):
+    mesh = refined.mesh
+    fc = mesh.face_cells
+    interior = (fc >= 0).all(axis=1)
+    assert np.all(fc[interior, 0] != fc[interior, 1])
+    uses = np.bincount(np.abs(mesh.cell_faces + (mesh.cell_faces < 0)), minlength=mesh.n_faces)
+    assert uses.max() == 2 and uses.min() == 1
+    assert np.all(uses[interior] == 2) and np.all(uses[~interior] == 1)
+    assert abs(mesh.cell_volumes.sum() - old.cell_volumes.sum()) <= 1e-12 * old.cell_volumes.sum()
+    assert mesh.cell_volumes.min() > 0
+    volume_by_parent = np.bincount(refined.parent, weights=mesh.cell_volumes, minlength=old.n_cells)
+    assert np.abs(volume_by_parent - old.cell_volumes).max() <= 1e-12 * old.cell_volumes.max()
+    before, after = _area_by_part(old), _area_by_part(mesh)
+    assert before.keys() == after.keys()
+    assert all(abs(before[k] - after[k]) <= 1e-12 * max(before[k], 1.0) for k in before)
+    for parent in refined.refined[:20]:  # the children's outer faces tile the parent's surface
+        children = np.flatnonzero(refined.parent == parent)
+        signed = np.concatenate([mesh.cell_face_list(c) for c in children])
+        faces, count = np.unique(np.where(signed >= 0, signed, -signed - 1), return_counts=True)
+        outer = faces[count == 1]
+        sign = np.array([1.0 if f in signed else -1.0 for f in outer])
+        flux = (sign[:, None] * mesh.face_vector_areas[outer]).sum(axis=0)
+        assert np.abs(flux).max() < 1e-13  # a closed surface
+        area = np.linalg.norm(mesh.face_vector_areas[outer], axis=1).sum()
+        old_faces = np.abs(old.cell_face_list(parent) + (old.cell_face_list(parent) < 0))
+        assert abs(area - np.linalg.norm(old.face_vector_areas[old_faces], axis=1).sum()) < 1e-12
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+@pytest.mark.parametrize("marking", [_random_marking, _graded_marking])
+def test_rounds_of_refinement_stay_valid_and_conforming(name, marking):
+    mesh = MESHES[name]()
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        marked = marking(mesh, rng)
+        predicted = predict_refinement(mesh, marked)
+        refined = refine_cells(mesh, marked)
+        validate_mesh3d(refined.mesh)
+        _check_conforming(mesh, refined)
+        new = refined.mesh
+        assert tuple(predicted) == (new.n_cells, new.n_vertices, new.n_faces)
+        assert new.n_cells == mesh.n_cells + 7 * np.unique(marked).size
+        mesh = new
+
+
+def test_neighbour_faces_gain_the_hanging_vertices():
+    """One cell of the 2 x 2 x 2 grid refined: its 3 face neighbours list 4 quarter faces instead of one,
+    and the edge midpoints on their other faces; the far cell keeps its 6 faces but gains a midpoint."""
+    mesh = hex(n=2)
+    refined = refine_cells(mesh, [0])
+    new = refined.mesh
+    sizes = np.diff(new.cell_offsets)
+    assert sizes[:8].tolist() == [6] * 8  # the children
+    assert sorted(sizes[8:].tolist()) == [6, 6, 6, 6, 9, 9, 9]
+    vertices = [
+        np.unique(np.concatenate([new.face(abs(s + (s < 0))) for s in new.cell_face_list(c)])) for c in range(8, 15)
+    ]
+    assert sorted(v.size for v in vertices) == [8, 9, 9, 9, 13, 13, 13]
+
+
+def test_prolongation_carries_linear_fields_exactly():
+    mesh = octree(n=2, rule="random", fraction=0.5, seed=1)
+    refined = refine_cells(mesh, [0, 3, 5])
+    G = np.array([[1.0, 2.0, -1.0], [0.5, 0.0, 3.0], [2.0, -1.0, 1.0]])
+    assert np.abs(refined.prolongation @ (mesh.vertices @ G.T) - refined.mesh.vertices @ G.T).max() < 1e-14
+
+
+def test_non_boxes_are_refused_in_one_line():
+    from vemkit.mesh.families3d.voronoi3d import voronoi
+
+    mesh = voronoi(n=2)
+    with pytest.raises(
+        MeshError, match="not an axis-aligned box; 3D refinement splits the cells of the families"
+    ) as err:
+        refine_cells(mesh, [0])
+    assert "\n" not in str(err.value)
+
+
+def test_registered_for_dimension_3_but_adapt_stays_2d():
+    assert of_dimension("refine", 3) is refine_cells
+    assert 3 not in ADAPTIVE_DIMENSIONS
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_patch_test_on_refined_meshes(name):
+    """A linear displacement on the whole boundary of a twice refined mesh is the k = 1 solution."""
+    from vemkit.vem.assembly import dirichlet_lift
+    from vemkit.vem.space import VirtualElementSpace
+
+    mesh = MESHES[name]()
+    rng = np.random.default_rng(2)
+    for _ in range(2):
+        mesh = refine_cells(mesh, _random_marking(mesh, rng)).mesh
+    lam, mu = 1.7, 0.6
+    G, c = rng.standard_normal((3, 3)), rng.standard_normal(3)
+    space = VirtualElementSpace(mesh, 1)
+    exact = space.interpolate(lambda x, y, z: tuple(G @ np.stack(np.broadcast_arrays(x, y, z)) + c[:, None]))
+    clamped = np.zeros(space.n_nodes, dtype=bool)
+    clamped[np.unique(mesh.face_vertex_ids(mesh.boundary_faces))] = True
+    assert not clamped.all()
+    dofs = space.numbering(clamped)
+    K = space.stiffness_matrix(lam, mu, "dofi", dofs)
+    load = dirichlet_lift(space, lam, mu, "dofi", dofs, exact)
+    u = dofs.node_values(spla.spsolve(K.tocsc(), load), clamped_values=np.where(clamped[:, None], exact, 0.0))
+    assert np.abs(u - exact).max() < 1e-10 * np.abs(exact).max()
