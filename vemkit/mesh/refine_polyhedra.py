@@ -40,6 +40,13 @@ LATTICE_TOL = 1e-9
 _LATTICE = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)[:, ::-1]
 # _LATTICE[9 k + 3 j + i] = (i, j, k): index of a lattice point from its half-step coordinates
 _CORNERS = np.array([p for p in range(27) if (_LATTICE[p] != 1).all()])
+#: the lattice points of each kind of new vertex (1, 2 or 3 coordinates at the middle) and, per point,
+#: the positions in _CORNERS of the box corners it is the mean of
+_KINDS = [np.array([p for p in range(27) if (_LATTICE[p] == 1).sum() == k]) for k in (1, 2, 3)]
+_ENDS = [
+    np.array([np.flatnonzero((np.abs(_LATTICE[_CORNERS] - _LATTICE[p]) <= 1).all(axis=1)) for p in where])
+    for where in _KINDS
+]
 
 
 class RefinementCounts(NamedTuple):
@@ -56,8 +63,8 @@ class _Plan(NamedTuple):
     upper: np.ndarray
     lattice: np.ndarray  # (m, 27) vertex id of every half-step lattice point (new ones numbered after old)
     points: np.ndarray  # (new, 3) coordinates of the new vertices
-    sources: list  # per new vertex: the old corners it is the mean of
-    split_edges: dict  # (min, max) old corner pair -> new midpoint id
+    sources: list  # per kind (edge midpoints, face centres, body centres): (new ids, (k, 2|4|8) old corners)
+    split_edges: tuple  # (sorted min * N + max keys of the old corner pairs split, their midpoints)
     whole_sides: int  # number of distinct whole faces split into quarters
 
 
@@ -69,28 +76,34 @@ def _marked_cells(mesh, marked) -> np.ndarray:
     return marked
 
 
-def _cell_box(mesh: PolyhedralMesh, c: int):
-    """(lower, upper, vertex ids) of cell c, or a MeshError when it is not an axis-aligned box."""
+def _boxes(mesh: PolyhedralMesh, cells: np.ndarray):
+    """(lower, upper, owner row, vertex ids) of the marked cells' vertices, or a MeshError naming the
+    first one that is not an axis-aligned box."""
     offsets, ids = mesh.cell_vertex_lists
-    own = ids[offsets[c] : offsets[c + 1]]
+    sizes = offsets[cells + 1] - offsets[cells]
+    row = np.repeat(np.arange(cells.size), sizes)
+    own = ids[np.repeat(offsets[cells] - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))]
     x = mesh.vertices[own]
-    lower, upper = x.min(axis=0), x.max(axis=0)
+    starts = np.cumsum(sizes) - sizes
+    lower, upper = np.minimum.reduceat(x, starts, axis=0), np.maximum.reduceat(x, starts, axis=0)
     size = upper - lower
-    signed = mesh.cell_face_list(c)
-    faces = np.where(signed >= 0, signed, -signed - 1)
-    normals = mesh.face_vector_areas[faces]
-    aligned = (np.abs(normals) > 1e-12 * np.abs(normals).sum(axis=1, keepdims=True)).sum(axis=1) == 1
-    on_side = np.isclose(x, lower, rtol=0, atol=LATTICE_TOL * size.max()) | np.isclose(
-        x, upper, rtol=0, atol=LATTICE_TOL * size.max()
+    tol = LATTICE_TOL * size.max(axis=1)[row, None]
+    on_side = ((np.abs(x - lower[row]) <= tol) | (np.abs(x - upper[row]) <= tol)).any(axis=1)
+    normals = np.abs(mesh.face_vector_areas)
+    aligned = (normals > 1e-12 * normals.sum(axis=1, keepdims=True)).sum(axis=1) == 1
+    face_rows = np.repeat(np.arange(mesh.n_cells), np.diff(mesh.cell_offsets))
+    tilted = np.bincount(
+        face_rows, weights=~aligned[np.abs(mesh.cell_faces + (mesh.cell_faces < 0))], minlength=mesh.n_cells
     )
-    box = abs(mesh.cell_volumes[c] - np.prod(size)) <= 1e-9 * np.prod(size)
-    if not (aligned.all() and on_side.any(axis=1).all() and box):
-        family = mesh.meta.get("family", "this")
+    box = np.abs(mesh.cell_volumes[cells] - np.prod(size, axis=1)) <= 1e-9 * np.prod(size, axis=1)
+    box &= (tilted[cells] == 0) & (np.bincount(row, weights=~on_side, minlength=cells.size) == 0)
+    if not box.all():
+        c = int(cells[np.argmin(box)])
         raise MeshError(
-            f"cell {c} of the {family} mesh is not an axis-aligned box; 3D refinement splits the cells of "
-            f"the families {', '.join(REFINABLE_FAMILIES)}"
+            f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box; 3D refinement "
+            f"splits the cells of the families {', '.join(REFINABLE_FAMILIES)}"
         )
-    return lower, upper, own
+    return lower, upper, row, own
 
 
 def _half_steps(x, lower, upper):
@@ -102,32 +115,29 @@ def _half_steps(x, lower, upper):
 def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
     """The lattice of every marked cell, its new vertices named once (module doc)."""
     n = mesh.n_vertices
-    lower, upper = np.zeros((cells.size, 3)), np.zeros((cells.size, 3))
+    lower, upper, row, own = _boxes(mesh, cells)
     lattice = np.full((cells.size, 27), -1, dtype=np.int64)
-    new_of: dict = {}
-    sources: list = []
-    points: list = []
-    for row, c in enumerate(cells):
-        lower[row], upper[row], own = _cell_box(mesh, int(c))
-        t, on = _half_steps(mesh.vertices[own], lower[row], upper[row])
-        p = np.round(t[on]).astype(np.int64)
-        lattice[row, 9 * p[:, 2] + 3 * p[:, 1] + p[:, 0]] = own[on]
-        corners = lattice[row, _CORNERS]
-        if (corners < 0).any():
-            raise MeshError(f"cell {c} lacks a corner of its box; 3D refinement splits boxes")
-        for q in np.flatnonzero(lattice[row] < 0):
-            near = _LATTICE[_CORNERS]
-            ends = corners[(np.abs(near - _LATTICE[q]) <= 1).all(axis=1)]  # the corners it is the mean of
-            key = tuple(sorted(ends.tolist())) if ends.size < 8 else ("centre", int(c), -1)
-            if key not in new_of:
-                new_of[key] = n + len(points)
-                sources.append(ends)
-                points.append(mesh.vertices[ends].mean(axis=0) if ends.size < 8 else 0.5 * (lower[row] + upper[row]))
-            lattice[row, q] = new_of[key]
-    split_edges = {k: v for k, v in new_of.items() if len(k) == 2}  # the centres' keys have 3 entries
-    whole_sides = sum(1 for k in new_of if len(k) == 4)
-    pts = np.array(points, dtype=float).reshape(-1, 3)
-    return _Plan(cells, lower, upper, lattice, pts, sources, split_edges, whole_sides)
+    t, on = _half_steps(mesh.vertices[own], lower[row], upper[row])
+    p = np.round(t[on]).astype(np.int64)
+    lattice[row[on], 9 * p[:, 2] + 3 * p[:, 1] + p[:, 0]] = own[on]
+    corners = lattice[:, _CORNERS]
+    if (corners < 0).any():
+        raise MeshError(f"cell {cells[np.argmax((corners < 0).any(axis=1))]} lacks a corner of its box")
+    points, sources, next_id, whole_sides, split = [], [], n, 0, (np.zeros(0, np.int64),) * 2
+    for kind, where in enumerate(_KINDS):  # edge midpoints, face centres, body centres
+        missing = lattice[:, where] < 0
+        at_row, at_q = np.nonzero(missing)
+        ends = np.sort(corners[at_row[:, None], _ENDS[kind][at_q]], axis=1)
+        unique, inverse = np.unique(ends, axis=0, return_inverse=True) if kind < 2 else (ends, np.arange(at_row.size))
+        new_ids = next_id + np.arange(unique.shape[0])
+        lattice[at_row, where[at_q]] = new_ids[inverse.ravel()]
+        points.append(mesh.vertices[unique].mean(axis=1) if kind < 2 else 0.5 * (lower + upper)[at_row])
+        sources.append((new_ids, unique))
+        next_id += unique.shape[0]
+        if kind == 0:
+            split = (unique[:, 0] * np.int64(n) + unique[:, 1], new_ids)
+        whole_sides += unique.shape[0] if kind == 1 else 0
+    return _Plan(cells, lower, upper, lattice, np.concatenate(points), sources, split, whole_sides)
 
 
 def predict_refinement(mesh: PolyhedralMesh, marked) -> RefinementCounts:
@@ -139,7 +149,7 @@ def predict_refinement(mesh: PolyhedralMesh, marked) -> RefinementCounts:
     )
 
 
-def _with_midpoints(mesh: PolyhedralMesh, split_edges: dict):
+def _with_midpoints(mesh: PolyhedralMesh, split_edges: tuple):
     """(offsets, vertices) of the faces with every new edge midpoint inserted between its corners."""
     offsets, ids = mesh.face_offsets, mesh.face_vertices
     following = np.arange(1, ids.size + 1, dtype=np.int64)
@@ -147,8 +157,7 @@ def _with_midpoints(mesh: PolyhedralMesh, split_edges: dict):
     n = np.int64(mesh.n_vertices)
     a, b = ids, ids[following]
     keys = np.minimum(a, b) * n + np.maximum(a, b)
-    split_keys = np.array([lo * n + hi for lo, hi in split_edges], dtype=np.int64)
-    mids = np.array(list(split_edges.values()), dtype=np.int64)
+    split_keys, mids = split_edges
     order = np.argsort(split_keys)
     split_keys, mids = split_keys[order], mids[order]
     at = np.clip(np.searchsorted(split_keys, keys), 0, max(split_keys.size - 1, 0))
@@ -162,21 +171,29 @@ def _with_midpoints(mesh: PolyhedralMesh, split_edges: dict):
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), out
 
 
-def _perimeter_polygon(ids, t, axis, level, low, high, outward):
-    """The vertices (of ``ids`` at half-step coordinates ``t``) on the perimeter of the rectangle
-    t[axis] = level, low <= t[b], t[d] <= high, in order, turning about +/- axis as ``outward``."""
+def _perimeter_polygons(ids, t, axis, level, low, high, outward) -> list:
+    """Per rectangle r (t[axis_r] = level_r, low_r <= (t[b], t[d]) <= high_r, b, d the next axes): the
+    vertices (of ``ids`` at half-step coordinates ``t``) on its perimeter, in order about +axis_r
+    (outward_r > 0) or -axis_r. All arguments but ids and t are per rectangle."""
+    axis = np.asarray(axis)
     b, d = (axis + 1) % 3, (axis + 2) % 3
+    low, high = np.asarray(low, float), np.asarray(high, float)
     tol = LATTICE_TOL
-    plane = np.abs(t[:, axis] - level) < tol
-    inside = plane & (t[:, b] > low[0] - tol) & (t[:, b] < high[0] + tol)
-    inside &= (t[:, d] > low[1] - tol) & (t[:, d] < high[1] + tol)
-    edge = (np.abs(t[:, b] - low[0]) < tol) | (np.abs(t[:, b] - high[0]) < tol)
-    edge |= (np.abs(t[:, d] - low[1]) < tol) | (np.abs(t[:, d] - high[1]) < tol)
-    keep = inside & edge
-    centre = 0.5 * (np.asarray(low) + np.asarray(high))
-    angle = np.arctan2(t[keep, d] - centre[1], t[keep, b] - centre[0])
-    ring = ids[keep][np.argsort(angle)]
-    return ring if outward > 0 else ring[::-1]
+    ta, tb, td = t[:, axis].T, t[:, b].T, t[:, d].T  # (R, k)
+    keep = np.abs(ta - np.asarray(level, float)[:, None]) < tol
+    keep &= (tb > low[:, :1] - tol) & (tb < high[:, :1] + tol) & (td > low[:, 1:] - tol) & (td < high[:, 1:] + tol)
+    on_b = (np.abs(tb - low[:, :1]) < tol) | (np.abs(tb - high[:, :1]) < tol)
+    keep &= on_b | (np.abs(td - low[:, 1:]) < tol) | (np.abs(td - high[:, 1:]) < tol)
+    centre = 0.5 * (low + high)
+    angle = np.where(keep, np.arctan2(td - centre[:, 1:], tb - centre[:, :1]), np.inf)
+    order = np.argsort(angle, axis=1)
+    counts = keep.sum(axis=1)
+    rings = [ids[order[r, : counts[r]]] for r in range(axis.size)]
+    return [ring if w > 0 else ring[::-1] for ring, w in zip(rings, outward)]
+
+
+#: the 12 quarters of the 3 mid-planes of a box (axis, lower corner in the next two axes)
+_INNER = np.array([(axis, qb, qd) for axis in range(3) for qb in (0, 1) for qd in (0, 1)])
 
 
 def _cell_cycles(mesh, c: int, face_offsets, face_vertices, split_faces: dict):
@@ -192,19 +209,24 @@ def _cell_cycles(mesh, c: int, face_offsets, face_vertices, split_faces: dict):
 def _children(mesh, plan: _Plan, row: int, cycles: list, labels):
     """The outward faces (vertex cycles) and labels of the 8 children of marked cell ``plan.cells[row]``;
     ``cycles``: its (face, outward cycle) with its whole sides already split."""
-    ids = np.unique(np.concatenate([cycle for _, cycle in cycles] + [plan.lattice[row]]))
+    flat = np.concatenate([cycle for _, cycle in cycles])
+    ids = np.unique(np.concatenate([flat, plan.lattice[row]]))
     x = np.concatenate([mesh.vertices, plan.points])[ids]
     t, _ = _half_steps(x, plan.lower[row], plan.upper[row])
-    centres = np.array([t[np.searchsorted(ids, cycle)].mean(axis=0) for _, cycle in cycles])
+    starts = np.cumsum([0] + [cycle.size for _, cycle in cycles[:-1]])
+    sizes = np.array([cycle.size for _, cycle in cycles])
+    centres = np.add.reduceat(t[np.searchsorted(ids, flat)], starts, axis=0) / sizes[:, None]
     octant_of = np.floor(np.clip(centres, 0.0, 2.0 - 1e-6)).astype(np.int64)
+    inner = _perimeter_polygons(
+        ids, t, _INNER[:, 0], np.ones(12), _INNER[:, 1:], _INNER[:, 1:] + 1, np.ones(12, dtype=np.int64)
+    )  # turning about +axis: outward for the child below the mid-plane
     out = []
     for o in _LATTICE[_CORNERS] // 2:  # octant (ox, oy, oz) in {0, 1}^3
         child, child_labels = [], []
         for axis in range(3):
-            b, d = (axis + 1) % 3, (axis + 2) % 3
-            outward = 1 if o[axis] else -1
-            child.append(_perimeter_polygon(ids, t, axis, 1, (o[b], o[d]), (o[b] + 1, o[d] + 1), -outward))
-            child_labels.append(-1)  # towards the sibling across the mid-plane
+            ring = inner[4 * axis + 2 * o[(axis + 1) % 3] + o[(axis + 2) % 3]]
+            child.append(ring[::-1] if o[axis] else ring)  # towards the sibling across the mid-plane
+            child_labels.append(-1)
         mine = np.flatnonzero((octant_of == o).all(axis=1))
         child.extend(cycles[k][1] for k in mine)
         child_labels.extend(labels[cycles[k][0]] for k in mine)
@@ -261,32 +283,37 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
 def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
     """Old face -> its 4 quarter cycles (as stored) for every whole side of a marked cell."""
     out: dict = {}
+    points = np.concatenate([mesh.vertices, plan.points])
+    quarters = np.array([(0, 0), (1, 0), (1, 1), (0, 1)])
     for row, c in enumerate(plan.cells):
         signed = mesh.cell_face_list(c)
         faces = np.where(signed >= 0, signed, -signed - 1)
         cycles = [face_vertices[face_offsets[f] : face_offsets[f + 1]] for f in faces]
-        ids = np.unique(np.concatenate(cycles + [plan.lattice[row]]))
-        t, _ = _half_steps(np.concatenate([mesh.vertices, plan.points])[ids], plan.lower[row], plan.upper[row])
-        for f, cycle in zip(faces.tolist(), cycles):
-            tf = t[np.searchsorted(ids, cycle)]
-            axis = int(np.argmin(np.ptp(tf, axis=0)))
-            b, d = (axis + 1) % 3, (axis + 2) % 3
-            if f in out or np.ptp(tf[:, b]) < 2 - LATTICE_TOL or np.ptp(tf[:, d]) < 2 - LATTICE_TOL:
-                continue
-            normal = np.sign(mesh.face_vector_areas[f, axis])
-            level = float(np.round(tf[0, axis]))
-            out[f] = [
-                _perimeter_polygon(ids, t, axis, level, (lo_b, lo_d), (lo_b + 1, lo_d + 1), normal)
-                for lo_b, lo_d in ((0, 0), (1, 0), (1, 1), (0, 1))
-            ]
+        flat = np.concatenate(cycles)
+        ids = np.unique(np.concatenate([flat, plan.lattice[row]]))
+        t, _ = _half_steps(points[ids], plan.lower[row], plan.upper[row])
+        tf = t[np.searchsorted(ids, flat)]
+        starts = np.cumsum([0] + [cycle.size for cycle in cycles[:-1]])
+        span = np.maximum.reduceat(tf, starts, axis=0) - np.minimum.reduceat(tf, starts, axis=0)
+        whole = (np.sort(span, axis=1)[:, 1:] > 2 - LATTICE_TOL).all(axis=1)
+        whole &= ~np.isin(faces, list(out))
+        if not whole.any():
+            continue
+        axis = np.repeat(np.argmin(span[whole], axis=1), 4)
+        level = np.round(tf[starts[whole], axis[::4]]).repeat(4)
+        normal = np.sign(mesh.face_vector_areas[faces[whole], axis[::4]]).repeat(4)
+        low = np.tile(quarters, (int(whole.sum()), 1))
+        rings = _perimeter_polygons(ids, t, axis, level, low, low + 1, normal)
+        for k, f in enumerate(faces[whole].tolist()):
+            out[f] = rings[4 * k : 4 * k + 4]
     return out
 
 
 def _prolongation(mesh: PolyhedralMesh, plan: _Plan) -> sp.csr_matrix:
     """(new vertices, old vertices): old ones kept, a new one the mean of the corners it lies between."""
     n = mesh.n_vertices
-    rows = [np.arange(n)] + [np.full(len(s), n + k) for k, s in enumerate(plan.sources)]
-    cols = [np.arange(n)] + [np.asarray(s) for s in plan.sources]
-    vals = [np.ones(n)] + [np.full(len(s), 1.0 / len(s)) for s in plan.sources]
-    shape = (n + len(plan.sources), n)
+    rows = [np.arange(n)] + [np.repeat(ids, ends.shape[1]) for ids, ends in plan.sources]
+    cols = [np.arange(n)] + [ends.ravel() for _, ends in plan.sources]
+    vals = [np.ones(n)] + [np.full(ends.size, 1.0 / ends.shape[1]) for _, ends in plan.sources]
+    shape = (n + plan.points.shape[0], n)
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape)
