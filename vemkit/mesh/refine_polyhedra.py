@@ -285,6 +285,7 @@ def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
     out: dict = {}
     points = np.concatenate([mesh.vertices, plan.points])
     quarters = np.array([(0, 0), (1, 0), (1, 1), (0, 1)])
+    done = np.zeros(mesh.n_faces, dtype=bool)  # split already (by the marked cell across)
     for row, c in enumerate(plan.cells):
         signed = mesh.cell_face_list(c)
         faces = np.where(signed >= 0, signed, -signed - 1)
@@ -296,7 +297,7 @@ def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
         starts = np.cumsum([0] + [cycle.size for cycle in cycles[:-1]])
         span = np.maximum.reduceat(tf, starts, axis=0) - np.minimum.reduceat(tf, starts, axis=0)
         whole = (np.sort(span, axis=1)[:, 1:] > 2 - LATTICE_TOL).all(axis=1)
-        whole &= ~np.isin(faces, list(out))
+        whole &= ~done[faces]
         if not whole.any():
             continue
         axis = np.repeat(np.argmin(span[whole], axis=1), 4)
@@ -306,6 +307,7 @@ def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
         rings = _perimeter_polygons(ids, t, axis, level, low, low + 1, normal)
         for k, f in enumerate(faces[whole].tolist()):
             out[f] = rings[4 * k : 4 * k + 4]
+        done[faces[whole]] = True
     return out
 
 
