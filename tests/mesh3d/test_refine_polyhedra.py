@@ -1,5 +1,5 @@
-"""Refinement of polyhedral meshes (vemkit.mesh.refine_polyhedra): boxes split into 8 with hanging
-vertices stay valid polyhedra (validate_mesh3d), the hanging vertices are conforming (every interior
+"""Refinement of polyhedral meshes (vemkit.mesh.refine_polyhedra): boxes and tetrahedra split into 8
+with hanging vertices stay valid polyhedra (validate_mesh3d), the hanging vertices are conforming (every interior
 face shared by two cells in opposite orientations, the children's outer faces tile the parent's
 surface, volume and boundary parts kept), the predicted counts are the built ones, and the k = 1
 patch test holds on the refined meshes."""
@@ -10,7 +10,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
-from vemkit.mesh.families3d.grid import hex
+from vemkit.mesh.families3d.grid import hex, tet
 from vemkit.mesh.families3d.octree import octree
 from vemkit.mesh.meshing import ADAPTIVE_DIMENSIONS, of_dimension
 from vemkit.mesh.refine_polyhedra import predict_refinement, refine_cells
@@ -19,6 +19,7 @@ MESHES = {
     "hex": lambda: hex(n=3),
     "octree-contact": lambda: octree(n=2),
     "octree-random": lambda: octree(n=3, rule="random", fraction=0.4, seed=3),
+    "tet": lambda: tet(n=2),  # Kuhn tetrahedra: red refinement (Bey), hanging vertices on the neighbours
 }
 
 
@@ -95,8 +96,22 @@ def test_neighbour_faces_gain_the_hanging_vertices():
     assert sorted(v.size for v in vertices) == [8, 9, 9, 9, 13, 13, 13]
 
 
-def test_prolongation_carries_linear_fields_exactly():
-    mesh = octree(n=2, rule="random", fraction=0.5, seed=1)
+def test_tetrahedron_neighbours_gain_hanging_vertices():
+    """One Kuhn tetrahedron refined: 8 children of 4 triangles; every neighbour across a side lists
+    that side's 4 triangles, and the cells around its edges gain the midpoints."""
+    mesh = tet(n=1)
+    refined = refine_cells(mesh, [0])
+    new = refined.mesh
+    assert new.n_cells == 6 + 7 and np.diff(new.cell_offsets)[:8].tolist() == [4] * 8
+    assert new.n_vertices == mesh.n_vertices + 6
+    across = np.flatnonzero((mesh.face_cells == 0).any(axis=1) & (mesh.face_cells >= 0).all(axis=1))
+    assert np.diff(new.cell_offsets)[8:].sum() == np.diff(mesh.cell_offsets)[1:].sum() + 3 * across.size
+    assert np.abs(new.cell_volumes[:8] - mesh.cell_volumes[0] / 8).max() < 1e-15
+
+
+@pytest.mark.parametrize("make", [lambda: octree(n=2, rule="random", fraction=0.5, seed=1), lambda: tet(n=2)])
+def test_prolongation_carries_linear_fields_exactly(make):
+    mesh = make()
     refined = refine_cells(mesh, [0, 3, 5])
     G = np.array([[1.0, 2.0, -1.0], [0.5, 0.0, 3.0], [2.0, -1.0, 1.0]])
     assert np.abs(refined.prolongation @ (mesh.vertices @ G.T) - refined.mesh.vertices @ G.T).max() < 1e-14
@@ -107,7 +122,8 @@ def test_non_boxes_are_refused_in_one_line():
 
     mesh = voronoi(n=2)
     with pytest.raises(
-        MeshError, match="not an axis-aligned box; 3D refinement splits the cells of the families"
+        MeshError,
+        match="neither an axis-aligned box nor a tetrahedron; 3D refinement splits the cells of the families hex, octree, tet",
     ) as err:
         refine_cells(mesh, [0])
     assert "\n" not in str(err.value)

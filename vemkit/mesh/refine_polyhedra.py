@@ -1,4 +1,4 @@
-"""Local refinement of polyhedral meshes with hanging vertices: axis-aligned boxes split into 8.
+"""Local refinement of polyhedral meshes with hanging vertices: boxes and tetrahedra split into 8.
 
 A marked cell that is an axis-aligned box (a hexahedron of the grid family, an octree cell, possibly
 with hanging vertices already on its faces) becomes the 8 boxes of half its size. Its new vertices
@@ -16,7 +16,9 @@ A child's face is the planar polygon of every vertex on its rectangle's perimete
 faces are then stored once (``polyhedral_build.from_face_soup``); boundary faces keep their part's
 name (a quarter face the name of the face it comes from).
 
-Other cells (tetrahedra, prisms, Voronoi polyhedra) are refused in one line naming what refines.
+Tetrahedra follow the same scheme by the red rule (``vemkit.mesh.refine_tetrahedra``). Other cells
+(prisms over triangles or polygons, Voronoi polyhedra) are refused in one line naming the families
+that refine (``REFINABLE_FAMILIES``; a prism over a rectangle is a box and refines).
 ``predict_refinement`` counts the cells, vertices and faces of a refinement before it is built.
 """
 
@@ -31,9 +33,10 @@ from vemkit.exceptions import InputError, MeshError
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import from_face_soup
 from vemkit.mesh.refine import RefinedMesh
+from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, tetrahedron_children, whole_sides
 
 #: the families whose cells this module splits
-REFINABLE_FAMILIES = ("grid (hexahedra)", "octree")
+REFINABLE_FAMILIES = ("hex", "octree", "tet (box and gmsh tetrahedra)")
 #: relative tolerance of a vertex on the half-step lattice of a box (in units of half its size)
 LATTICE_TOL = 1e-9
 
@@ -66,6 +69,7 @@ class _Plan(NamedTuple):
     sources: list  # per kind (edge midpoints, face centres, body centres): (new ids, (k, 2|4|8) old corners)
     split_edges: tuple  # (sorted min * N + max keys of the old corner pairs split, their midpoints)
     whole_sides: int  # number of distinct whole faces split into quarters
+    kind: str = "box"  # or "tet" (vemkit.mesh.refine_tetrahedra: the lattice is 4 corners and 6 midpoints)
 
 
 def _marked_cells(mesh, marked) -> np.ndarray:
@@ -140,12 +144,23 @@ def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
     return _Plan(cells, lower, upper, lattice, np.concatenate(points), sources, split, whole_sides)
 
 
+def _any_plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
+    """The plan of the boxes' rule, else of the tetrahedra's (a MeshError naming the families that refine)."""
+    try:
+        return _plan(mesh, cells)
+    except MeshError:
+        lattice, points, sources, split, sides = plan_tetrahedra(mesh, cells, ", ".join(REFINABLE_FAMILIES))
+        return _Plan(cells, None, None, lattice, points, sources, split, sides, "tet")
+
+
 def predict_refinement(mesh: PolyhedralMesh, marked) -> RefinementCounts:
     """The cells, vertices and faces of ``refine_cells(mesh, marked)``, without building it."""
-    plan = _plan(mesh, _marked_cells(mesh, marked))
-    m = plan.cells.size
+    plan = _any_plan(mesh, _marked_cells(mesh, marked))
+    m = plan.cells.size  # a box has 12 inner faces, a tetrahedron 8
     return RefinementCounts(
-        mesh.n_cells + 7 * m, mesh.n_vertices + len(plan.points), mesh.n_faces + 12 * m + 3 * plan.whole_sides
+        mesh.n_cells + 7 * m,
+        mesh.n_vertices + len(plan.points),
+        mesh.n_faces + (12 if plan.kind == "box" else 8) * m + 3 * plan.whole_sides,
     )
 
 
@@ -244,13 +259,14 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     if circles:
         raise InputError("circles: 3D refinement of boxes has no curved sides; leave it out", key="circles")
     cells = _marked_cells(mesh, marked)
-    plan = _plan(mesh, cells)
+    plan = _any_plan(mesh, cells)
     face_offsets, face_vertices = _with_midpoints(mesh, plan.split_edges)
     names = list(mesh.boundary)
     labels = np.full(mesh.n_faces, -1, dtype=np.int64)
     for k, name in enumerate(names):
         labels[np.asarray(mesh.boundary[name], dtype=np.int64)] = k
-    split_faces = _split_faces(mesh, plan, face_offsets, face_vertices)
+    split_faces = (_split_faces if plan.kind == "box" else _split_tetrahedra)(mesh, plan, face_offsets, face_vertices)
+    x = np.concatenate([mesh.vertices, plan.points])
     row_of = np.full(mesh.n_cells, -1, dtype=np.int64)
     row_of[cells] = np.arange(cells.size)
     cell_sizes, soup, soup_labels, parent = [], [], [], []
@@ -258,6 +274,8 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
         cycles = _cell_cycles(mesh, c, face_offsets, face_vertices, split_faces)
         pieces = (
             _children(mesh, plan, int(row_of[c]), cycles, labels)
+            if row_of[c] >= 0 and plan.kind == "box"
+            else tetrahedron_children(mesh, plan.lattice[row_of[c]], cycles, labels, x)
             if row_of[c] >= 0
             else [([cycle for _, cycle in cycles], [labels[f] for f, _ in cycles])]
         )
@@ -308,6 +326,16 @@ def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
         for k, f in enumerate(faces[whole].tolist()):
             out[f] = rings[4 * k : 4 * k + 4]
         done[faces[whole]] = True
+    return out
+
+
+def _split_tetrahedra(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
+    """Old face -> its 4 triangles (as stored) for every whole side of a marked tetrahedron."""
+    x = np.concatenate([mesh.vertices, plan.points])
+    out: dict = {}
+    for row, c in enumerate(plan.cells.tolist()):
+        for f, rings in whole_sides(mesh, plan.lattice[row], c, face_offsets, face_vertices, x):
+            out.setdefault(f, rings)
     return out
 
 
