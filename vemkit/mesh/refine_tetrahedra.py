@@ -86,15 +86,26 @@ def plan_tetrahedra(mesh, cells: np.ndarray, refinable: str):
 
 def _on_edges(corners, pool, x):
     """The cycle of ``corners`` (vertex ids) with the vertices of ``pool`` lying inside its edges inserted."""
+    a, b = x[corners], x[np.roll(corners, -1)]
+    d = b - a  # (3, 3): edge vectors
+    rel = x[pool][None, :, :] - a[:, None, :]  # (3, k, 3)
+    length2 = (d * d).sum(axis=1)
+    s = np.einsum("ekc,ec->ek", rel, d) / length2[:, None]
+    off = ((rel - s[:, :, None] * d[:, None, :]) ** 2).sum(axis=2)
+    inside = (s > TOL) & (s < 1 - TOL) & (off < TOL * TOL * length2[:, None])
+    if not inside.any():
+        return np.asarray(corners, dtype=np.int64)
     out = []
-    for a, b in zip(corners, np.roll(corners, -1)):
-        out.append(a)
-        d = x[b] - x[a]
-        s = (x[pool] - x[a]) @ d / (d @ d)
-        off = np.linalg.norm(x[pool] - x[a] - s[:, None] * d, axis=1)
-        inside = (s > TOL) & (s < 1 - TOL) & (off < TOL * np.sqrt(d @ d))
-        out.extend(pool[inside][np.argsort(s[inside])].tolist())
+    for e in range(len(corners)):
+        out.append(corners[e])
+        out.extend(pool[inside[e]][np.argsort(s[e, inside[e]])].tolist())
     return np.array(out, dtype=np.int64)
+
+
+def _normal(x, ids):
+    """The (unnormalized) normal of the triangle x[ids]."""
+    u, v = x[ids[1]] - x[ids[0]], x[ids[2]] - x[ids[0]]
+    return np.array([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]])
 
 
 def whole_sides(mesh, lattice_row, cell: int, face_offsets, face_vertices, x):
@@ -118,8 +129,7 @@ def whole_sides(mesh, lattice_row, cell: int, face_offsets, face_vertices, x):
         rings = []
         for tri in triangles:
             ids = lattice_row[tri]
-            normal = np.cross(x[ids[1]] - x[ids[0]], x[ids[2]] - x[ids[0]])
-            ids = ids if normal @ mesh.face_vector_areas[f] > 0 else ids[::-1]
+            ids = ids if _normal(x, ids) @ mesh.face_vector_areas[f] > 0 else ids[::-1]
             rings.append(_on_edges(ids, pool, x))
         yield f, rings
 
@@ -160,8 +170,8 @@ def tetrahedron_children(mesh, lattice_row, cycles: list, labels, x):
             if (np.abs(_BARY[tri]) < TOL).all(axis=0).any():  # on a side of the parent: its faces are there
                 continue
             ids = lattice_row[tri]
-            normal = np.cross(x[ids[1]] - x[ids[0]], x[ids[2]] - x[ids[0]])
-            ids = ids if normal @ (x[ids].mean(axis=0) - x[lattice_row[child]].mean(axis=0)) > 0 else ids[::-1]
+            outward = _normal(x, ids) @ (x[ids].mean(axis=0) - x[lattice_row[child]].mean(axis=0)) > 0
+            ids = ids if outward else ids[::-1]
             faces.append(_on_edges(ids, pool, x))
             face_labels.append(-1)
         out.append((faces, face_labels))
