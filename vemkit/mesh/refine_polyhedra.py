@@ -33,10 +33,11 @@ from vemkit.exceptions import InputError, MeshError
 from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import from_face_soup
 from vemkit.mesh.refine import RefinedMesh
+from vemkit.mesh.refine_prisms import plan_prisms, prism_children, split_prism_sides
 from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, tetrahedron_children, whole_sides
 
 #: the families whose cells this module splits
-REFINABLE_FAMILIES = ("hex", "octree", "tet (box and gmsh tetrahedra)")
+REFINABLE_FAMILIES = ("hex", "octree", "tet (box and gmsh tetrahedra)", "the extruded ones over convex polygons")
 #: relative tolerance of a vertex on the half-step lattice of a box (in units of half its size)
 LATTICE_TOL = 1e-9
 
@@ -68,8 +69,9 @@ class _Plan(NamedTuple):
     points: np.ndarray  # (new, 3) coordinates of the new vertices
     sources: list  # per kind (edge midpoints, face centres, body centres): (new ids, (k, 2|4|8) old corners)
     split_edges: tuple  # (sorted min * N + max keys of the old corner pairs split, their midpoints)
-    whole_sides: int  # number of distinct whole faces split into quarters
-    kind: str = "box"  # or "tet" (vemkit.mesh.refine_tetrahedra: the lattice is 4 corners and 6 midpoints)
+    added_faces: int  # the children's inner faces and the pieces added by splitting whole sides
+    kind: str = "box"  # "tet" (vemkit.mesh.refine_tetrahedra: the lattice is 4 corners and 6 midpoints)
+    # or "prism" (vemkit.mesh.refine_prisms: a list of lattices, 6 m + 3 points each)
 
 
 def _marked_cells(mesh, marked) -> np.ndarray:
@@ -116,6 +118,31 @@ def _half_steps(x, lower, upper):
     return t, (np.abs(t - np.round(t)) < LATTICE_TOL).all(axis=1)
 
 
+def _check_face_pieces(mesh: PolyhedralMesh, cells: np.ndarray, lower, upper) -> None:
+    """Every face of a marked box is a whole side or lies in one quarter of it; a MeshError otherwise
+    (a strip across a mid-plane: the anisotropic hanging vertices of an extruded quadtree)."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    row = np.repeat(np.arange(cells.size), sizes)
+    signed = mesh.cell_faces[
+        np.repeat(mesh.cell_offsets[cells] - np.cumsum(sizes) + sizes, sizes) + np.arange(row.size)
+    ]
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    counts = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
+    owner = np.repeat(row, counts)
+    t = 2.0 * (mesh.vertices[mesh.face_vertex_ids(faces)] - lower[owner]) / (upper - lower)[owner]
+    starts = np.cumsum(counts) - counts
+    low, high = np.minimum.reduceat(t, starts, axis=0), np.maximum.reduceat(t, starts, axis=0)
+    across = (low < 1 - LATTICE_TOL) & (high > 1 + LATTICE_TOL)
+    whole = (high - low > 2 - LATTICE_TOL).sum(axis=1) == 2
+    bad = np.flatnonzero(across.any(axis=1) & ~whole)
+    if bad.size:
+        raise MeshError(
+            f"cell {cells[row[bad[0]]]} has face {faces[bad[0]]} across a mid-plane of its box without being a "
+            "whole side (anisotropic hanging vertices, as in an extruded quadtree); 3D refinement splits boxes "
+            "whose faces are whole sides or lie in a quarter of one"
+        )
+
+
 def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
     """The lattice of every marked cell, its new vertices named once (module doc)."""
     n = mesh.n_vertices
@@ -127,6 +154,7 @@ def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
     corners = lattice[:, _CORNERS]
     if (corners < 0).any():
         raise MeshError(f"cell {cells[np.argmax((corners < 0).any(axis=1))]} lacks a corner of its box")
+    _check_face_pieces(mesh, cells, lower, upper)
     points, sources, next_id, whole_sides, split = [], [], n, 0, (np.zeros(0, np.int64),) * 2
     for kind, where in enumerate(_KINDS):  # edge midpoints, face centres, body centres
         missing = lattice[:, where] < 0
@@ -141,26 +169,35 @@ def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
         if kind == 0:
             split = (unique[:, 0] * np.int64(n) + unique[:, 1], new_ids)
         whole_sides += unique.shape[0] if kind == 1 else 0
-    return _Plan(cells, lower, upper, lattice, np.concatenate(points), sources, split, whole_sides)
+    added = 12 * cells.size + 3 * whole_sides
+    return _Plan(cells, lower, upper, lattice, np.concatenate(points), sources, split, added)
 
 
 def _any_plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
-    """The plan of the boxes' rule, else of the tetrahedra's (a MeshError naming the families that refine)."""
+    """The plan of the boxes' rule, else of the tetrahedra's, else of the prisms' (a MeshError naming the
+    families that refine)."""
     try:
         return _plan(mesh, cells)
     except MeshError:
-        lattice, points, sources, split, sides = plan_tetrahedra(mesh, cells, ", ".join(REFINABLE_FAMILIES))
-        return _Plan(cells, None, None, lattice, points, sources, split, sides, "tet")
+        pass
+    refinable = ", ".join(REFINABLE_FAMILIES)
+    try:
+        lattice, points, sources, split, sides = plan_tetrahedra(mesh, cells, refinable)
+        return _Plan(cells, None, None, lattice, points, sources, split, 8 * cells.size + 3 * sides, "tet")
+    except MeshError:
+        lattices, points, sources, split, added, inner = plan_prisms(mesh, cells, refinable)
+        return _Plan(cells, None, None, lattices, points, sources, split, added + inner, "prism")
 
 
 def predict_refinement(mesh: PolyhedralMesh, marked) -> RefinementCounts:
     """The cells, vertices and faces of ``refine_cells(mesh, marked)``, without building it."""
     plan = _any_plan(mesh, _marked_cells(mesh, marked))
-    m = plan.cells.size  # a box has 12 inner faces, a tetrahedron 8
+    m = plan.cells.size
+    children = sum(2 * ((lattice.size - 3) // 6) for lattice in plan.lattice) if plan.kind == "prism" else 8 * m
     return RefinementCounts(
-        mesh.n_cells + 7 * m,
+        mesh.n_cells - m + children,
         mesh.n_vertices + len(plan.points),
-        mesh.n_faces + (12 if plan.kind == "box" else 8) * m + 3 * plan.whole_sides,
+        mesh.n_faces + plan.added_faces,
     )
 
 
@@ -265,7 +302,8 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     labels = np.full(mesh.n_faces, -1, dtype=np.int64)
     for k, name in enumerate(names):
         labels[np.asarray(mesh.boundary[name], dtype=np.int64)] = k
-    split_faces = (_split_faces if plan.kind == "box" else _split_tetrahedra)(mesh, plan, face_offsets, face_vertices)
+    split = {"box": _split_faces, "tet": _split_by(whole_sides), "prism": _split_by(split_prism_sides)}[plan.kind]
+    split_faces = split(mesh, plan, face_offsets, face_vertices)
     x = np.concatenate([mesh.vertices, plan.points])
     row_of = np.full(mesh.n_cells, -1, dtype=np.int64)
     row_of[cells] = np.arange(cells.size)
@@ -275,7 +313,9 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
         pieces = (
             _children(mesh, plan, int(row_of[c]), cycles, labels)
             if row_of[c] >= 0 and plan.kind == "box"
-            else tetrahedron_children(mesh, plan.lattice[row_of[c]], cycles, labels, x)
+            else (tetrahedron_children if plan.kind == "tet" else prism_children)(
+                mesh, plan.lattice[row_of[c]], cycles, labels, x
+            )
             if row_of[c] >= 0
             else [([cycle for _, cycle in cycles], [labels[f] for f, _ in cycles])]
         )
@@ -329,21 +369,29 @@ def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
     return out
 
 
-def _split_tetrahedra(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
-    """Old face -> its 4 triangles (as stored) for every whole side of a marked tetrahedron."""
-    x = np.concatenate([mesh.vertices, plan.points])
-    out: dict = {}
-    for row, c in enumerate(plan.cells.tolist()):
-        for f, rings in whole_sides(mesh, plan.lattice[row], c, face_offsets, face_vertices, x):
-            out.setdefault(f, rings)
-    return out
+def _split_by(sides_of):
+    """The splitter of whole sides by a rule's ``sides_of(mesh, lattice, cell, face_offsets, face_vertices, x)``
+    (pairs of a face and its pieces as stored): old face -> its pieces, each face split once."""
+
+    def split(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
+        x = np.concatenate([mesh.vertices, plan.points])
+        out: dict = {}
+        for row, c in enumerate(plan.cells.tolist()):
+            for f, rings in sides_of(mesh, plan.lattice[row], c, face_offsets, face_vertices, x):
+                out.setdefault(f, rings)
+        return out
+
+    return split
 
 
 def _prolongation(mesh: PolyhedralMesh, plan: _Plan) -> sp.csr_matrix:
     """(new vertices, old vertices): old ones kept, a new one the mean of the corners it lies between."""
     n = mesh.n_vertices
-    rows = [np.arange(n)] + [np.repeat(ids, ends.shape[1]) for ids, ends in plan.sources]
-    cols = [np.arange(n)] + [ends.ravel() for _, ends in plan.sources]
-    vals = [np.ones(n)] + [np.full(ends.size, 1.0 / ends.shape[1]) for _, ends in plan.sources]
+    rows = [np.arange(n)] + [np.repeat(source[0], source[1].shape[1]) for source in plan.sources]
+    cols = [np.arange(n)] + [source[1].ravel() for source in plan.sources]
+    vals = [np.ones(n)] + [  # the means of the corners, or the weights given (the prisms' centroids)
+        source[2].ravel() if len(source) > 2 else np.full(source[1].size, 1.0 / source[1].shape[1])
+        for source in plan.sources
+    ]
     shape = (n + plan.points.shape[0], n)
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape)
