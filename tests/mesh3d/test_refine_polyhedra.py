@@ -166,3 +166,30 @@ def test_patch_test_on_refined_meshes(name):
     load = dirichlet_lift(space, lam, mu, "dofi", dofs, exact)
     u = dofs.node_values(spla.spsolve(K.tocsc(), load), clamped_values=np.where(clamped[:, None], exact, 0.0))
     assert np.abs(u - exact).max() < 1e-10 * np.abs(exact).max()
+
+
+def test_new_vertices_of_a_curved_side_stay_on_its_circle():
+    """An extruded plate with a circular hole: refined everywhere, every vertex of the bore is on its circle;
+    refined at random twice more, the mesh stays valid (a side whose neighbours do not split with it
+    keeps its new vertices on the chord, so that no face bends)."""
+    domain = {
+        "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]],
+        "sides": ["bottom", "right", "top", "left"],
+        "holes": [{"circle": [1.0, 0.5, 0.25], "side": "bore"}],
+    }
+    mesh = extrude(build_mesh("triangle", 4, domain=domain), 2, 0.25)
+    circles = {"bore": [1.0, 0.5, 0.25]}
+
+    def radius(m):
+        v = m.vertices[m.boundary_vertices("bore")]
+        return np.hypot(v[:, 0] - 1.0, v[:, 1] - 0.5)
+
+    mesh = refine_cells(mesh, np.arange(mesh.n_cells), circles=circles).mesh
+    validate_mesh3d(mesh)
+    assert np.abs(radius(mesh) - 0.25).max() < 1e-12
+    rng = np.random.default_rng(0)
+    for _ in range(2):
+        refined = refine_cells(mesh, _random_marking(mesh, rng), circles=circles)
+        validate_mesh3d(refined.mesh)
+        assert radius(refined.mesh).max() < 0.25 + 1e-12
+        mesh = refined.mesh

@@ -173,7 +173,7 @@ def _plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
     return _Plan(cells, lower, upper, lattice, np.concatenate(points), sources, split, added)
 
 
-def _any_plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
+def _any_plan(mesh: PolyhedralMesh, cells: np.ndarray, curves=None) -> _Plan:
     """The plan of the boxes' rule, else of the tetrahedra's, else of the prisms' (a MeshError naming the
     families that refine)."""
     try:
@@ -185,13 +185,13 @@ def _any_plan(mesh: PolyhedralMesh, cells: np.ndarray) -> _Plan:
         lattice, points, sources, split, sides = plan_tetrahedra(mesh, cells, refinable)
         return _Plan(cells, None, None, lattice, points, sources, split, 8 * cells.size + 3 * sides, "tet")
     except MeshError:
-        lattices, points, sources, split, added, inner = plan_prisms(mesh, cells, refinable)
+        lattices, points, sources, split, added, inner = plan_prisms(mesh, cells, refinable, curves)
         return _Plan(cells, None, None, lattices, points, sources, split, added + inner, "prism")
 
 
-def predict_refinement(mesh: PolyhedralMesh, marked) -> RefinementCounts:
+def predict_refinement(mesh: PolyhedralMesh, marked, circles=None) -> RefinementCounts:
     """The cells, vertices and faces of ``refine_cells(mesh, marked)``, without building it."""
-    plan = _any_plan(mesh, _marked_cells(mesh, marked))
+    plan = _any_plan(mesh, _marked_cells(mesh, marked), circles)
     m = plan.cells.size
     children = sum(2 * ((lattice.size - 3) // 6) for lattice in plan.lattice) if plan.kind == "prism" else 8 * m
     return RefinementCounts(
@@ -287,16 +287,15 @@ def _children(mesh, plan: _Plan, row: int, cycles: list, labels):
 
 
 def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None, circles=None) -> RefinedMesh:
-    """Split the marked boxes into 8 (module doc); ``max_hanging`` and ``circles`` are not used yet
-    (boxes have no curved sides) and must be None or empty."""
+    """Split the marked cells (module doc). ``circles``: the curved pieces of an extruded body's base
+    (``vemkit.mesh.curves``; default the base mesh's ``circles``), followed by prisms' new boundary
+    vertices; ``max_hanging`` is not supported in 3D yet and must be None."""
     if max_hanging is not None:
         raise InputError(
             "max_hanging: 3D refinement does not limit hanging vertices yet; leave it out", key="max_hanging"
         )
-    if circles:
-        raise InputError("circles: 3D refinement of boxes has no curved sides; leave it out", key="circles")
     cells = _marked_cells(mesh, marked)
-    plan = _any_plan(mesh, cells)
+    plan = _any_plan(mesh, cells, circles)
     face_offsets, face_vertices = _with_midpoints(mesh, plan.split_edges)
     names = list(mesh.boundary)
     labels = np.full(mesh.n_faces, -1, dtype=np.int64)

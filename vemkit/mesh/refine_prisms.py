@@ -9,15 +9,20 @@ an edge midpoint named by its two corners, a face centre by the face's corners. 
 midpoints are inserted into every face listing the two corners in a row; a whole side (a lateral
 rectangle, or a cap) is split into its 4 quarters (or the m quadrilaterals Q_i); a side already split
 keeps its faces, each going to the child it lies on. A child's face is the polygon of its corners with
-every vertex of the parent lying on its edges inserted in order. Curved sides are not followed (a new
-vertex of a boundary edge is put on its chord).
+every vertex of the parent lying on its edges inserted in order. On a curved side (a circular hole or
+an arc of the base, ``vemkit.mesh.curves``) the new points of a whole lateral side move radially onto
+the circle, all three together, where every cell along its cap edges splits there too; otherwise they
+stay on the chord (so that no face bends).
 """
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from vemkit.exceptions import MeshError
+from vemkit.mesh.curves import as_pieces, on_curves
 from vemkit.mesh.refine_tetrahedra import TOL, _on_edges
 
 
@@ -93,7 +98,7 @@ def _check_lateral_faces(mesh, c: int, b, t, tol: float) -> None:
             )
 
 
-def plan_prisms(mesh, cells: np.ndarray, refinable: str):
+def plan_prisms(mesh, cells: np.ndarray, refinable: str, curves=None):
     """(lattices, new points, sources, split edges, faces added by splits, inner faces) of the marked
     prisms; a lattice is B, T, V, SB, ST, SM (m each: corners, vertical midpoints, edge midpoints
     at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism)."""
@@ -144,7 +149,83 @@ def plan_prisms(mesh, cells: np.ndarray, refinable: str):
     keys = edges[:, 0] * np.int64(n) + edges[:, 1]
     order = np.argsort(keys)
     added = sum(v for k, v in extra.items() if tuple(k) in new_of)  # a whole side has a new centre
-    return lattices, np.array(points).reshape(-1, 3), sources, (keys[order], mids[order]), added, inner
+    points = _onto_curves(mesh, cells, lattices, np.array(points).reshape(-1, 3), curves)
+    return lattices, points, sources, (keys[order], mids[order]), added, inner
+
+
+def _onto_curves(mesh, cells: np.ndarray, lattices: list, points: np.ndarray, curves) -> np.ndarray:
+    """``points`` with the new points of the whole lateral sides on curved boundary pieces (the 2D
+    mesh's ``circles`` or ``curves``: ``vemkit.mesh.curves``' pieces in the xy plane) moved radially onto their circle: the edge midpoints
+    s_i at both caps and the face centre between them, together (so that the quarters stay planar),
+    and only where every cell along those edges splits its side there too (else a neighbour's face
+    would bend): a point moves when as many moving sides pass through it as cells hold its edge."""
+    pieces = as_pieces(mesh.meta.get("base", {}).get("circles") if curves is None else curves)
+    if not pieces:
+        return points
+    n = mesh.n_vertices
+    part_of = np.full(mesh.n_faces, -1, dtype=np.int64)
+    names = list(mesh.boundary)
+    for k, name in enumerate(names):
+        part_of[mesh.boundary[name]] = k
+    triples, sides, ends = [], [], []
+    for c, lattice in zip(cells.tolist(), lattices):
+        m = (lattice.size - 3) // 6
+        for s in mesh.cell_face_list(c).tolist():
+            f = s if s >= 0 else -s - 1
+            i = next((i for i in range(m) if np.isin(lattice[[i, (i + 1) % m]], mesh.face(f)).all()), None)
+            if (
+                i is None
+                or part_of[f] < 0
+                or np.abs(mesh.face_vector_areas[f, 2]) > 1e-9 * np.abs(mesh.face_vector_areas[f]).sum()
+                or lattice[5 * m + i] < n
+            ):
+                continue  # not a whole lateral boundary side (a new centre)
+            triples.append(lattice[[3 * m + i, 5 * m + i, 4 * m + i]])
+            sides.append(names[part_of[f]])
+            ends.append(lattice[[i, (i + 1) % m, m + i, m + (i + 1) % m]])
+    if not triples:
+        return points
+    triples, ends = np.array(triples), np.array(ends)
+    around = _cells_around(mesh, ends)  # (k, 2): cells along the bottom and the top edge
+    cap_points = triples[:, [0, 2]]
+    uses = np.bincount(cap_points.ravel(), minlength=n + points.shape[0])  # sides through each point
+    moves = (cap_points >= n).all(axis=1) & (uses[cap_points] == around).all(axis=1)
+    while True:  # a cap midpoint moves only if every side through it moves
+        blocked = np.unique(triples[~moves][:, [0, 2]])
+        still = moves & ~np.isin(triples[:, [0, 2]], blocked).any(axis=1)
+        if (still == moves).all():
+            break
+        moves = still
+    out = points.copy()
+    for side in set(sides):
+        rows = np.flatnonzero(moves & (np.array(sides) == side))
+        if not rows.size:
+            continue
+        chord = ends[rows, :2]
+        fake = SimpleNamespace(n_vertices=n, boundary={side: chord})  # the chords of this side, as 2D edges
+        xy = on_curves(fake, chord, mesh.vertices[chord, :2].mean(axis=1), pieces)
+        for column in range(3):
+            out[triples[rows, column] - n, :2] = xy
+    return out
+
+
+def _cells_around(mesh, caps: np.ndarray) -> np.ndarray:
+    """Per row of ``caps`` (k, 4): (bottom edge, top edge) vertex pairs; the number of cells with a face
+    along each of the two edges (the cell itself and the one across its cap, if any)."""
+    offsets, ids = mesh.face_offsets, mesh.face_vertices
+    following = np.arange(1, ids.size + 1, dtype=np.int64)
+    following[offsets[1:] - 1] = offsets[:-1]
+    n = np.int64(mesh.n_vertices)
+    keys = np.minimum(ids, ids[following]) * n + np.maximum(ids, ids[following])
+    order = np.argsort(keys, kind="stable")
+    keys, faces = keys[order], np.repeat(np.arange(mesh.n_faces), np.diff(offsets))[order]
+    out = np.zeros((caps.shape[0], 2), dtype=np.int64)
+    for r, (a, b, c, d) in enumerate(caps.tolist()):
+        for e, (u, v) in enumerate(((a, b), (c, d))):
+            key = min(u, v) * n + max(u, v)
+            around = mesh.face_cells[faces[np.searchsorted(keys, key) : np.searchsorted(keys, key, side="right")]]
+            out[r, e] = np.unique(around[around >= 0]).size
+    return out
 
 
 def _ring(m: int, level: int, i: int) -> list:
