@@ -139,6 +139,33 @@ def test_non_boxes_are_refused_in_one_line():
     assert "\n" not in str(err.value)
 
 
+def test_resources_of_a_refinement_are_predicted_before_it_is_built():
+    from vemkit.config.limits import estimate_resources3d
+    from vemkit.mesh.families3d.resources import refinement_resources3d
+
+    mesh = octree(n=3, rule="random", fraction=0.4, seed=3)
+    marked = np.arange(0, mesh.n_cells, 3)
+    predicted = refinement_resources3d(mesh, marked)
+    new = refine_cells(mesh, marked).mesh
+    assert predicted == estimate_resources3d(new.n_cells, new.n_vertices, new.n_faces)
+    assert predicted.dofs == 3 * new.n_vertices
+
+
+@pytest.mark.parametrize("n", [3])
+def test_gmsh_tetrahedra_refine_with_hanging_vertices(n):
+    pytest.importorskip("gmsh")
+    from vemkit.mesh.families3d import build_mesh3d
+
+    box = {"box": [[0, 0, 0], [1, 1, 1]], "sides": ["left", "right", "front", "back", "bottom", "top"]}
+    mesh = build_mesh3d("tet", box, n=n)
+    rng = np.random.default_rng(1)
+    for _ in range(2):
+        refined = refine_cells(mesh, rng.choice(mesh.n_cells, mesh.n_cells // 5, replace=False))
+        validate_mesh3d(refined.mesh)
+        _check_conforming(mesh, refined)
+        mesh = refined.mesh
+
+
 def test_registered_for_dimension_3_but_adapt_stays_2d():
     assert of_dimension("refine", 3) is refine_cells
     assert 3 not in ADAPTIVE_DIMENSIONS
