@@ -23,7 +23,7 @@ import numpy as np
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.curves import as_pieces, on_curves
-from vemkit.mesh.refine_tetrahedra import TOL, _on_edges
+from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
 
 
 def _newell(x, ids):
@@ -45,7 +45,7 @@ def prism_corners(mesh, c: int):
     faces = np.where(signed >= 0, signed, -signed - 1)
     normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    planes = np.unique(np.round(normals, 8), axis=0, return_inverse=True)[1].ravel()
+    planes = plane_labels(normals)
     caps = np.abs(normals[:, 2]) > 1 - 1e-9
     if np.abs(normals[~caps, 2]).max(initial=0) > 1e-9 or np.unique(planes[caps]).size != 2:
         return None

@@ -25,13 +25,23 @@ _BARY = np.vstack([np.eye(4), [(np.eye(4)[i] + np.eye(4)[j]) / 2 for i, j in _ED
 TOL = 1e-9
 
 
+def plane_labels(normals: np.ndarray) -> np.ndarray:
+    """A label per unit outward normal, equal for the faces of one plane of a convex cell (normals
+    within 1e-9 of each other; not a rounding, which could split one plane in two)."""
+    labels = np.full(normals.shape[0], -1, dtype=np.int64)
+    for k in range(normals.shape[0]):
+        if labels[k] < 0:
+            labels[(labels < 0) & (normals @ normals[k] > 1 - 1e-9)] = labels.max() + 1
+    return labels
+
+
 def tetrahedron_corners(mesh, c: int) -> np.ndarray | None:
     """The 4 corners of cell c (positively oriented), or None when it is not a tetrahedron."""
     signed = mesh.cell_face_list(c)
     faces = np.where(signed >= 0, signed, -signed - 1)
     normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    planes = np.unique(np.round(normals, 8), axis=0, return_inverse=True)[1].ravel()
+    planes = plane_labels(normals)
     if planes.max() != 3:
         return None
     on = {}
