@@ -28,7 +28,7 @@ from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
 
 def _newell(x, ids):
     """The normal (times twice the area) of the polygon x[ids] by Newell's formula."""
-    p, q = x[ids], x[np.roll(ids, -1)]
+    p, q = x[ids], x[np.append(ids[1:], ids[0])]
     return np.array(
         [
             ((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),

@@ -96,7 +96,7 @@ def plan_tetrahedra(mesh, cells: np.ndarray, refinable: str):
 
 def _on_edges(corners, pool, x):
     """The cycle of ``corners`` (vertex ids) with the vertices of ``pool`` lying inside its edges inserted."""
-    a, b = x[corners], x[np.roll(corners, -1)]
+    a, b = x[corners], x[np.append(corners[1:], corners[0])]
     d = b - a  # (3, 3): edge vectors
     rel = x[pool][None, :, :] - a[:, None, :]  # (3, k, 3)
     length2 = (d * d).sum(axis=1)
