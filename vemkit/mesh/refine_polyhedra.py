@@ -63,11 +63,12 @@ class RefinementCounts(NamedTuple):
 
 class _Plan(NamedTuple):
     cells: np.ndarray  # (m,) the marked cells
-    lower: np.ndarray  # (m, 3) their boxes
+    lower: np.ndarray  # (m, 3) their boxes (None for tetrahedra and prisms)
     upper: np.ndarray
-    lattice: np.ndarray  # (m, 27) vertex id of every half-step lattice point (new ones numbered after old)
+    lattice: np.ndarray  # (m, 27) vertex id of every half-step lattice point (new ones numbered after old);
+    # tetrahedra: (m, 10) corners and edge midpoints; prisms: a list of (6 m_c + 3,) (refine_prisms)
     points: np.ndarray  # (new, 3) coordinates of the new vertices
-    sources: list  # per kind (edge midpoints, face centres, body centres): (new ids, (k, 2|4|8) old corners)
+    sources: list  # groups of (new ids, (k, s) old vertices, optional (k, s) weights; default the mean)
     split_edges: tuple  # (sorted min * N + max keys of the old corner pairs split, their midpoints)
     added_faces: int  # the children's inner faces and the pieces added by splitting whole sides
     kind: str = "box"  # "tet" (vemkit.mesh.refine_tetrahedra: the lattice is 4 corners and 6 midpoints)
@@ -309,24 +310,14 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     cell_sizes, soup, soup_labels, parent = [], [], [], []
     for c in range(mesh.n_cells):
         cycles = _cell_cycles(mesh, c, face_offsets, face_vertices, split_faces)
-        pieces = (
-            _children(mesh, plan, int(row_of[c]), cycles, labels)
-            if row_of[c] >= 0 and plan.kind == "box"
-            else (tetrahedron_children if plan.kind == "tet" else prism_children)(
-                mesh, plan.lattice[row_of[c]], cycles, labels, x
-            )
-            if row_of[c] >= 0
-            else [([cycle for _, cycle in cycles], [labels[f] for f, _ in cycles])]
-        )
-        for child, child_labels in pieces:
+        for child, child_labels in _pieces(mesh, plan, int(row_of[c]), cycles, labels, x):
             cell_sizes.append(len(child))
             soup.extend(child)
             soup_labels.extend(child_labels)
             parent.append(c)
-    vertices = np.concatenate([mesh.vertices, plan.points])
     meta = dict(mesh.meta, refined_3d=int(mesh.meta.get("refined_3d", 0)) + 1)
     new = from_face_soup(
-        vertices,
+        x,
         cell_sizes,
         [len(f) for f in soup],
         np.concatenate(soup) if soup else np.zeros(0, np.int64),
@@ -335,6 +326,17 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
         meta,
     )
     return RefinedMesh(new, np.asarray(parent, dtype=np.int64), _prolongation(mesh, plan), cells, np.zeros(0, np.int64))
+
+
+def _pieces(mesh, plan: _Plan, row: int, cycles: list, labels, x) -> list:
+    """(outward faces, labels) of the cells a cell becomes: its children (``row``: its row in the
+    plan), or itself with its split faces' pieces (row -1)."""
+    if row < 0:
+        return [([cycle for _, cycle in cycles], [labels[f] for f, _ in cycles])]
+    if plan.kind == "box":
+        return _children(mesh, plan, row, cycles, labels)
+    rule = tetrahedron_children if plan.kind == "tet" else prism_children
+    return rule(mesh, plan.lattice[row], cycles, labels, x)
 
 
 def _split_faces(mesh, plan: _Plan, face_offsets, face_vertices) -> dict:
