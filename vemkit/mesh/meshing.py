@@ -30,9 +30,13 @@ BY_DIMENSION: dict[str, dict[int, tuple[str, str]]] = {
         2: ("vemkit.config.limits", "check_scene_resources"),
         3: ("vemkit.mesh.families3d.resources", "check_scene_resources3d"),
     },
-    # the refinement of marked cells with hanging vertices (vemkit adapt): plane meshes
-    "refine": {2: ("vemkit.mesh.refine", "refine_cells")},
+    # the refinement of marked cells with hanging vertices: plane meshes; polyhedral meshes of boxes
+    "refine": {2: ("vemkit.mesh.refine", "refine_cells"), 3: ("vemkit.mesh.refine_polyhedra", "refine_cells")},
 }
+
+#: the dimensions whose scenes ``vemkit adapt`` runs: a mesh that refines (``BY_DIMENSION["refine"]``)
+#: and an error estimator; the 3D estimator is not there yet (issue 36)
+ADAPTIVE_DIMENSIONS = (2,)
 
 
 def of_dimension(role: str, dimension: int) -> Callable[..., Any]:
@@ -41,7 +45,7 @@ def of_dimension(role: str, dimension: int) -> Callable[..., Any]:
     return getattr(importlib.import_module(module), name)
 
 
-__all__ = ["BY_DIMENSION", "checked_mesh", "of_dimension", "scene_mesh"]
+__all__ = ["ADAPTIVE_DIMENSIONS", "BY_DIMENSION", "checked_mesh", "of_dimension", "scene_mesh"]
 
 
 def checked_mesh(mesh, what: str, fix: str):

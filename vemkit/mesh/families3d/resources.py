@@ -137,3 +137,13 @@ def check_scene_resources3d(scene, max_dofs, layout: dict | None = None):
     from vemkit.config.limits import check_scene_estimate
 
     return check_scene_estimate(scene, scene_resources3d(scene), max_dofs, dimension=3)
+
+
+def refinement_resources3d(mesh, marked, circles=None):
+    """Cells, DOFs and peak memory of solving ``mesh`` after its ``marked`` cells are refined
+    (``vemkit.mesh.refine_polyhedra``), predicted before the refined mesh is built: the refinement's
+    exact counts (``predict_refinement``) in the model of ``vemkit.config.limits.estimate_resources3d``."""
+    from vemkit.config.limits import estimate_resources3d
+    from vemkit.mesh.refine_polyhedra import predict_refinement
+
+    return estimate_resources3d(*predict_refinement(mesh, marked, circles))

@@ -1,0 +1,294 @@
+"""Refinement of prisms (extruded bodies) with hanging vertices, the prism rule of
+``vemkit.mesh.refine_polyhedra``: the 2D rule on the base and two in depth.
+
+A marked prism K x [z0, z1] (K a convex polygon with geometric corners c_0 ... c_{m-1}, counter-
+clockwise from +z: the vertices on 3 of the prism's planes) becomes 2m prisms Q_i x [z0, zm] and
+Q_i x [zm, z1], Q_i = [c_i, s_i, z, s_{i-1}] the quadrilaterals of the 2D rule (``vemkit.mesh.refine``:
+s_i the midpoint of c_i c_{i+1}, z the centroid of K) and zm the mid-depth. A new point is made once:
+an edge midpoint named by its two corners, a face centre by the face's corners. Missing edge
+midpoints are inserted into every face listing the two corners in a row; a whole side (a lateral
+rectangle, or a cap) is split into its 4 quarters (or the m quadrilaterals Q_i); a side already split
+keeps its faces, each going to the child it lies on. A child's face is the polygon of its corners with
+every vertex of the parent lying on its edges inserted in order. On a curved side (a circular hole or
+an arc of the base, ``vemkit.mesh.curves``) the new points of a whole lateral side move radially onto
+the circle, all three together, where every cell along its cap edges splits there too; otherwise they
+stay on the chord (so that no face bends).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from vemkit.exceptions import MeshError
+from vemkit.mesh.curves import as_pieces, on_curves
+from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
+
+
+def _newell(x, ids):
+    """The normal (times twice the area) of the polygon x[ids] by Newell's formula."""
+    p, q = x[ids], x[np.append(ids[1:], ids[0])]
+    return np.array(
+        [
+            ((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),
+            ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
+            ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum(),
+        ]
+    )
+
+
+def prism_corners(mesh, c: int):
+    """(bottom corners, top corners) of cell c, counter-clockwise from +z and matched, or None when
+    it is not a prism along z over a convex polygon."""
+    signed = mesh.cell_face_list(c)
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    planes = plane_labels(normals)
+    caps = np.abs(normals[:, 2]) > 1 - 1e-9
+    if np.abs(normals[~caps, 2]).max(initial=0) > 1e-9 or np.unique(planes[caps]).size != 2:
+        return None
+    on = {}
+    for f, plane in zip(faces, planes):
+        for v in mesh.face(f).tolist():
+            on.setdefault(v, set()).add(int(plane))
+    corners = np.array([v for v, p in on.items() if len(p) >= 3])
+    x = mesh.vertices[corners]
+    low = x[:, 2] < x[:, 2].mean()
+    bottom, top = corners[low], corners[~low]
+    if bottom.size < 3 or bottom.size != top.size:
+        return None
+    centre = mesh.vertices[bottom, :2].mean(axis=0)
+    bottom = bottom[np.argsort(np.arctan2(*(mesh.vertices[bottom, :2] - centre).T[::-1]))]
+    match = np.linalg.norm(mesh.vertices[top, None, :2] - mesh.vertices[None, bottom, :2], axis=2).argmin(axis=0)
+    top = top[match]
+    p = mesh.vertices[bottom, :2]
+    e, f = np.roll(p, -1, axis=0) - p, np.roll(p, -2, axis=0) - np.roll(p, -1, axis=0)
+    turn = e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]
+    if (turn <= 0).any() or np.unique(match).size != top.size:
+        return None
+    return bottom, top
+
+
+def _centroid_weights(x2):
+    """Weights of the corners of a convex polygon (k, 2) giving its area centroid (the fan from
+    corner 0: every triangle's area over 3 to each of its corners), so that prolongation is exact."""
+    e1, e2 = x2[1:-1] - x2[0], x2[2:] - x2[0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    w = np.zeros(x2.shape[0])
+    w[0] = area.sum()
+    w[1:-1] += area
+    w[2:] += area
+    return w / (3.0 * area.sum())
+
+
+def _check_lateral_faces(mesh, c: int, b, t, tol: float) -> None:
+    """Every lateral face of a marked prism is a whole side or lies in one half of its depth."""
+    zm = 0.5 * (mesh.vertices[b, 2].mean() + mesh.vertices[t, 2].mean())
+    corners = set(b.tolist()) | set(t.tolist())
+    for s in mesh.cell_face_list(c).tolist():
+        face = mesh.face(s if s >= 0 else -s - 1)
+        z = mesh.vertices[face, 2]
+        if z.min() < zm - tol and z.max() > zm + tol and np.ptp(z) > 0 and len(corners.intersection(face.tolist())) < 4:
+            raise MeshError(
+                f"cell {c} has a lateral face across its mid-depth without being a whole side (the hanging "
+                "vertices of an extruded mesh with hanging nodes); 3D refinement splits prisms whose lateral faces "
+                "are whole sides or lie in one half of the depth"
+            )
+
+
+def plan_prisms(mesh, cells: np.ndarray, refinable: str, curves=None):
+    """(lattices, new points, sources, split edges, faces added by splits, inner faces) of the marked
+    prisms; a lattice is B, T, V, SB, ST, SM (m each: corners, vertical midpoints, edge midpoints
+    at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism)."""
+    n, vertices = mesh.n_vertices, mesh.vertices
+    offsets, ids = mesh.cell_vertex_lists
+    new_of, points, sources, lattices, extra, inner = {}, [], [], [], {}, 0
+    for c in cells.tolist():
+        found = prism_corners(mesh, c)
+        if found is None:
+            raise MeshError(
+                f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box, a tetrahedron "
+                f"or a prism along z over a convex polygon; 3D refinement splits the cells of the families {refinable}"
+            )
+        b, t = found
+        m = b.size
+        own = ids[offsets[c] : offsets[c + 1]]
+        size = np.ptp(vertices[own], axis=0).max()
+        _check_lateral_faces(mesh, c, b, t, TOL * size)
+        nb, nt = np.roll(b, -1), np.roll(t, -1)
+        groups = [[b[i], t[i]] for i in range(m)] + [[b[i], nb[i]] for i in range(m)]
+        groups += [[t[i], nt[i]] for i in range(m)] + [[b[i], nb[i], t[i], nt[i]] for i in range(m)]
+        groups += [list(b), list(t), list(b) + list(t) + [-1 - c]]
+        row = list(b) + list(t)
+        for k, group in enumerate(groups):
+            real = [g for g in group if g >= 0]
+            weights = np.full(len(real), 1.0 / len(real))
+            if k >= 4 * m:  # a centroid: of a cap, or between the caps
+                w = _centroid_weights(vertices[real[:m], :2])
+                weights = w if len(real) == m else np.concatenate([w, w]) / 2
+            point = weights @ vertices[real]
+            near = own[np.linalg.norm(vertices[own] - point, axis=1) < TOL * size]
+            key = tuple(sorted(group))
+            if near.size:
+                row.append(int(near[0]))
+                continue
+            if key not in new_of:
+                new_of[key] = n + len(points)
+                points.append(point)
+                sources.append((np.array([new_of[key]]), np.array([real]), weights[None, :]))
+            row.append(new_of[key])
+        lattices.append(np.array(row, dtype=np.int64))
+        inner += 3 * m
+        for key, pieces in ((tuple(sorted([b[i], nb[i], t[i], nt[i]])), 4) for i in range(m)):
+            extra[key] = pieces - 1
+        extra[tuple(sorted(b))] = extra[tuple(sorted(t))] = m - 1
+    edges = np.array([k for k in new_of if len(k) == 2], dtype=np.int64).reshape(-1, 2)
+    mids = np.array([new_of[tuple(k)] for k in edges.tolist()], dtype=np.int64)
+    keys = edges[:, 0] * np.int64(n) + edges[:, 1]
+    order = np.argsort(keys)
+    added = sum(v for k, v in extra.items() if tuple(k) in new_of)  # a whole side has a new centre
+    points = _onto_curves(mesh, cells, lattices, np.array(points).reshape(-1, 3), curves)
+    return lattices, points, sources, (keys[order], mids[order]), added, inner
+
+
+def _onto_curves(mesh, cells: np.ndarray, lattices: list, points: np.ndarray, curves) -> np.ndarray:
+    """``points`` with the new points of the whole lateral sides on curved boundary pieces (the 2D
+    mesh's ``circles`` or ``curves``: ``vemkit.mesh.curves``' pieces in the xy plane) moved radially onto their circle: the edge midpoints
+    s_i at both caps and the face centre between them, together (so that the quarters stay planar),
+    and only where every cell along those edges splits its side there too (else a neighbour's face
+    would bend): a point moves when as many moving sides pass through it as cells hold its edge."""
+    pieces = as_pieces(mesh.meta.get("base", {}).get("circles") if curves is None else curves)
+    if not pieces:
+        return points
+    n = mesh.n_vertices
+    part_of = np.full(mesh.n_faces, -1, dtype=np.int64)
+    names = list(mesh.boundary)
+    for k, name in enumerate(names):
+        part_of[mesh.boundary[name]] = k
+    triples, sides, ends = [], [], []
+    for c, lattice in zip(cells.tolist(), lattices):
+        m = (lattice.size - 3) // 6
+        for s in mesh.cell_face_list(c).tolist():
+            f = s if s >= 0 else -s - 1
+            i = next((i for i in range(m) if np.isin(lattice[[i, (i + 1) % m]], mesh.face(f)).all()), None)
+            if (
+                i is None
+                or part_of[f] < 0
+                or np.abs(mesh.face_vector_areas[f, 2]) > 1e-9 * np.abs(mesh.face_vector_areas[f]).sum()
+                or lattice[5 * m + i] < n
+            ):
+                continue  # not a whole lateral boundary side (a new centre)
+            triples.append(lattice[[3 * m + i, 5 * m + i, 4 * m + i]])
+            sides.append(names[part_of[f]])
+            ends.append(lattice[[i, (i + 1) % m, m + i, m + (i + 1) % m]])
+    if not triples:
+        return points
+    triples, ends = np.array(triples), np.array(ends)
+    around = _cells_around(mesh, ends)  # (k, 2): cells along the bottom and the top edge
+    cap_points = triples[:, [0, 2]]
+    uses = np.bincount(cap_points.ravel(), minlength=n + points.shape[0])  # sides through each point
+    moves = (cap_points >= n).all(axis=1) & (uses[cap_points] == around).all(axis=1)
+    while True:  # a cap midpoint moves only if every side through it moves
+        blocked = np.unique(triples[~moves][:, [0, 2]])
+        still = moves & ~np.isin(triples[:, [0, 2]], blocked).any(axis=1)
+        if (still == moves).all():
+            break
+        moves = still
+    out = points.copy()
+    for side in set(sides):
+        rows = np.flatnonzero(moves & (np.array(sides) == side))
+        if not rows.size:
+            continue
+        chord = ends[rows, :2]
+        fake = SimpleNamespace(n_vertices=n, boundary={side: chord})  # the chords of this side, as 2D edges
+        xy = on_curves(fake, chord, mesh.vertices[chord, :2].mean(axis=1), pieces)
+        for column in range(3):
+            out[triples[rows, column] - n, :2] = xy
+    return out
+
+
+def _cells_around(mesh, caps: np.ndarray) -> np.ndarray:
+    """Per row of ``caps`` (k, 4): (bottom edge, top edge) vertex pairs; the number of cells with a face
+    along each of the two edges (the cell itself and the one across its cap, if any)."""
+    offsets, ids = mesh.face_offsets, mesh.face_vertices
+    following = np.arange(1, ids.size + 1, dtype=np.int64)
+    following[offsets[1:] - 1] = offsets[:-1]
+    n = np.int64(mesh.n_vertices)
+    keys = np.minimum(ids, ids[following]) * n + np.maximum(ids, ids[following])
+    order = np.argsort(keys, kind="stable")
+    keys, faces = keys[order], np.repeat(np.arange(mesh.n_faces), np.diff(offsets))[order]
+    out = np.zeros((caps.shape[0], 2), dtype=np.int64)
+    for r, (a, b, c, d) in enumerate(caps.tolist()):
+        for e, (u, v) in enumerate(((a, b), (c, d))):
+            key = min(u, v) * n + max(u, v)
+            around = mesh.face_cells[faces[np.searchsorted(keys, key) : np.searchsorted(keys, key, side="right")]]
+            out[r, e] = np.unique(around[around >= 0]).size
+    return out
+
+
+def _ring(m: int, level: int, i: int) -> list:
+    """Lattice positions of Q_i (c_i, s_i, z, s_{i-1}) at level 0 (bottom), 1 (mid-depth) or 2 (top)."""
+    corner, mid, centre = [(0, 3 * m, 6 * m), (2 * m, 5 * m, 6 * m + 2), (m, 4 * m, 6 * m + 1)][level]
+    return [corner + i, mid + i, centre, mid + (i - 1) % m]
+
+
+def _oriented(x, ids, direction):
+    return ids if _newell(x, ids) @ direction > 0 else ids[::-1]
+
+
+def split_prism_sides(mesh, lattice, cell: int, face_offsets, face_vertices, x):
+    """(face, pieces as stored) of the sides of a marked prism that are one face."""
+    m = (lattice.size - 3) // 6
+    signed = mesh.cell_face_list(cell)
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    cycles = [face_vertices[face_offsets[f] : face_offsets[f + 1]] for f in faces]
+    pool = np.union1d(np.concatenate(cycles), lattice)
+    for f, cycle in zip(faces.tolist(), cycles):
+        if np.isin(lattice[:m], cycle).all():
+            pieces = [_ring(m, 0, i) for i in range(m)]
+        elif np.isin(lattice[m : 2 * m], cycle).all():
+            pieces = [_ring(m, 2, i) for i in range(m)]
+        else:
+            i = next(
+                (i for i in range(m) if np.isin(lattice[[i, (i + 1) % m, m + i, m + (i + 1) % m]], cycle).all()), None
+            )
+            if i is None:
+                continue
+            j = (i + 1) % m
+            B, T, V, SB, ST, SM = (k * m for k in range(6))
+            pieces = [[B + i, SB + i, SM + i, V + i], [SB + i, B + j, V + j, SM + i]]
+            pieces += [[SM + i, V + j, T + j, ST + i], [V + i, SM + i, ST + i, T + i]]
+        direction = mesh.face_vector_areas[f]
+        yield f, [_on_edges(_oriented(x, lattice[p], direction), pool, x) for p in pieces]
+
+
+def prism_children(mesh, lattice, cycles: list, labels, x):
+    """The outward faces and labels of the 2m children of a marked prism; ``cycles``: its (face,
+    outward cycle) with its whole sides already split."""
+    m = (lattice.size - 3) // 6
+    pool = np.union1d(np.concatenate([cycle for _, cycle in cycles]), lattice)
+    centres = np.array([x[cycle].mean(axis=0) for _, cycle in cycles])
+    size = np.ptp(x[lattice], axis=0).max()
+    upper = centres[:, 2] > x[lattice[6 * m + 2], 2]
+    out = []
+    for layer in (0, 1):
+        for i in range(m):
+            low, high = _ring(m, layer, i), _ring(m, layer + 1, i)
+            q = x[lattice[_ring(m, 0, i)], :2]
+            d, r = np.roll(q, -1, axis=0) - q, centres[:, None, :2] - q[None]
+            cross = d[None, :, 0] * r[:, :, 1] - d[None, :, 1] * r[:, :, 0]
+            mine = np.flatnonzero((cross > -TOL * size * size).all(axis=1) & (upper == bool(layer)))
+            faces = [cycles[k][1] for k in mine]
+            face_labels = [labels[cycles[k][0]] for k in mine]
+            child_centre = x[lattice[low + high]].mean(axis=0)
+            polygons = [] if layer == 0 else [low]
+            polygons += [] if layer == 1 else [high]
+            polygons += [[low[k], low[k + 1], high[k + 1], high[k]] for k in (1, 2)]
+            for polygon in polygons:
+                ids = lattice[polygon]
+                faces.append(_on_edges(_oriented(x, ids, x[ids].mean(axis=0) - child_centre), pool, x))
+                face_labels.append(-1)
+            out.append((faces, face_labels))
+    return out

@@ -1,0 +1,188 @@
+"""Red refinement of tetrahedra with hanging vertices (Bey 1995), the tetrahedral rule of
+``vemkit.mesh.refine_polyhedra``.
+
+A marked tetrahedron x0 x1 x2 x3 (its corners: the vertices on 3 of its 4 planes; hanging vertices
+of refined neighbours may sit on its edges and sides) becomes 8: the 4 corner tetrahedra
+(x_i, m_ij, m_ik, m_il) and the octahedron of the 6 edge midpoints m_ij cut along its shortest
+diagonal into 4. A missing midpoint is made once (named by its edge's two corners) and inserted into
+every face listing the two corners in a row; a whole side is split into its 4 triangles (the 3
+corner ones and the middle one); a side already split keeps its faces, each going to the child it
+lies on. A child's face is the triangle of its corners with every vertex of the parent lying on
+its edges inserted in order (so hanging vertices of finer neighbours are kept).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vemkit.exceptions import MeshError
+
+#: the 6 edges of a tetrahedron as corner pairs; lattice point 4 + k is the midpoint of _EDGES[k]
+_EDGES = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+_MID = {pair: 4 + k for k, pair in enumerate(_EDGES)} | {pair[::-1]: 4 + k for k, pair in enumerate(_EDGES)}
+#: barycentric coordinates of the 10 lattice points (4 corners, 6 midpoints)
+_BARY = np.vstack([np.eye(4), [(np.eye(4)[i] + np.eye(4)[j]) / 2 for i, j in _EDGES]])
+TOL = 1e-9
+
+
+def plane_labels(normals: np.ndarray) -> np.ndarray:
+    """A label per unit outward normal, equal for the faces of one plane of a convex cell (normals
+    within 1e-9 of each other; not a rounding, which could split one plane in two)."""
+    labels = np.full(normals.shape[0], -1, dtype=np.int64)
+    for k in range(normals.shape[0]):
+        if labels[k] < 0:
+            labels[(labels < 0) & (normals @ normals[k] > 1 - 1e-9)] = labels.max() + 1
+    return labels
+
+
+def tetrahedron_corners(mesh, c: int) -> np.ndarray | None:
+    """The 4 corners of cell c (positively oriented), or None when it is not a tetrahedron."""
+    signed = mesh.cell_face_list(c)
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    planes = plane_labels(normals)
+    if planes.max() != 3:
+        return None
+    on = {}
+    for f, plane in zip(faces, planes):
+        for v in mesh.face(f).tolist():
+            on.setdefault(v, set()).add(int(plane))
+    corners = np.array([v for v, p in on.items() if len(p) == 3])
+    if corners.size != 4:
+        return None
+    x = mesh.vertices[corners]
+    if np.linalg.det(x[1:] - x[0]) < 0:
+        corners = corners[[1, 0, 2, 3]]
+    return corners
+
+
+def plan_tetrahedra(mesh, cells: np.ndarray, refinable: str):
+    """(lattice (m, 10) vertex ids, new points, sources, split edges, number of whole sides) of the
+    marked tetrahedra (``refine_polyhedra._Plan``'s fields)."""
+    n = mesh.n_vertices
+    offsets, ids = mesh.cell_vertex_lists
+    lattice = np.full((cells.size, 10), -1, dtype=np.int64)
+    new_of: dict = {}
+    for row, c in enumerate(cells.tolist()):
+        corners = tetrahedron_corners(mesh, c)
+        if corners is None:
+            raise MeshError(
+                f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is neither an axis-aligned box nor a "
+                f"tetrahedron; 3D refinement splits the cells of the families {refinable}"
+            )
+        lattice[row, :4] = corners
+        own = ids[offsets[c] : offsets[c + 1]]
+        for k, (i, j) in enumerate(_EDGES):
+            mid = 0.5 * (mesh.vertices[corners[i]] + mesh.vertices[corners[j]])
+            length = np.linalg.norm(mesh.vertices[corners[i]] - mesh.vertices[corners[j]])
+            near = own[np.linalg.norm(mesh.vertices[own] - mid, axis=1) < TOL * length]
+            key = (min(corners[i], corners[j]), max(corners[i], corners[j]))
+            lattice[row, 4 + k] = near[0] if near.size else new_of.setdefault(key, n + len(new_of))
+    ends = np.array(sorted(new_of, key=new_of.get), dtype=np.int64).reshape(-1, 2)
+    new_ids = n + np.arange(ends.shape[0])
+    points = mesh.vertices[ends].mean(axis=1)
+    split = (ends[:, 0] * np.int64(n) + ends[:, 1], new_ids)
+    order = np.argsort(split[0])
+    sides = set()
+    for row, c in enumerate(cells.tolist()):
+        corners = set(lattice[row, :4].tolist())
+        signed = mesh.cell_face_list(c)
+        for f in np.where(signed >= 0, signed, -signed - 1).tolist():
+            if len(corners.intersection(mesh.face(f).tolist())) == 3:
+                sides.add(f)
+    return lattice, points, [(new_ids, ends)], (split[0][order], split[1][order]), len(sides)
+
+
+def _on_edges(corners, pool, x):
+    """The cycle of ``corners`` (vertex ids) with the vertices of ``pool`` lying inside its edges inserted."""
+    a, b = x[corners], x[np.append(corners[1:], corners[0])]
+    d = b - a  # (3, 3): edge vectors
+    rel = x[pool][None, :, :] - a[:, None, :]  # (3, k, 3)
+    length2 = (d * d).sum(axis=1)
+    s = np.einsum("ekc,ec->ek", rel, d) / length2[:, None]
+    off = ((rel - s[:, :, None] * d[:, None, :]) ** 2).sum(axis=2)
+    inside = (s > TOL) & (s < 1 - TOL) & (off < TOL * TOL * length2[:, None])
+    if not inside.any():
+        return np.asarray(corners, dtype=np.int64)
+    out = []
+    for e in range(len(corners)):
+        out.append(corners[e])
+        out.extend(pool[inside[e]][np.argsort(s[e, inside[e]])].tolist())
+    return np.array(out, dtype=np.int64)
+
+
+def _normal(x, ids):
+    """The (unnormalized) normal of the triangle x[ids]."""
+    u, v = x[ids[1]] - x[ids[0]], x[ids[2]] - x[ids[0]]
+    return np.array([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]])
+
+
+def whole_sides(mesh, lattice_row, cell: int, face_offsets, face_vertices, x):
+    """(face, 4 triangles as stored) of the sides of a marked tetrahedron that are one face."""
+    signed = mesh.cell_face_list(cell)
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    corners = set(lattice_row[:4].tolist())
+    pool = np.unique(np.concatenate([face_vertices[face_offsets[f] : face_offsets[f + 1]] for f in faces]))
+    pool = np.union1d(pool, lattice_row)
+    for f in faces.tolist():
+        cycle = face_vertices[face_offsets[f] : face_offsets[f + 1]]
+        mine = [v for v in cycle.tolist() if v in corners]
+        if len(mine) < 3:
+            continue
+        p = [int(np.flatnonzero(lattice_row == v)[0]) for v in mine]
+        triangles = [[p[0], _MID[p[0], p[1]], _MID[p[0], p[2]]], [p[1], _MID[p[1], p[2]], _MID[p[1], p[0]]]]
+        triangles += [
+            [p[2], _MID[p[2], p[0]], _MID[p[2], p[1]]],
+            [_MID[p[0], p[1]], _MID[p[1], p[2]], _MID[p[2], p[0]]],
+        ]
+        rings = []
+        for tri in triangles:
+            ids = lattice_row[tri]
+            ids = ids if _normal(x, ids) @ mesh.face_vector_areas[f] > 0 else ids[::-1]
+            rings.append(_on_edges(ids, pool, x))
+        yield f, rings
+
+
+def _children_corners(x, lattice_row):
+    """The 8 children as lattice positions (4 each): the corner tetrahedra and the octahedron's 4."""
+    out = [[i] + [_MID[i, j] for j in range(4) if j != i] for i in range(4)]
+    diagonals = [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]
+    length = [np.linalg.norm(x[lattice_row[_MID[a]]] - x[lattice_row[_MID[b]]]) for a, b in diagonals]
+    a, b = diagonals[int(np.argmin(length))]
+    ring = [_MID[p] for p in _EDGES if p not in (a, b)]
+    ordered = [ring[0]]  # the ring around the diagonal: neighbours share a corner
+    while len(ordered) < 4:
+        last = set(_EDGES[ordered[-1] - 4])
+        ordered.append(next(q for q in ring if q not in ordered and last & set(_EDGES[q - 4])))
+    out += [[_MID[a], _MID[b], ordered[k], ordered[(k + 1) % 4]] for k in range(4)]
+    return out
+
+
+def tetrahedron_children(mesh, lattice_row, cycles: list, labels, x):
+    """The outward faces and labels of the 8 children of a marked tetrahedron; ``cycles``: its
+    (face, outward cycle) with its whole sides already split."""
+    pool = np.union1d(np.concatenate([cycle for _, cycle in cycles]), lattice_row)
+    corner_x = x[lattice_row[:4]]
+    to_bary = np.linalg.inv(np.vstack([corner_x.T, np.ones(4)]))
+    centres = np.array([x[cycle].mean(axis=0) for _, cycle in cycles])
+    bary = (to_bary @ np.vstack([centres.T, np.ones(len(cycles))])).T  # (faces, 4)
+    out = []
+    for child in _children_corners(x, lattice_row):
+        cb = _BARY[child]  # (4, 4) barycentric coordinates of the child's corners
+        inside = np.linalg.solve(cb.T, bary.T).T  # the face centres in the child's barycentric coordinates
+        faces, face_labels = [], []
+        mine = np.flatnonzero((inside > -TOL).all(axis=1))
+        faces += [cycles[k][1] for k in mine]
+        face_labels += [labels[cycles[k][0]] for k in mine]
+        for skip in range(4):
+            tri = [child[q] for q in range(4) if q != skip]
+            if (np.abs(_BARY[tri]) < TOL).all(axis=0).any():  # on a side of the parent: its faces are there
+                continue
+            ids = lattice_row[tri]
+            outward = _normal(x, ids) @ (x[ids].mean(axis=0) - x[lattice_row[child]].mean(axis=0)) > 0
+            ids = ids if outward else ids[::-1]
+            faces.append(_on_edges(ids, pool, x))
+            face_labels.append(-1)
+        out.append((faces, face_labels))
+    return out
