@@ -34,8 +34,9 @@ BY_DIMENSION: dict[str, dict[int, tuple[str, str]]] = {
     "refine": {2: ("vemkit.mesh.refine", "refine_cells"), 3: ("vemkit.mesh.refine_polyhedra", "refine_cells")},
 }
 
-#: the dimensions whose scenes ``vemkit adapt`` runs: a mesh that refines (``BY_DIMENSION["refine"]``)
-#: and an error estimator; the 3D estimator is not there yet (issue 36)
+#: the dimensions whose scenes ``vemkit adapt`` runs: a mesh that refines (``BY_DIMENSION["refine"]``),
+#: an error estimator (``vemkit.vem.estimator``, both dimensions) and the adaptive loop's scene data
+#: (``vemkit.studies.adaptivity.scene_indicators``: 2D only so far, issue 36)
 ADAPTIVE_DIMENSIONS = (2,)
 
 
