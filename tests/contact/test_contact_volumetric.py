@@ -3,7 +3,6 @@ through the real ``vemkit solve``: ``auto`` resolves to ``nodal_average`` (k = 1
 3D, nu > 0.45), both solvers converge, pass the independent check (the command exits 0 only then)
 and agree; the solution file records the treatment."""
 
-import subprocess
 import sys
 from pathlib import Path
 
@@ -12,6 +11,9 @@ import pytest
 import xarray as xr
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tests"))
+from measured_process import run_vemkit  # noqa: E402
+
 CASES = {
     "2d": (
         ROOT / "config" / "scenes" / "paper.yaml",
@@ -28,13 +30,8 @@ def _solve(tmp_path, case: str, method: str):
     scene, sets = CASES[case]
     out = tmp_path / f"{case}-{method}.nc"
     args = [a for s in [*sets, f"solver.method={method}"] for a in ("--set", s)]
-    run = subprocess.run(
-        [sys.executable, "-m", "vemkit.cli", "solve", scene, "-o", out, "-q", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert run.returncode == 0, run.stderr
+    status, _, stderr, _, _ = run_vemkit(["solve", scene, "-o", out, "-q", *args], tmp_path)
+    assert status == 0, stderr
     with xr.open_dataset(out) as ds:
         return ds.load()
 
