@@ -161,19 +161,11 @@ def _check_resources(scene, max_dofs):
 def _adapt_inputs(args):
     """The scene, the adaptivity settings, the true-error measure and the output targets of ``adapt``."""
     from vemkit.config.scene import load_scene
-    from vemkit.mesh.meshing import ADAPTIVE_DIMENSIONS
     from vemkit.studies.adaptivity import AdaptivitySettings
     from vemkit.studies.adaptivity_errors import reference_path, scene_true_error
 
     _outputs(args, [args.scene])
     scene = load_scene(args.scene, args.set or ())
-    if scene.dimension not in ADAPTIVE_DIMENSIONS:
-        bodies = " and ".join(f"{d}D" for d in ADAPTIVE_DIMENSIONS)
-        raise InputError(
-            f"vemkit adapt: {args.scene} is a {scene.dimension}D scene (its body is {scene.dimension}D); "
-            f"adaptivity is for {bodies} bodies (see docs/reference/files.md); solve it with vemkit solve",
-            key="domain",
-        )
     mesh_file = scene.mesh_options.get("file")
     inputs = [args.scene, Path(args.scene).parent / mesh_file if mesh_file else None, reference_path(scene)]
     targets = _outputs(args, inputs)

@@ -133,7 +133,7 @@ def test_bad_3d_scene_keys_are_refused_in_one_line(tmp_path, extra, message):
     assert not (tmp_path / "s.nc").exists()
 
 
-def test_a_2d_domain_with_model_3d_and_adapt_on_3d_are_refused(tmp_path):
+def test_a_2d_domain_with_model_3d_is_refused(tmp_path):
     text = scene_text("hex", 2).replace("domain: {box: [[0, 0, 0], [1, 1, 0.5]]}", "domain: unit_square")
     (tmp_path / "flat.yaml").write_text(
         text.replace(scene_text("hex", 2).split("dirichlet:\n")[1].split("discr")[0], "    bottom: [0, 0, 0]\n")
@@ -142,10 +142,7 @@ def test_a_2d_domain_with_model_3d_and_adapt_on_3d_are_refused(tmp_path):
     assert run.returncode == 2 and "model = '3d' does not fit the body: domain unit_square is 2D" in run.stderr, (
         run.stderr
     )
-    (tmp_path / "s.yaml").write_text(scene_text("hex", 2))
-    run = vemkit("adapt", tmp_path / "s.yaml", "-o", tmp_path / "a.nc")
-    assert run.returncode == 2 and "adaptivity is for 2D bodies" in run.stderr
-    assert not (tmp_path / "a.nc").exists() and not (tmp_path / "s.nc").exists()
+    assert not (tmp_path / "s.nc").exists()
 
 
 def test_a_3d_scene_solves_on_its_mesh_file_and_a_2d_scene_refuses_it(tmp_path):

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
 
-from vemkit.exceptions import MeshError
+from vemkit.exceptions import InputError, MeshError
 from vemkit.mesh.checks3d import validate_mesh3d
 from vemkit.mesh.families import build_mesh
 from vemkit.mesh.families3d import extrude
 from vemkit.mesh.families3d.grid import hex, tet
 from vemkit.mesh.families3d.octree import octree
-from vemkit.mesh.meshing import ADAPTIVE_DIMENSIONS, of_dimension
+from vemkit.mesh.meshing import HANGING_LIMIT_DIMENSIONS, of_dimension
 from vemkit.mesh.refine_polyhedra import predict_refinement, refine_cells
 
 MESHES = {
@@ -166,9 +166,11 @@ def test_gmsh_tetrahedra_refine_with_hanging_vertices(n):
         mesh = refined.mesh
 
 
-def test_registered_for_dimension_3_but_adapt_stays_2d():
+def test_registered_for_dimension_3_without_a_hanging_limit():
     assert of_dimension("refine", 3) is refine_cells
-    assert 3 not in ADAPTIVE_DIMENSIONS
+    assert 3 not in HANGING_LIMIT_DIMENSIONS
+    with pytest.raises(InputError, match="max_hanging"):
+        refine_cells(hex(n=2), [0], max_hanging=1)
 
 
 @pytest.mark.parametrize("name", sorted(MESHES))

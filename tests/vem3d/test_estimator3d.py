@@ -216,3 +216,29 @@ def test_the_contact_term_lives_on_the_contact_zone_and_peaks_at_its_edges():
     # and the indicator rises again at the separation line x ~ 0.5, above the zone's inside
     column = lambda xc: found["indicator"][bottom[np.abs(x - xc) < 1e-6]].mean()  # noqa: E731
     assert column(0.4375) > column(0.3125)
+
+
+@pytest.mark.parametrize("body", ["hex", "voronoi", "extruded"])
+def test_a_normal_pressure_is_the_traction_minus_p_nu(body):
+    """A side under a normal pressure p has the Neumann datum −p ν: the same terms as the traction
+    field −p ν on each plane side of the body, and zero for the pure pressure field u = −p x / (3λ + 2μ)."""
+    domain, family, sizes = BODIES[body]
+    mesh = build_mesh3d(family, domain, n=sizes[0])
+    p = 0.7
+    u = -p / (3 * LAM + 2 * MU) * mesh.vertices  # σ = −p I
+    pressure = {side: (lambda x, y, z: p + 0 * x) for side in mesh.boundaries}
+    assert error_indicators(mesh, u, LAM, MU, STAB, pressure=pressure)["estimate"] < 1e-6
+    rng = np.random.default_rng(4)
+    v = u + 0.01 * rng.standard_normal(u.shape)
+
+    def traction_of(side):
+        first = mesh.boundaries[side][0]
+        normal = mesh.facet_normals[first] * (1 if mesh.facet_cells[first, 0] >= 0 else -1)
+        return lambda x, y, z: tuple(-p * normal[i] + 0 * x for i in range(3))
+
+    by_pressure = error_indicators(mesh, v, LAM, MU, STAB, pressure=pressure)
+    by_traction = error_indicators(
+        mesh, v, LAM, MU, STAB, neumann={side: traction_of(side) for side in mesh.boundaries}
+    )
+    assert np.allclose(by_pressure["neumann"], by_traction["neumann"], rtol=1e-12, atol=0)
+    assert by_pressure["neumann"].max() > 0

@@ -52,6 +52,7 @@ class Box:
     upper: tuple
     sides: tuple = BOX_SIDES
     volume = property(lambda self: float(np.prod(np.subtract(self.upper, self.lower))), doc="its volume")
+    base = None  # no plane section with curves: its faces are planes (``plane_section``)
 
     @property
     def side_names(self) -> tuple:
@@ -100,6 +101,13 @@ def domain3d_from_spec(spec):
     if len(kinds) > 1:
         raise SceneError("domain: give either box or extrude, not both", key="domain")
     return _SOLIDS[kinds[0]](spec)
+
+
+def plane_section(spec):
+    """The plane Domain whose curves (arcs, circular holes) a body's boundary follows: a plane body's own
+    domain, an extruded body's base (curves in the xy plane, the same at every z); None for a box."""
+    solid = isinstance(spec, (Box, Extruded)) or (isinstance(spec, dict) and any(key in spec for key in _SOLIDS))
+    return domain3d_from_spec(spec).base if solid else domain_from_spec(spec)
 
 
 def _names(value, count: int, key: str, what: str) -> tuple:

@@ -124,6 +124,14 @@ def estimate_resources3d(cells: int, vertices: int, faces: int) -> Resources:
     )
 
 
+#: dimension -> the prediction for a built mesh from (cells, nodes of its space, facets): what the
+#: adaptive loop checks before it solves a refined mesh (a plane mesh's model reads no facets)
+RESOURCE_MODELS = {
+    2: lambda cells, nodes, _facets: estimate_resources(cells, nodes),
+    3: lambda cells, nodes, facets: estimate_resources3d(cells, nodes, facets),
+}
+
+
 def domain_area(domain) -> float:
     """Area of a scene's ``domain`` (docs/reference/files.md): 1 for the unit square, else the shoelace area of
     its outer polygon (holes ignored: an upper bound)."""

@@ -32,12 +32,16 @@ BY_DIMENSION: dict[str, dict[int, tuple[str, str]]] = {
     },
     # the refinement of marked cells with hanging vertices: plane meshes; polyhedral meshes of boxes
     "refine": {2: ("vemkit.mesh.refine", "refine_cells"), 3: ("vemkit.mesh.refine_polyhedra", "refine_cells")},
+    # (mesh, curves) -> None or a MeshError naming a cell the refinement cannot split (before any solve)
+    "check_refinable": {
+        2: ("vemkit.mesh.refine", "check_refinable"),
+        3: ("vemkit.mesh.families3d.resources", "check_refinable3d"),
+    },
 }
 
-#: the dimensions whose scenes ``vemkit adapt`` runs: a mesh that refines (``BY_DIMENSION["refine"]``),
-#: an error estimator (``vemkit.vem.estimator``, both dimensions) and the adaptive loop's scene data
-#: (``vemkit.studies.adaptivity.scene_indicators``: 2D only so far, issue 36)
-ADAPTIVE_DIMENSIONS = (2,)
+#: the dimensions whose refinement (``BY_DIMENSION["refine"]``) can keep at most k hanging vertices per
+#: edge of a cell (``max_hanging``; polyhedra: not yet)
+HANGING_LIMIT_DIMENSIONS = (2,)
 
 
 def of_dimension(role: str, dimension: int) -> Callable[..., Any]:
@@ -46,7 +50,7 @@ def of_dimension(role: str, dimension: int) -> Callable[..., Any]:
     return getattr(importlib.import_module(module), name)
 
 
-__all__ = ["ADAPTIVE_DIMENSIONS", "BY_DIMENSION", "checked_mesh", "of_dimension", "scene_mesh"]
+__all__ = ["HANGING_LIMIT_DIMENSIONS", "BY_DIMENSION", "checked_mesh", "of_dimension", "scene_mesh"]
 
 
 def checked_mesh(mesh, what: str, fix: str):

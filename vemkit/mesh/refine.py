@@ -95,6 +95,11 @@ def _rings(mesh: Mesh, splits: _Splits):
     return points, offsets, ring
 
 
+def check_refinable(mesh: Mesh, circles=None) -> None:
+    """Nothing to refuse: every polygon is split or, without a kernel, left whole and reported in
+    ``RefinedMesh.skipped`` (the plane counterpart of ``check_refinable3d``)."""
+
+
 def refine_cells(mesh: Mesh, marked, *, max_hanging: int | None = None, circles=None) -> RefinedMesh:
     """Split the marked cells (indices or a boolean mask) as the module docstring describes."""
     marked = np.asarray(marked)

@@ -28,20 +28,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from vemkit.config.limits import check_resources, estimate_resources
+from vemkit.config.domain3d import plane_section
+from vemkit.config.expressions import vector_field
+from vemkit.config.limits import RESOURCE_MODELS, check_resources
 from vemkit.contact.problem import DiscreteProblem, scene_problem
-from vemkit.exceptions import InputError, ResourceLimitError, ResultError
+from vemkit.exceptions import InputError, MeshError, ResourceLimitError, ResultError
 from vemkit.io.solution_file import solution_dataset
 from vemkit.mesh.curves import domain_curves
-from vemkit.mesh.meshing import checked_mesh, scene_mesh
-from vemkit.mesh.refine import refine_cells
-from vemkit.mesh.triangulate import triangulate_cells
+from vemkit.mesh.meshing import HANGING_LIMIT_DIMENSIONS, checked_mesh, of_dimension, scene_mesh
+from vemkit.mesh.ugrid import mesh_topology
 from vemkit.solvers.dispatch import floating_point_errors_raise, solve
 from vemkit.solvers.solution import ContactSolution, contact_state
 from vemkit.studies.error_records import RECORD_KEYS
 from vemkit.studies.scene_solve import verified
 from vemkit.vem.estimator import dorfler_marking, error_indicators
-from vemkit.vem.quadrature import cell_averages
 from vemkit.vem.space import VirtualElementSpace
 
 
@@ -68,6 +68,12 @@ class AdaptivitySettings:
         """The settings of ``scene.adaptivity_options`` (validated by the scene schema); ``max_dofs``
         (e.g. ``vemkit adapt --max-dofs``) caps ``adaptivity.max_dofs``."""
         options = scene.adaptivity_options
+        if options["max_hanging"] is not None and scene.dimension not in HANGING_LIMIT_DIMENSIONS:
+            raise InputError(
+                f"adaptivity.max_hanging = {options['max_hanging']}: the refinement of {scene.dimension}D bodies "
+                "does not limit hanging vertices; leave it out (null)",
+                key="adaptivity.max_hanging",
+            )
         cap = options["max_dofs"] if max_dofs is None else min(options["max_dofs"], int(max_dofs))
         return cls(
             theta=options["marking"]["dorfler"],
@@ -103,19 +109,13 @@ def contact_tractions(problem, solution) -> dict:
     return {side: at_nodes for side in problem.info.get("contact_sides", ())}
 
 
-def _pair(expressions):
-    fx, fy = expressions
-    return lambda x, y: (np.broadcast_to(fx(x, y), np.shape(x)), np.broadcast_to(fy(x, y), np.shape(y)))
-
-
 def scene_indicators(scene, problem, solution) -> dict:
     """error_indicators for a solved scene: its body force, tractions and the contact traction."""
-    mesh = problem.mesh
     body = None
     if any(not (e.is_constant and float(e(0.0, 0.0)) == 0.0) for e in scene.body_force):
-        triangles, parent = triangulate_cells(mesh)
-        body = cell_averages(mesh, _pair(scene.body_force), triangles, parent)
-    neumann = {side: _pair(scene.traction(side)) for side in scene.neumann_sides}
+        body = problem.space.body_force_averages(vector_field(scene.body_force))
+    pressure = {side: scene.pressure(side) for side in scene.neumann_sides if scene.pressure(side) is not None}
+    neumann = {side: vector_field(scene.traction(side)) for side in scene.neumann_sides if side not in pressure}
     contact = contact_tractions(problem, solution)
     return error_indicators(
         problem.space,
@@ -125,6 +125,7 @@ def scene_indicators(scene, problem, solution) -> dict:
         problem.stabilization,
         body_force=body,
         neumann=neumann,
+        pressure=pressure,
         contact=contact,
         volumetric_strain=problem.volumetric_strain,
     )
@@ -132,8 +133,10 @@ def scene_indicators(scene, problem, solution) -> dict:
 
 def curved_sides(domain_spec) -> list:
     """The boundary pieces of the domain (``vemkit.mesh.curves.domain_curves``: circular holes, outer
-    arcs and edges, polygonal holes' edges); refinement puts a new boundary vertex on its edge's own piece."""
-    return domain_curves(domain_spec)
+    arcs and edges, polygonal holes' edges; of an extruded body, its base's, in the xy plane; a box has
+    none); refinement puts a new boundary vertex on its edge's own piece."""
+    section = plane_section(domain_spec)
+    return [] if section is None else domain_curves(section)
 
 
 def prolongated_start(refined, problem, solution, new_problem):
@@ -244,6 +247,10 @@ def adapt(
     """
     mesh = scene_mesh(scene)
     circles = curved_sides(scene.domain)
+    try:
+        of_dimension("check_refinable", mesh.dimension)(mesh, circles)
+    except MeshError as error:
+        raise MeshError(f"vemkit adapt: {error}; choose a family that refines", key="discretization.mesh") from None
     run, previous = None, None
     for step in range(settings.max_steps):
         start = time.perf_counter()
@@ -265,7 +272,9 @@ def adapt(
                 if settings.theta >= 1.0
                 else dorfler_marking(found["indicator"], settings.theta)
             )
-            refined = refine_cells(mesh, marked, max_hanging=settings.max_hanging, circles=circles)
+            refined = of_dimension("refine", mesh.dimension)(
+                mesh, marked, max_hanging=settings.max_hanging, circles=circles
+            )
             record["marked"], record["skipped"] = int(marked.size), int(refined.skipped.size)
             reason = _limit_reason(refined.mesh, settings.max_dofs, problem.space.element)  # before it is solved
             if reason is None and refined.refined.size == 0:
@@ -295,7 +304,8 @@ def adapt(
 def _limit_reason(mesh, max_dofs: int, element):
     """ "max_dofs" or "memory" when solving ``mesh`` with ``element`` would pass ``max_dofs`` or the memory
     this machine has (the prediction of ``vemkit.config.limits`` from the space's nodes), else None."""
-    estimate = estimate_resources(mesh.n_cells, VirtualElementSpace(mesh, element).n_nodes)
+    nodes = VirtualElementSpace(mesh, element).n_nodes
+    estimate = RESOURCE_MODELS[mesh.dimension](mesh.n_cells, nodes, mesh.n_facets)
     if estimate.dofs > max_dofs:
         return "max_dofs"
     try:
@@ -354,13 +364,14 @@ def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
             f"the stresses of the solution overflow double precision ({error}); "
             "rescale the units of the scene (E, k, tractions)"
         ) from None
+    topology = mesh_topology(run.problem.mesh)
     ds["error_indicator"] = (
-        "mesh2d_nFaces",
+        topology.cell_dimension,
         run.indicators["indicator"],
         {
             "long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
-            "mesh": "mesh2d",
-            "location": "face",
+            "mesh": topology.name,
+            "location": topology.cell_location,
             "units": "sqrt(energy)",
         },
     )

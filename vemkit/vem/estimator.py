@@ -7,7 +7,8 @@ diameter, |e| for an edge):
 
     η_K² = (1 / 2μ) [ h_K² |f_K + div σ_K|² |K|                         volume residual
                     + ½ Σ_{F ⊂ ∂K interior} h_F ‖[σ n_F]‖²_F           jumps of the projected traction
-                    + Σ_{F ⊂ ∂K ∩ Γ_F} h_F ‖f2 − σ_K n_F‖²_F           mismatch on Neumann sides
+                    + Σ_{F ⊂ ∂K ∩ Γ_F} h_F ‖f2 − σ_K n_F‖²_F           mismatch on Neumann sides (f2 = −p n_F
+                                                                      on a side under a normal pressure p)
                     + Σ_{F ⊂ ∂K ∩ Γ_C} h_F ‖t_C − σ_K n_F‖²_F ]        mismatch with the contact traction
            + α_K S_K((I − Π) u_h, (I − Π) u_h)                            the VEM stabilization term (3.9)
 
@@ -182,6 +183,7 @@ def error_indicators(
     *,
     body_force=None,
     neumann=None,
+    pressure=None,
     contact=None,
     volumetric_strain: str = "cell",
 ) -> dict:
@@ -189,7 +191,8 @@ def error_indicators(
 
     space: a :class:`~vemkit.vem.space.VirtualElementSpace` (or a mesh of either dimension: k = 1); u_nodes its
     degrees of freedom (n_nodes, d). body_force: (M, d) cell averages f_K or None; neumann: {side:
-    traction(x, y[, z]) -> its d components}; contact: {side: (n_nodes, d) contact traction t_C at
+    traction(x, y[, z]) -> its d components}; pressure: {side: p(x, y[, z])}, the
+    Neumann datum −p ν of a normal pressure; contact: {side: (n_nodes, d) contact traction t_C at
     every node (only Γ_C contact points are read)}. Returns {"indicator" (M,) η_K, "volume", "jump", "neumann",
     "contact", "stabilization" (M,) the squared terms, "estimate" η, "energy" a_h(u_h, u_h)}.
     volumetric_strain: the stiffness's treatment of λ (``vemkit.vem.volumetric``): with
@@ -217,6 +220,8 @@ def error_indicators(
     facets = BOUNDARY_RESIDUALS[mesh.dimension]
     for side, traction in (neumann or {}).items():
         terms["neumann"] += facets.neumann(space, sig, side, traction)
+    for side, p in (pressure or {}).items():
+        terms["neumann"] += facets.pressure(space, sig, side, p)
     for side, at_nodes in (contact or {}).items():
         terms["contact"] += facets.contact(space, sig, side, at_nodes)
     residual = sum(terms.values()) / (2.0 * mu)

@@ -108,12 +108,26 @@ def sampled(field):
     return datum
 
 
+def pressed(pressure):
+    """datum(points (..., d), _, normal (..., d)) -> the traction −p ν of a normal pressure p(x, y[, z])."""
+
+    def datum(points, _where, normal):
+        p = np.broadcast_to(pressure(*(points[..., i] for i in range(points.shape[-1]))), points.shape[:-1])
+        return -p[..., None] * normal
+
+    return datum
+
+
 class EdgeResiduals:
     """d = 2: the misfits on the edges of a side (vertex pairs ``mesh.boundary[side]``), 3-point Gauss."""
 
     @staticmethod
     def neumann(space, sig, side, field) -> np.ndarray:
         return _edge_terms(space.mesh, sig, space.mesh.boundary[side], sampled(field))
+
+    @staticmethod
+    def pressure(space, sig, side, pressure) -> np.ndarray:
+        return _edge_terms(space.mesh, sig, space.mesh.boundary[side], pressed(pressure))
 
     @staticmethod
     def contact(space, sig, side, at_nodes) -> np.ndarray:
@@ -139,7 +153,7 @@ def _boundary_cells(mesh, edges: np.ndarray) -> np.ndarray:
 
 
 def _edge_terms(mesh, sig: ProjectedStress, edges: np.ndarray, datum) -> np.ndarray:
-    """|e| ∫_e |datum − σ_K n|² per cell, ``datum(points (Q, E, 2), t (Q,)) -> (Q, E, 2)``."""
+    """|e| ∫_e |datum − σ_K n|² per cell, ``datum(points (Q, E, 2), t (Q,), normal (E, 2)) -> (Q, E, 2)``."""
     out = np.zeros(mesh.n_cells)
     if edges.size == 0:
         return out
@@ -152,7 +166,7 @@ def _edge_terms(mesh, sig: ProjectedStress, edges: np.ndarray, datum) -> np.ndar
         own = traction(sig.constant[cells], normal)[None]
     else:
         own = np.stack([traction(sig.at(cells, p), normal) for p in points])
-    misfit = datum(points, t) - own
+    misfit = datum(points, t, normal) - own
     np.add.at(out, cells, length**2 * np.einsum("q,qe->e", w, np.sum(misfit**2, axis=2)))
     return out
 
@@ -164,13 +178,13 @@ def _trace_along(space, at_nodes: np.ndarray, edges: np.ndarray):
     if space.element.order == 1:  # two trace nodes per edge
         ta, tb = at_nodes[nodes[:, 0]], at_nodes[nodes[:, 1]]
 
-        def datum(_points, t):
+        def datum(_points, t, _normal):
             return ta[None] + t[:, None, None] * (tb - ta)[None]
 
         return datum
     values = at_nodes[nodes]  # (E, k + 1, 2)
 
-    def datum(_points, t):
+    def datum(_points, t, _normal):
         return np.einsum("qn,enc->qec", space.element.edge_trace(t), values)
 
     return datum
@@ -187,13 +201,17 @@ class FaceResiduals:
     @staticmethod
     def neumann(space, sig, side, field) -> np.ndarray:
         datum = sampled(field)
-        return _face_terms(space.mesh, sig, space.mesh.boundaries[side], lambda points, _fan: datum(points))
+        return _face_terms(space.mesh, sig, space.mesh.boundaries[side], datum)
+
+    @staticmethod
+    def pressure(space, sig, side, pressure) -> np.ndarray:
+        return _face_terms(space.mesh, sig, space.mesh.boundaries[side], pressed(pressure))
 
     @staticmethod
     def contact(space, sig, side, at_nodes) -> np.ndarray:
         values = np.asarray(at_nodes, dtype=float)
 
-        def datum(_points, fan):
+        def datum(_points, fan, _normal):
             corners = np.stack([fan.centre_mean(values), values[fan.a], values[fan.b]], axis=1)  # (T, 3, d)
             return np.einsum("qk,tkc->qtc", FAN_POINTS, corners)
 
@@ -224,7 +242,7 @@ class _Fan:
 
 
 def _face_terms(mesh, sig: ProjectedStress, faces: np.ndarray, datum) -> np.ndarray:
-    """h_F ∫_F |datum − σ_K n_F|² per cell, ``datum(points (3, T, 3), fan) -> (3, T, 3)``."""
+    """h_F ∫_F |datum − σ_K n_F|² per cell, ``datum(points (3, T, 3), fan, normal (T, 3)) -> (3, T, 3)``."""
     out = np.zeros(mesh.n_cells)
     faces = np.asarray(faces, dtype=np.int64)
     if faces.size == 0:
@@ -239,7 +257,7 @@ def _face_terms(mesh, sig: ProjectedStress, faces: np.ndarray, datum) -> np.ndar
         own = traction(sig.constant[tri_cells], normal[fan.face])[None]
     else:
         own = np.stack([traction(sig.at(tri_cells, p), normal[fan.face]) for p in fan.points])
-    misfit = datum(fan.points, fan) - own
+    misfit = datum(fan.points, fan, normal[fan.face]) - own
     integral = np.bincount(fan.face, fan.area * np.sum(misfit**2, axis=2).mean(axis=0), faces.size)
     np.add.at(out, cells, facet_diameters(mesh)[faces] * integral)
     return out

@@ -147,6 +147,10 @@ class VirtualElementSpace:
         """(n_nodes, 2) the body-force load of Section 3.3 (``projection``: the data's projection)."""
         return self.element.body_force_load(self.mesh, field, lam, mu, projection)
 
+    def body_force_averages(self, field) -> np.ndarray:
+        """(M, d) the cell averages P_0 f of a body force field(x, y[, z]) (Section 3.3)."""
+        return self.element.body_force_averages(self.mesh, field)
+
     def stiffness_matrix(self, lam: float, mu: float, stabilization: str, dofs: DofMap | None = None):
         """The global stiffness matrix (3.9) on the free dofs of ``dofs`` (``vemkit.vem.assembly``)."""
         from vemkit.vem.assembly import stiffness_matrix

@@ -147,3 +147,11 @@ def refinement_resources3d(mesh, marked, circles=None):
     from vemkit.mesh.refine_polyhedra import predict_refinement
 
     return estimate_resources3d(*predict_refinement(mesh, marked, circles))
+
+
+def check_refinable3d(mesh, circles=None) -> None:
+    """MeshError naming the first cell of ``mesh`` that ``vemkit.mesh.refine_polyhedra`` cannot split
+    and the families that refine: checked before an adaptive run solves its first mesh."""
+    from vemkit.mesh.refine_polyhedra import predict_refinement
+
+    predict_refinement(mesh, np.arange(mesh.n_cells), circles)

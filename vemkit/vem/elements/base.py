@@ -111,6 +111,13 @@ class Element:
         """(weights, measures) of ``k1_divergence``; only elements with a constant strain per cell have it."""
         raise ValueError(f"the {self.name} element has no constant divergence per cell: no nodal averaging")
 
+    def body_force_averages(self, mesh, field) -> np.ndarray:
+        """(M, d) P_0 f on every cell of a field f(x, y) -> (f1, f2): the averages the k = 1 load and
+        the estimator's volume residual read (a triangulation of each polygon)."""
+        from vemkit.vem.quadrature import body_force_averages
+
+        return body_force_averages(mesh, field)
+
     def geometry(self, mesh):
         """The first argument of ``cell_matrix`` (module docstring): the vertex coordinates."""
         return mesh.vertices

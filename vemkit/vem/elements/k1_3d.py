@@ -119,6 +119,10 @@ class FirstOrder3D(Element):
         """int_K P_0 f . Pi v_h dx (Section 3.3), P_0 f the cell average of f."""
         return k1_3d_fields.body_force_load(mesh, self.geometry(mesh), field)
 
+    def body_force_averages(self, mesh, field) -> np.ndarray:
+        """(M, 3) P_0 f on every cell of a field f(x, y, z) -> (f1, f2, f3) (the fan rule of the load)."""
+        return k1_3d_fields.body_force_averages(mesh, field)
+
     def traction_load(self, mesh, faces, traction) -> np.ndarray:
         """int_F g . v_h ds over boundary ``faces`` (face numbers), v_h as Pi^F v_h on each face."""
         return k1_3d_fields.traction_load(mesh, faces, traction)

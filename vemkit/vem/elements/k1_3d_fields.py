@@ -122,12 +122,9 @@ def projected_solution(mesh, geometry, node_values) -> ProjectedSolution3D:
     return ProjectedSolution3D(*projected_fields(vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, u))
 
 
-def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK) -> np.ndarray:
-    """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid: f evaluated on
-    the fan rule of about ``chunk_points`` points at a time (whole cells), bounded memory."""
-    vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
-    offsets, ids = mesh.cell_vertex_lists
-    out = np.zeros((mesh.n_vertices, 3))
+def _cell_moments_in_chunks(mesh, field, chunk_points: int):
+    """(lo, hi, |K|, P_0 f, x_K) of the cells lo <= c < hi, chunk by chunk: f evaluated on the fan rule
+    of about ``chunk_points`` points at a time (whole cells), bounded memory."""
     faces = np.where(mesh.cell_faces >= 0, mesh.cell_faces, -mesh.cell_faces - 1)
     tetrahedra = int(np.diff(mesh.face_offsets)[faces].sum())  # BODY_FORCE_POINTS^3 points each
     step = max(1, int(chunk_points * mesh.n_cells // max(BODY_FORCE_POINTS**3 * tetrahedra, 1)))
@@ -135,10 +132,26 @@ def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK)
         hi = min(lo + step, mesh.n_cells)
         x, w, cells = cell_quadrature(mesh, BODY_FORCE_POINTS, (lo, hi))
         f = np.stack(np.broadcast_arrays(*field(x[:, 0], x[:, 1], x[:, 2])), axis=1).astype(float)
-        volume, mean_f, centroid = cell_moments(cells - lo, w, x, f, hi - lo)
+        yield (lo, hi, *cell_moments(cells - lo, w, x, f, hi - lo))
+
+
+def body_force_load(mesh, geometry, field, chunk_points: int = QUADRATURE_CHUNK) -> np.ndarray:
+    """(N, 3) int_K P_0 f . Pi phi_j dx = |K| f_K . (Pi phi_j)(x_K), x_K the centroid (Section 3.3)."""
+    vertices, cell_face_ptr, face_ptr, face_local = geometry[:4]
+    offsets, ids = mesh.cell_vertex_lists
+    out = np.zeros((mesh.n_vertices, 3))
+    for lo, _hi, volume, mean_f, centroid in _cell_moments_in_chunks(mesh, field, chunk_points):
         body_force_scatter(
             vertices, offsets, ids, cell_face_ptr, face_ptr, face_local, lo, volume, mean_f, centroid, out
         )
+    return out
+
+
+def body_force_averages(mesh, field, chunk_points: int = QUADRATURE_CHUNK) -> np.ndarray:
+    """(M, 3) P_0 f: the cell averages of ``field`` that ``body_force_load`` scatters."""
+    out = np.zeros((mesh.n_cells, 3))
+    for lo, hi, _volume, mean_f, _centroid in _cell_moments_in_chunks(mesh, field, chunk_points):
+        out[lo:hi] = mean_f
     return out
 
 
