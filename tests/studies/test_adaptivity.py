@@ -221,3 +221,16 @@ def test_the_reference_error_takes_the_slivers_at_a_circular_hole_finer_than_the
     fine_vs_coarse = reference_errors(meshes[1], fields[1], refs[0])["error_h1_semi"] * norms[0]
     coarse_vs_fine = reference_errors(meshes[0], fields[0], refs[1])["error_h1_semi"] * norms[1]
     assert 0.05 < fine_vs_coarse / norms[0] < 0.5 and np.isclose(fine_vs_coarse, coarse_vs_fine, rtol=0.01)
+
+
+def test_a_pressure_side_is_estimated_as_its_traction_minus_p_nu():
+    """The L-bracket's shelf (outward normal +y) under traction (0, −5) and under pressure 5: one load,
+    one estimate, the same adaptive meshes."""
+
+    runs = []
+    for load in ("{traction: [0.0, -5.0]}", "{pressure: 5.0}"):
+        overrides = ["discretization.mesh.h=5", "adaptivity.max_steps=3", f"boundary.neumann.shelf={load}"]
+        scene = load_scene("config/scenes/lbracket.yaml", overrides)
+        runs.append(adapt(scene, AdaptivitySettings.from_scene(scene)).history)
+    assert [r["n_dofs"] for r in runs[0]] == [r["n_dofs"] for r in runs[1]]
+    assert np.allclose([r["estimate"] for r in runs[0]], [r["estimate"] for r in runs[1]], rtol=1e-9, atol=0)
