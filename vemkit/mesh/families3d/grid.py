@@ -6,6 +6,11 @@ with ``kind: structured``, while its default kind, delaunay, is gmsh's: ``gmsh_t
 The box is ``[lower, upper]``; its faces x = x0, x = x1, y = y0, y = y1, z = z0, z = z1 are named by
 ``sides`` (default ``left, right, front, back, bottom, top``). The grid has ``max(1, round(n L))``
 cells along an edge of length L (``n`` cells per unit length), or exactly ``shape`` = (nx, ny, nz).
+
+``hex_without_box`` is the hex grid with the cells whose centres lie in a second box ``removed``
+left out: with ``removed`` on grid lines, the body box minus that box. ``(-1, 1)^3`` minus
+``[0, 1]^3`` is Fichera's corner (three re-entrant edges meeting at a re-entrant vertex); no scene
+key makes it, a mesh file does (``vemkit.mesh.ugrid.write_ugrid``, ``config/scenes/3d/fichera.yaml``).
 """
 
 from __future__ import annotations
@@ -70,6 +75,26 @@ def hex(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
     labels = np.tile(np.arange(6), ids.shape[0])
     mesh = _cells_mesh(vertices, ids, HEX_FACES, labels, tuple(sides), _grid_meta(n, shape, box, family="hex"))
     return _merge_repeated_names(mesh, sides)
+
+
+def hex_without_box(
+    n=None, box=UNIT_BOX, removed=None, sides=BOX_SIDES, removed_side="notch", shape=None
+) -> PolyhedralMesh:
+    """The hex grid of ``box`` without the cells whose centres lie inside the box ``removed`` (module
+    doc); the faces on the planes of ``box`` named by ``sides``, the faces the removal opens by
+    ``removed_side``."""
+    shape = grid_shape(n, box, shape)
+    vertices, ids = lattice(shape, box)
+    lower, upper = check_box(removed)
+    centres = vertices[ids].mean(axis=1)
+    kept = ids[~((centres > lower) & (centres < upper)).all(axis=1)]
+    used, corners = np.unique(kept, return_inverse=True)
+    meta = _grid_meta(n, shape, box, family="hex", removed=np.asarray(removed, float).tolist())
+    mesh = _cells_mesh(vertices[used], corners.reshape(kept.shape), HEX_FACES, None, (), meta)
+    mesh = tag_box_faces(mesh, *check_box(box), tuple(sides))
+    named = np.concatenate([np.zeros(0, np.int64), *mesh.boundary.values()])
+    opened = np.setdiff1d(mesh.boundary_faces, named)
+    return replace(mesh, boundary={**mesh.boundary, removed_side: opened})
 
 
 def tet(n=None, box=UNIT_BOX, sides=BOX_SIDES, shape=None) -> PolyhedralMesh:
