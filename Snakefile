@@ -3,7 +3,7 @@
 #   snakemake -j2 results/table1.nc      only what Table 1 needs
 #   snakemake --report report.html       the HTML report
 # Layout: workflow/rules/*.smk (rules), workflow/scripts/ (thin scripts calling vemkit),
-# config/config.yaml, config/sweeps.yaml, config/adaptivity.yaml, config/three_d.yaml (Snakemake's
+# config/config.yaml, config/sweeps.yaml, config/adaptivity.yaml, config/adaptivity3d.yaml, config/three_d.yaml (Snakemake's
 # config; add yours with --configfile), checked in common.smk before any job (also in `snakemake -n`):
 # workflow/schemas/*.schema.yaml, then vemkit.studies.workflow_config; a refusal is one line naming the
 # file and the key (docs/paper.md, "The configuration and its checks").
@@ -15,6 +15,7 @@ min_version("8.0")
 configfile: "config/config.yaml"
 configfile: "config/sweeps.yaml"
 configfile: "config/adaptivity.yaml"
+configfile: "config/adaptivity3d.yaml"
 configfile: "config/three_d.yaml"
 
 
@@ -33,7 +34,7 @@ include: "workflow/rules/tradeoff.smk"
 include: "workflow/rules/stability.smk"
 # k = 1 against k = 2 (issue 14, not in the default target either): `snakemake -j2 order2`
 include: "workflow/rules/order2.smk"
-# adaptive against uniform refinement (not in `rule all`): `snakemake -j2 adaptivity`
+# adaptive against uniform refinement (not in `rule all`): `snakemake -j2 adaptivity`, in 3D `adaptivity3d`
 include: "workflow/rules/adaptivity.smk"
 # the shipped scenes against published references (not in `rule all`): `snakemake -j2 verification`
 include: "workflow/rules/verification.smk"

@@ -73,3 +73,40 @@ def test_every_output_is_written_under_results_adaptive():
     scenes = [label for label, case in STUDY["scenes"].items() if (ROOT / case["scene"]).is_file()]
     for label in scenes:
         assert {f"results/adaptive/{label}/{mode}.nc" for mode in ("adaptive", "uniform")} <= set(outputs)
+
+
+STUDY3D = yaml.safe_load((ROOT / "config" / "adaptivity3d.yaml").read_text())["adaptivity3d_study"]
+
+
+def test_the_3d_study_runs_every_3d_scene_under_results_adaptive3d(tmp_path):
+    """Issue 36 item 5: `snakemake adaptivity3d` plans per 3D scene an adaptive and a uniform run
+    (no reference: exact solutions or the estimate), the figures (convergence, the cut), one summary."""
+    run = dry_run("adaptivity3d")
+    assert run.returncode == 0, run.stdout + run.stderr
+    outputs = [path.strip() for line in re.findall(r"^\s+output: (.+)$", run.stdout, re.M) for path in line.split(",")]
+    assert outputs and all(path.startswith("results/adaptive3d/") for path in outputs), outputs
+    scenes = [label for label, case in STUDY3D["scenes"].items() if (ROOT / case["scene"]).is_file()]
+    assert {"lshape_edge", "fichera"} <= set(scenes)
+    for label in scenes:
+        expected = {f"results/adaptive3d/{label}/{name}" for name in ("adaptive.nc", "uniform.nc", "meshes.png")}
+        assert expected <= set(outputs)
+    jobs = planned("adaptivity3d")
+    assert jobs == {"adaptivity3d": 1, "adaptivity_summary": 1, "adaptivity3d_run": 2 * len(scenes),
+                    "adaptivity_figures": len(scenes)}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "entry, key",
+    [
+        ({"scene": "config/scenes/3d/sheared_box.yaml", "reference": {"uniform": 2}}, "reference"),
+        ({"scene": "config/scenes/3d/sheared_box.yaml", "cut": {"axis": "w", "at": 0}}, "axis"),
+        ({"scene": "config/scenes/3d/sheared_box.yaml", "overrides": ["discretization.mesh.n=0"]}, "overrides"),
+    ],
+)
+def test_bad_3d_settings_are_refused_naming_the_key(tmp_path, entry, key):
+    path = tmp_path / "mine3d.yaml"
+    path.write_text(yaml.safe_dump({"adaptivity3d_study": {"scenes": {"mine": entry}}}))
+    run = dry_run("adaptivity3d", "--configfile", str(path))
+    message = run.stdout + run.stderr
+    assert run.returncode != 0 and key in message and "adaptivity3d_study" in message, message
+    assert "Traceback" not in message

@@ -4,7 +4,8 @@
   refinement on one log-log plot, with the fitted rates (``vemkit.studies.adaptivity_compare``) and
   an N^-1/2 guide (the optimal rate of k = 1 elements);
 - :func:`mesh_sequence_figure`: meshes of an adaptive run, every cell coloured by its indicator η_K
-  and, below, by its diameter (the grading).
+  and, below, by its diameter (the grading); a 3D mesh is drawn as its cut by a plane
+  (``vemkit.report.mesh_cuts``).
 
 Each returns a ``matplotlib.figure.Figure``; save with ``vemkit.report.figures.save``.
 """
@@ -16,6 +17,7 @@ from matplotlib.collections import PolyCollection
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
+from vemkit.report.mesh_cuts import drawn_cells
 from vemkit.studies.adaptivity_compare import fitted_rate
 
 STYLES = {"adaptive": ("#d62728", "o"), "uniform": ("#1f77b4", "s")}
@@ -67,41 +69,39 @@ def adaptive_convergence_figure(histories: dict, error: str = "true_error_h1", t
     return fig
 
 
-def _polygons(mesh):
-    xy, off = mesh.vertices, mesh.cell_offsets
-    return [xy[mesh.cell_vertices[off[k] : off[k + 1]]] for k in range(mesh.n_cells)]
-
-
-def _cells_panel(fig, ax, mesh, values, label: str, cmap: str):
-    values = np.maximum(np.asarray(values, float), np.finfo(float).tiny)
+def _cells_panel(fig, ax, drawn, values, label: str, cmap: str):
+    polygons, cells = drawn
+    values = np.maximum(np.asarray(values, float)[cells], np.finfo(float).tiny)
     positive = values[values > np.finfo(float).tiny]
-    norm = LogNorm(vmin=positive.min() if positive.size else 1e-300, vmax=values.max())
-    cells = PolyCollection(
-        _polygons(mesh),
+    norm = LogNorm(vmin=positive.min() if positive.size else 1e-300, vmax=values.max(initial=1e-300))
+    collection = PolyCollection(
+        polygons,
         array=values,
         cmap=cmap,
         norm=norm,
         edgecolors="k",
-        linewidths=0.15 if mesh.n_cells < 5000 else 0.0,
+        linewidths=0.15 if len(polygons) < 5000 else 0.0,
         rasterized=True,
     )
-    ax.add_collection(cells)
+    ax.add_collection(collection)
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    fig.colorbar(cells, ax=ax, shrink=0.8, label=label)
+    fig.colorbar(collection, ax=ax, shrink=0.8, label=label)
 
 
-def mesh_sequence_figure(panels, title: str = "") -> Figure:
+def mesh_sequence_figure(panels, title: str = "", cut=None) -> Figure:
     """``panels``: [(mesh, indicator per cell, label), ...]; one column each: η_K (top) and the cell
-    diameter h_K (bottom: the grading of the mesh), both on log colour scales."""
+    diameter h_K (bottom: the grading of the mesh), both on log colour scales. A 3D mesh is drawn as
+    its section by the plane ``cut`` ({axis, at}; ``vemkit.report.mesh_cuts``)."""
     count = len(panels)
     fig = Figure(figsize=(3.4 * count, 6.4), layout="constrained")
     axes = np.asarray(fig.subplots(2, count)).reshape(2, count)
     for column, (mesh, indicator, label) in enumerate(panels):
-        _cells_panel(fig, axes[0, column], mesh, indicator, "η$_K$", "viridis")
-        _cells_panel(fig, axes[1, column], mesh, mesh.cell_diameters, "cell diameter h$_K$", "magma")
+        drawn = drawn_cells(mesh, cut)
+        _cells_panel(fig, axes[0, column], drawn, indicator, "η$_K$", "viridis")
+        _cells_panel(fig, axes[1, column], drawn, mesh.cell_diameters, "cell diameter h$_K$", "magma")
         axes[0, column].set_title(f"{label}, {mesh.n_cells} cells", fontsize=9)
     if title:
         fig.suptitle(title, fontsize=10)

@@ -312,13 +312,14 @@ def _check_tradeoff(config, scenes: _Scenes) -> None:
 
 # -- adaptivity and 3D ----------------------------------------------------------------------------
 def _check_adaptivity(config, scenes: _Scenes) -> None:
-    for label, case in config["adaptivity_study"]["scenes"].items():
-        if Path(case["scene"]).is_file():  # a scene whose file does not exist is skipped (by design)
-            scenes.check(
-                ("adaptivity_study", "scenes", label, "scene"),
-                case["scene"],
-                _override_steps(("adaptivity_study", "scenes", label, "overrides"), case.get("overrides", [])),
-            )
+    for study in ("adaptivity_study", "adaptivity3d_study"):
+        for label, case in config.get(study, {"scenes": {}})["scenes"].items():
+            if Path(case["scene"]).is_file():  # a scene whose file does not exist is skipped (by design)
+                scenes.check(
+                    (study, "scenes", label, "scene"),
+                    case["scene"],
+                    _override_steps((study, "scenes", label, "overrides"), case.get("overrides", [])),
+                )
 
 
 def _check_three_d(config, scenes: _Scenes) -> None:

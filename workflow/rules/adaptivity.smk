@@ -1,110 +1,151 @@
 # Adaptive against uniform refinement (vemkit.studies.adaptivity, docs/reference/files.md) for the scenes of
-# config/adaptivity.yaml: per scene a reference solution (unless the scene has an exact one), the
+# config/adaptivity.yaml (plane bodies, results/adaptive/) and config/adaptivity3d.yaml (3D bodies,
+# results/adaptive3d/): per scene a reference solution (2D, unless the scene has an exact one), the
 # adaptive and the uniform run (each a `vemkit adapt` file: final solution, error_indicator, adapt_*
 # history; plus the meshes of the sequence figure), the figures; one summary of every scene.
-# Not in the default target: `snakemake -j2 adaptivity`. Scene files that do not exist are skipped.
+# Not in the default target: `snakemake -j2 adaptivity`, `snakemake -j2 adaptivity3d`. Scene files
+# that do not exist are skipped.
 import re
 from pathlib import Path
 
-ADAPTIVITY = config["adaptivity_study"]
+#: the study's directory under results/ -> its part of the configuration
+ADAPTIVE_STUDIES = {"adaptive": config["adaptivity_study"], "adaptive3d": config["adaptivity3d_study"]}
+ADAPTIVITY = ADAPTIVE_STUDIES["adaptive"]
 ADAPTIVITY_CASE_DEFAULTS = {"overrides": [], "theta": 0.5, "target": 1e-3, "max_dofs": 200000, "max_steps": 60,
-                            "max_hanging": None, "uniform_steps": 5, "reference": None}
-ADAPTIVITY_SCENES = [label for label, case in ADAPTIVITY["scenes"].items() if Path(case["scene"]).is_file()]
-ADAPTIVITY_SNAPSHOTS = int(ADAPTIVITY.get("snapshots", 4))
+                            "max_hanging": None, "uniform_steps": 5, "reference": None, "cut": None}
 
 
-def adaptivity_case(label):
-    """The settings of one scene of config/adaptivity.yaml, defaults filled in."""
-    return {**ADAPTIVITY_CASE_DEFAULTS, "error": ADAPTIVITY.get("error", "true_error"), **ADAPTIVITY["scenes"][label]}
+def adaptive_scenes(study):
+    """The labels of a study's scenes whose scene file exists."""
+    return [label for label, case in ADAPTIVE_STUDIES[study]["scenes"].items() if Path(case["scene"]).is_file()]
 
 
-def adaptivity_reference(label):
+def adaptivity_case(study, label):
+    """The settings of one scene of a study, defaults filled in."""
+    part = ADAPTIVE_STUDIES[study]
+    return {**ADAPTIVITY_CASE_DEFAULTS, "error": part.get("error", "true_error"), "cut": part.get("cut"),
+            **part["scenes"][label]}
+
+
+def adaptivity_reference(study, label):
     """The reference solution a scene's errors are measured against ([] : the scene's exact solution)."""
-    return [] if adaptivity_case(label)["reference"] is None else [f"results/adaptive/{label}/reference.nc"]
+    return [] if adaptivity_case(study, label)["reference"] is None else [f"results/{study}/{label}/reference.nc"]
 
 
-def adaptivity_snapshots(label, mode):
-    return [f"results/adaptive/{label}/{mode}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)]
+def snapshot_count(study):
+    return int(ADAPTIVE_STUDIES[study].get("snapshots", 4))
 
 
-ADAPTIVITY_TARGETS = ["results/adaptive/summary.md"] + [
-    f"results/adaptive/{label}/{name}.png" for label in ADAPTIVITY_SCENES for name in ("convergence", "meshes")]
+def adaptivity_snapshots(study, label, mode):
+    return [f"results/{study}/{label}/{mode}-mesh{k}.nc" for k in range(1, snapshot_count(study) + 1)]
 
 
-ADAPTIVITY_SCENE_PATTERN = "|".join(map(re.escape, ADAPTIVITY_SCENES)) if ADAPTIVITY_SCENES else "noscene"
+def snapshot_outputs(study):
+    """The output patterns of a run's snapshots (their number is the study's)."""
+    return [f"results/{{study}}/{{adaptive_scene}}/{{mode}}-mesh{k}.nc" for k in range(1, snapshot_count(study) + 1)]
 
 
-def adaptivity_reference_case(label):
+def adaptivity_targets(study):
+    return [f"results/{study}/summary.md"] + [
+        f"results/{study}/{label}/{name}.png" for label in adaptive_scenes(study) for name in ("convergence", "meshes")]
+
+
+def _pattern(labels):
+    return "|".join(map(re.escape, labels)) if labels else "noscene"
+
+
+ADAPTIVITY_SCENES = adaptive_scenes("adaptive")
+ADAPTIVITY_SCENE_PATTERN = _pattern(sorted({label for study in ADAPTIVE_STUDIES for label in adaptive_scenes(study)}))
+ADAPTIVE_STUDY_PATTERN = _pattern(ADAPTIVE_STUDIES)
+
+
+def adaptivity_reference_case(study, label):
     """What a reference depends on (other settings may change without recomputing it)."""
-    case = adaptivity_case(label)
+    case = adaptivity_case(study, label)
     return {key: case[key] for key in ("scene", "overrides", "theta", "reference")}
 
 
 rule adaptivity_reference:
     output:
-        "results/adaptive/{adaptive_scene}/reference.nc",
+        "results/{study}/{adaptive_scene}/reference.nc",
     params:
-        case=lambda wc: adaptivity_reference_case(wc.adaptive_scene),
+        case=lambda wc: adaptivity_reference_case(wc.study, wc.adaptive_scene),
     wildcard_constraints:
+        study=ADAPTIVE_STUDY_PATTERN,
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
     log:
-        "logs/adaptive/{adaptive_scene}/reference.log",
+        "logs/{study}/{adaptive_scene}/reference.log",
     benchmark:
-        "results/benchmarks/adaptive/{adaptive_scene}/reference.tsv"
+        "results/benchmarks/{study}/{adaptive_scene}/reference.tsv"
     script:
         "../scripts/adaptivity_reference.py"
 
 
 rule adaptivity_run:
     input:
-        reference=lambda wc: adaptivity_reference(wc.adaptive_scene),
+        reference=lambda wc: adaptivity_reference(wc.study, wc.adaptive_scene),
     output:
-        nc="results/adaptive/{adaptive_scene}/{mode}.nc",
-        snapshots=[f"results/adaptive/{{adaptive_scene}}/{{mode}}-mesh{k}.nc" for k in range(1, ADAPTIVITY_SNAPSHOTS + 1)],
+        nc="results/{study}/{adaptive_scene}/{mode}.nc",
+        snapshots=snapshot_outputs("adaptive"),
     params:
-        case=lambda wc: adaptivity_case(wc.adaptive_scene),
+        case=lambda wc: adaptivity_case(wc.study, wc.adaptive_scene),
     wildcard_constraints:
+        study="adaptive",
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
         mode="adaptive|uniform",
     log:
-        "logs/adaptive/{adaptive_scene}/{mode}.log",
+        "logs/{study}/{adaptive_scene}/{mode}.log",
     benchmark:
-        "results/benchmarks/adaptive/{adaptive_scene}/{mode}.tsv"
+        "results/benchmarks/{study}/{adaptive_scene}/{mode}.tsv"
     script:
         "../scripts/adaptivity_run.py"
 
 
+use rule adaptivity_run as adaptivity3d_run with:
+    output:
+        nc="results/{study}/{adaptive_scene}/{mode}.nc",
+        snapshots=snapshot_outputs("adaptive3d"),
+    wildcard_constraints:
+        study="adaptive3d",
+        adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
+        mode="adaptive|uniform",
+
+
 rule adaptivity_figures:
     input:
-        adaptive="results/adaptive/{adaptive_scene}/adaptive.nc",
-        uniform="results/adaptive/{adaptive_scene}/uniform.nc",
-        snapshots=lambda wc: adaptivity_snapshots(wc.adaptive_scene, "adaptive"),
+        adaptive="results/{study}/{adaptive_scene}/adaptive.nc",
+        uniform="results/{study}/{adaptive_scene}/uniform.nc",
+        snapshots=lambda wc: adaptivity_snapshots(wc.study, wc.adaptive_scene, "adaptive"),
     output:
-        convergence="results/adaptive/{adaptive_scene}/convergence.png",
-        meshes="results/adaptive/{adaptive_scene}/meshes.png",
+        convergence="results/{study}/{adaptive_scene}/convergence.png",
+        meshes="results/{study}/{adaptive_scene}/meshes.png",
     params:
-        error=lambda wc: adaptivity_case(wc.adaptive_scene)["error"],
+        error=lambda wc: adaptivity_case(wc.study, wc.adaptive_scene)["error"],
+        cut=lambda wc: adaptivity_case(wc.study, wc.adaptive_scene)["cut"],
     wildcard_constraints:
+        study=ADAPTIVE_STUDY_PATTERN,
         adaptive_scene=ADAPTIVITY_SCENE_PATTERN,
     log:
-        "logs/adaptive/{adaptive_scene}/figures.log",
+        "logs/{study}/{adaptive_scene}/figures.log",
     script:
         "../scripts/adaptivity_figures.py"
 
 
 rule adaptivity_summary:
     input:
-        adaptive=[f"results/adaptive/{label}/adaptive.nc" for label in ADAPTIVITY_SCENES],
-        uniform=[f"results/adaptive/{label}/uniform.nc" for label in ADAPTIVITY_SCENES],
+        adaptive=lambda wc: [f"results/{wc.study}/{label}/adaptive.nc" for label in adaptive_scenes(wc.study)],
+        uniform=lambda wc: [f"results/{wc.study}/{label}/uniform.nc" for label in adaptive_scenes(wc.study)],
     output:
-        md="results/adaptive/summary.md",
-        json="results/adaptive/summary.json",
+        md="results/{study}/summary.md",
+        json="results/{study}/summary.json",
     params:
-        scenes=ADAPTIVITY_SCENES,
-        errors=[adaptivity_case(label)["error"] for label in ADAPTIVITY_SCENES],
-        targets=ADAPTIVITY.get("targets", [0.01]),
+        scenes=lambda wc: adaptive_scenes(wc.study),
+        errors=lambda wc: [adaptivity_case(wc.study, label)["error"] for label in adaptive_scenes(wc.study)],
+        targets=lambda wc: ADAPTIVE_STUDIES[wc.study].get("targets", [0.01]),
+    wildcard_constraints:
+        study=ADAPTIVE_STUDY_PATTERN,
     log:
-        "logs/adaptive/summary.log",
+        "logs/{study}/summary.log",
     script:
         "../scripts/adaptivity_summary.py"
 
@@ -112,11 +153,18 @@ rule adaptivity_summary:
 rule adaptivity:
     """Adaptive against uniform refinement for every scene of config/adaptivity.yaml (not in `all`)."""
     input:
-        ADAPTIVITY_TARGETS,
+        adaptivity_targets("adaptive"),
+
+
+rule adaptivity3d:
+    """The same for the 3D bodies of config/adaptivity3d.yaml (issue 36; not in `all`)."""
+    input:
+        adaptivity_targets("adaptive3d"),
 
 
 localrules:
     adaptivity,
+    adaptivity3d,
     adaptivity_summary,
 
 

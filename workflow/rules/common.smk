@@ -18,6 +18,7 @@ CONFIG_PARTS = {
     "paper": ("../schemas/config.schema.yaml", "config/config.yaml"),
     "studies": ("../schemas/sweeps.schema.yaml", "config/sweeps.yaml"),
     "adaptivity": ("../schemas/adaptivity.schema.yaml", "config/adaptivity.yaml"),
+    "adaptivity3d": ("../schemas/adaptivity3d.schema.yaml", "config/adaptivity3d.yaml"),
     "three_d": ("../schemas/three_d.schema.yaml", "config/three_d.yaml"),
 }
 

@@ -15,7 +15,7 @@ with logged(smk):
 
     from vemkit.config.scene import load_scene
     from vemkit.io.solution_file import write_netcdf
-    from vemkit.mesh.ugrid import mesh_to_ugrid_dataset
+    from vemkit.mesh.ugrid import mesh_to_ugrid_dataset, mesh_topology
     from vemkit.studies.adaptivity import adapt, adaptive_dataset
     from vemkit.studies.adaptivity_compare import run_settings
     from vemkit.studies.adaptivity_errors import scene_true_error
@@ -50,13 +50,21 @@ with logged(smk):
     chosen = np.unique(np.linspace(0, max(len(steps) - 2, 0), len(smk.output.snapshots)).round().astype(int))
     for path, k in zip(smk.output.snapshots, np.resize(chosen, len(smk.output.snapshots))):
         mesh, indicator, u, record = steps[k]
-        ds = mesh_to_ugrid_dataset(mesh)
+        ds, topology = mesh_to_ugrid_dataset(mesh), mesh_topology(mesh)
         ds["error_indicator"] = (
-            "mesh2d_nFaces",
+            topology.cell_dimension,
             indicator,
-            {"long_name": "a posteriori error indicator eta_K", "mesh": "mesh2d", "location": "face"},
+            {
+                "long_name": "a posteriori error indicator eta_K",
+                "mesh": topology.name,
+                "location": topology.cell_location,
+            },
         )
-        for name, values in (("u1", u[:, 0]), ("u2", u[:, 1])):
-            ds[name] = ("mesh2d_nNodes", values, {"mesh": "mesh2d", "location": "node", "units": "mm"})
+        for c in range(u.shape[1]):
+            ds[f"u{c + 1}"] = (
+                topology.node_dimension,
+                u[:, c],
+                {"mesh": topology.name, "location": "node", "units": "mm"},
+            )
         ds.attrs.update({"adapt_step": int(k), "n_dofs": int(record["n_dofs"]), "estimate": float(record["estimate"])})
         write_netcdf(ds, path)
