@@ -2,7 +2,7 @@
 
 - :func:`adaptive_convergence_figure`: true error and estimate against DOFs, adaptive and uniform
   refinement on one log-log plot, with the fitted rates (``vemkit.studies.adaptivity_compare``) and
-  an N^-1/2 guide (the optimal rate of k = 1 elements);
+  an N^(-1/d) guide (the optimal rate of k = 1 elements in d dimensions);
 - :func:`mesh_sequence_figure`: meshes of an adaptive run, every cell coloured by its indicator η_K
   and, below, by its diameter (the grading); a 3D mesh is drawn as its cut by a plane
   (``vemkit.report.mesh_cuts``).
@@ -23,14 +23,17 @@ from vemkit.studies.adaptivity_compare import fitted_rate
 STYLES = {"adaptive": ("#d62728", "o"), "uniform": ("#1f77b4", "s")}
 
 
-def adaptive_convergence_figure(histories: dict, error: str = "true_error_h1", title: str = "") -> Figure:
-    """``histories``: {"adaptive": history, "uniform": history} (``adaptivity_compare.history``)."""
+def adaptive_convergence_figure(
+    histories: dict, error: str = "true_error_h1", title: str = "", dimension: int = 2
+) -> Figure:
+    """``histories``: {"adaptive": history, "uniform": history} (``adaptivity_compare.history``);
+    ``dimension``: the body's, for the guide N^(-1/d)."""
     fig = Figure(figsize=(6.6, 4.8), layout="constrained")
     ax = fig.subplots()
     for name, h in histories.items():
         color, marker = STYLES.get(name, ("k", "^"))
         dofs = h["n_dofs"]
-        if error in h:
+        if error in h and error != "estimate":  # the estimate has its own line below
             rate = fitted_rate(dofs, h[error])
             ax.loglog(
                 dofs,
@@ -59,7 +62,10 @@ def adaptive_convergence_figure(histories: dict, error: str = "true_error_h1", t
     first = histories.get("adaptive", next(iter(histories.values())))
     start = first.get(error, first["estimate"])[0]
     guide = np.array([everything.min(), everything.max()], float)
-    ax.loglog(guide, 0.6 * start * (guide / guide[0]) ** -0.5, color="grey", ls=":", lw=1, label="N$^{-1/2}$")
+    ax.loglog(
+        guide, 0.6 * start * (guide / guide[0]) ** (-1.0 / dimension), color="grey", ls=":", lw=1,
+        label=f"N$^{{-1/{dimension}}}$",
+    )  # fmt: skip
     ax.set_xlabel("free unknowns N (DOFs)")
     ax.set_ylabel("relative error / estimate")
     ax.grid(alpha=0.3, which="both")

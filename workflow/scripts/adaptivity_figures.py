@@ -17,8 +17,11 @@ with logged(smk):
     for mode in ("adaptive", "uniform"):
         with xr.open_dataset(getattr(smk.input, mode)) as ds:
             histories[mode] = history(ds)
+            dimension = topology_dimension(ds)
     save(
-        adaptive_convergence_figure(histories, smk.params.error, title=f"{scene}: adaptive against uniform refinement"),
+        adaptive_convergence_figure(
+            histories, smk.params.error, title=f"{scene}: adaptive against uniform refinement", dimension=dimension
+        ),
         smk.output.convergence,
     )
     panels = []
