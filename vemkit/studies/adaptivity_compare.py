@@ -118,7 +118,7 @@ def summary_markdown(comparisons: dict) -> str:
     lines = [
         "# Adaptive against uniform refinement",
         "",
-        "Rates: slope of log(error) against log(DOFs) over the asymptotic steps (optimal k = 1: −0.5). "
+        "Rates: slope of log(error) against log(DOFs) over the asymptotic steps (optimal for k = 1: −1/2 in 2D, −1/3 in 3D). "
         "DOFs ratio: uniform / adaptive DOFs at the finest uniform step's error. Times: the adaptive loop's "
         "cumulative wall time to that error against the uniform run's single solve there.",
         "",
