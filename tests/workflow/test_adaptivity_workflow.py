@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
+import xarray as xr
 import yaml
 from snakemake_runs import dry_run as run_dry
 
@@ -110,3 +112,33 @@ def test_bad_3d_settings_are_refused_naming_the_key(tmp_path, entry, key):
     message = run.stdout + run.stderr
     assert run.returncode != 0 and key in message and "adaptivity3d_study" in message, message
     assert "Traceback" not in message
+
+
+def test_a_tiny_3d_study_runs_through_its_scripts(tmp_path):
+    """The rules' scripts for a 3D scene, really run (a copy of the workflow in tmp_path): the adaptive and
+    the uniform file, the snapshots on mesh3d, the convergence figure and the cut."""
+    import shutil
+
+    for name in ("Snakefile", "workflow", "config"):
+        (shutil.copytree if (ROOT / name).is_dir() else shutil.copy)(ROOT / name, tmp_path / name)
+    (tmp_path / "benchmarks").mkdir()
+    for scene in ROOT.glob("benchmarks/*.yaml"):  # scenes the configuration's checks read
+        shutil.copy(scene, tmp_path / "benchmarks" / scene.name)
+    tiny = {"scene": "config/scenes/3d/sheared_box.yaml", "overrides": ["discretization.mesh.n=2"],
+            "max_dofs": 2000, "uniform_steps": 2, "cut": {"axis": "y", "at": 0.5}}  # fmt: skip
+    (tmp_path / "tiny.yaml").write_text(yaml.safe_dump({"adaptivity3d_study": {"scenes": {"tiny": tiny}}}))
+    exe = Path(sys.executable).with_name("snakemake")
+    targets = [f"results/adaptive3d/tiny/{name}.png" for name in ("convergence", "meshes")]
+    run = subprocess.run(
+        [str(exe), *targets, "--cores", "1", "--configfile", "tiny.yaml"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    with xr.open_dataset(tmp_path / "results/adaptive3d/tiny/adaptive-mesh1.nc") as ds:
+        assert "mesh3d" in ds and ds["error_indicator"].dims == ("mesh3d_nVolumes",) and "u3" in ds
+    with xr.open_dataset(tmp_path / "results/adaptive3d/tiny/uniform.nc") as ds:
+        assert ds.attrs["adapt_steps"] == 2 and ds["adapt_n_cells"].values.tolist() == [
+            4,
+            32,
+        ]  # 2 x 2 x 1 boxes, then 8 each
+    assert all((tmp_path / target).stat().st_size > 10_000 for target in targets)
