@@ -220,3 +220,44 @@ def test_new_vertices_of_a_curved_side_stay_on_its_circle():
         validate_mesh3d(refined.mesh)
         assert radius(refined.mesh).max() < 0.25 + 1e-12
         mesh = refined.mesh
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_faces_numbered_by_the_refinement_are_the_faces_of_their_vertices(name):
+    """The refined mesh (faces known by the cycles they come from) is the mesh ``from_face_soup`` finds
+    from its cells' outward faces alone (faces matched by their vertices)."""
+    from vemkit.mesh.polyhedral_build import from_face_soup
+    from vemkit.mesh.refine_boxes import cycles_of
+
+    mesh = MESHES[name]()
+    rng = np.random.default_rng(4)
+    for _ in range(2):
+        mesh = refine_cells(mesh, _random_marking(mesh, rng)).mesh
+        faces = np.abs(mesh.cell_faces + (mesh.cell_faces < 0))
+        sizes, soup = cycles_of(mesh.face_offsets, mesh.face_vertices, faces, mesh.cell_faces < 0)
+        labels = np.full(mesh.n_faces, -1)
+        for k, part in enumerate(mesh.boundary.values()):
+            labels[part] = k
+        names = list(mesh.boundary)
+        again = from_face_soup(mesh.vertices, np.diff(mesh.cell_offsets), sizes, soup, labels[faces], names)
+        for key in ("face_offsets", "face_vertices", "cell_offsets", "cell_faces"):
+            assert np.array_equal(getattr(again, key), getattr(mesh, key))
+        assert all(np.array_equal(again.boundary[k], mesh.boundary[k]) for k in names)
+
+
+def test_ring_kernel_equals_its_numpy_twin(monkeypatch):
+    """The Numba kernel of the boxes' face polygons (``refine_polyhedra_kernels.rectangle_rings``) and
+    its numpy twin give the same refined meshes."""
+    from vemkit.mesh import refine_boxes
+
+    mesh = octree(n=3, rule="random", fraction=0.4, seed=3)
+    rng = np.random.default_rng(6)
+    for _ in range(2):
+        marked = _random_marking(mesh, rng)
+        fast = refine_cells(mesh, marked).mesh
+        with monkeypatch.context() as patch:
+            patch.setattr(refine_boxes, "_rectangle_rings", refine_boxes.rectangle_rings_numpy)
+            twin = refine_cells(mesh, marked).mesh
+        for key in ("face_offsets", "face_vertices", "cell_offsets", "cell_faces"):
+            assert np.array_equal(getattr(fast, key), getattr(twin, key))
+        mesh = fast

@@ -21,6 +21,8 @@ import numpy as np
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.polyhedral import PolyhedralMesh
+from vemkit.mesh.polyhedral_build import segments
+from vemkit.mesh.refine_polyhedra_kernels import rectangle_rings
 
 #: relative tolerance of a vertex on the half-step lattice of a box (in units of half its size)
 LATTICE_TOL = 1e-9
@@ -41,13 +43,6 @@ _INNER = np.array([(axis, qb, qd) for axis in range(3) for qb in (0, 1) for qd i
 _OCTANTS = _LATTICE[_CORNERS] // 2
 #: the quarters of a whole side, in the order of its 4 pieces
 _QUARTERS = np.array([(0, 0), (1, 0), (1, 1), (0, 1)])
-
-
-def segments(starts: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """The indices start, ..., start + size - 1 of every segment, one after the other."""
-    sizes = np.asarray(sizes, dtype=np.int64)
-    total = int(sizes.sum())
-    return np.repeat(np.asarray(starts, dtype=np.int64) - np.cumsum(sizes) + sizes, sizes) + np.arange(total)
 
 
 def cycles_of(offsets: np.ndarray, vertices: np.ndarray, ids: np.ndarray, reverse: np.ndarray):
@@ -165,7 +160,7 @@ class _Pools:
     their half-step coordinates ``t``; ``find(row, vertex)`` is the position in the pool."""
 
     def __init__(self, row: np.ndarray, vertex: np.ndarray, lattice, lower, upper, x):
-        self.scale = np.int64(x.shape[0])
+        self.scale, self.rows = np.int64(x.shape[0]), lattice.shape[0]
         rows = np.concatenate([row, np.repeat(np.arange(lattice.shape[0]), lattice.shape[1])])
         keys = np.sort(rows * self.scale + np.concatenate([vertex, lattice.ravel()]))
         self.keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
@@ -179,7 +174,21 @@ class _Pools:
 def _rectangle_rings(pools: _Pools, row, axis, level, low, high, outward):
     """(sizes, flat vertices) per rectangle r of box row_r (t[axis_r] = level_r, low_r <= (t[b], t[d])
     <= high_r, b, d the next axes): the pool's vertices on its perimeter, in order about +axis_r
-    (outward_r > 0) or -axis_r. All arguments are per rectangle."""
+    (outward_r > 0) or -axis_r. All arguments are per rectangle. Runs the Numba kernel."""
+    start = np.searchsorted(pools.row, np.arange(pools.rows + 1))
+    args = (
+        row.astype(np.int64),
+        axis.astype(np.int64),
+        np.asarray(level, float),
+        low,
+        high,
+        np.asarray(outward, float),
+    )
+    return rectangle_rings(start, pools.t, pools.vertex, *args, LATTICE_TOL)
+
+
+def rectangle_rings_numpy(pools: _Pools, row, axis, level, low, high, outward):
+    """The numpy twin of ``_rectangle_rings`` (``refine_polyhedra_kernels.rectangle_rings``)."""
     tol, t = LATTICE_TOL, pools.t
     entry, entry_axis = np.nonzero(np.abs(t - np.round(t)) < tol)  # pool entries on a lattice plane
     entry_level = np.round(t[entry, entry_axis]).astype(np.int64)

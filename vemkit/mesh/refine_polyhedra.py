@@ -31,9 +31,9 @@ import scipy.sparse as sp
 
 from vemkit.exceptions import InputError, MeshError
 from vemkit.mesh.polyhedral import PolyhedralMesh
-from vemkit.mesh.polyhedral_build import from_face_soup
+from vemkit.mesh.polyhedral_build import from_numbered_soup, same_faces, segments
 from vemkit.mesh.refine import RefinedMesh
-from vemkit.mesh.refine_boxes import box_children, cycles_of, plan_boxes, segments, split_box_sides
+from vemkit.mesh.refine_boxes import box_children, cycles_of, plan_boxes, split_box_sides
 from vemkit.mesh.refine_prisms import plan_prisms, prism_children, split_prism_sides
 from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, tetrahedron_children, whole_sides
 
@@ -133,9 +133,8 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     cells = _marked_cells(mesh, marked)
     plan = _any_plan(mesh, cells, circles)
     face_offsets, face_vertices = _with_midpoints(mesh, plan.split_edges)
-    names = list(mesh.boundary)
     labels = np.full(mesh.n_faces, -1, dtype=np.int64)
-    for k, name in enumerate(names):
+    for k, name in enumerate(mesh.boundary):
         labels[np.asarray(mesh.boundary[name], dtype=np.int64)] = k
     x = np.concatenate([mesh.vertices, plan.points])
     if plan.kind == "box":
@@ -144,7 +143,18 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
         split = _split_by(
             mesh, plan, whole_sides if plan.kind == "tet" else split_prism_sides, face_offsets, face_vertices, x
         )
-    table, face_cycles = _cycle_table(mesh, face_offsets, face_vertices, *split)
+    new, children = _refined_mesh(mesh, plan, labels, _cycle_table(mesh, face_offsets, face_vertices, *split), x)
+    parent = np.repeat(np.arange(mesh.n_cells), children)
+    return RefinedMesh(new, parent, _prolongation(mesh, plan), cells, np.zeros(0, np.int64))
+
+
+def _refined_mesh(mesh, plan: _Plan, labels, cycles, x):
+    """(the refined mesh, the number of cells each old one becomes): the unmarked cells' faces (as
+    cycles of the table, split faces as their pieces) copied in bulk, the marked cells' children by
+    their rule, in the order of the old cells; every face is a cycle of the table, or for the
+    tetrahedra's and prisms' rules the same vertices as another one."""
+    table, face_cycles = cycles
+    cells = plan.cells
     unmarked = np.ones(mesh.n_cells, dtype=bool)
     unmarked[cells] = False
     kept = _appearances(mesh, np.flatnonzero(unmarked), face_cycles)
@@ -152,27 +162,45 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     children[cells] = [2 * ((lattice.size - 3) // 6) for lattice in plan.lattice] if plan.kind == "prism" else 8
     first_child = np.cumsum(children) - children
     row, cycle, reverse, face = _appearances(mesh, cells, face_cycles)
+    known = table[0].size - 1  # cycles known by number; the rules' new faces by their vertices
     args = (row, cycle, reverse, labels[face], *table, x)
     table, (row, child, cycle, reverse, face_labels) = (
         _box_pieces(plan, *args) if plan.kind == "box" else _rule_pieces(mesh, plan, *args)
     )
+    face_id = _face_numbers(table, known, args[1])
     new_cell = np.concatenate([first_child[np.flatnonzero(unmarked)][kept[0]], first_child[cells][row] + child])
     order = np.argsort(new_cell, kind="stable")
-    face_sizes, soup = cycles_of(
-        *table, np.concatenate([kept[1], cycle])[order], np.concatenate([kept[2], reverse])[order]
-    )
-    meta = dict(mesh.meta, refined_3d=int(mesh.meta.get("refined_3d", 0)) + 1)
-    new = from_face_soup(
+    cycle = np.concatenate([kept[1], cycle])[order]
+    face_sizes, soup = cycles_of(*table, cycle, np.concatenate([kept[2], reverse])[order])
+    new = from_numbered_soup(
         x,
         np.bincount(new_cell, minlength=int(children.sum())),
         face_sizes,
         soup,
+        face_id[cycle],
         np.concatenate([labels[kept[3]], face_labels])[order],
-        names,
-        meta,
+        list(mesh.boundary),
+        dict(mesh.meta, refined_3d=int(mesh.meta.get("refined_3d", 0)) + 1),
     )
-    parent = np.repeat(np.arange(mesh.n_cells), children)
-    return RefinedMesh(new, parent, _prolongation(mesh, plan), cells, np.zeros(0, np.int64))
+    return new, children
+
+
+def _face_numbers(table, known: int, touched: np.ndarray) -> np.ndarray:
+    """A number per cycle of the table, equal for cycles of one face: its own for the ``known`` first
+    ones (the old faces and their pieces), a known one's for a rule's face of the same vertices as one
+    of the ``touched`` known cycles (the marked cells' faces), else one per vertex set."""
+    offsets, vertices = table
+    out = np.arange(offsets.size - 1)
+    if known == out.size:
+        return out
+    touched = np.unique(touched)
+    ids = np.concatenate([touched, out[known:]])
+    sizes, flat = cycles_of(offsets, vertices, ids, np.zeros(ids.size, dtype=bool))
+    group = same_faces(np.concatenate([[0], np.cumsum(sizes)]), flat)
+    number = known + np.arange(group.max() + 1)
+    number[group[: touched.size]] = touched
+    out[known:] = number[group[touched.size :]]
+    return out
 
 
 def _cycle_table(mesh, face_offsets, face_vertices, split_faces, pieces):
