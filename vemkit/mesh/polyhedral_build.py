@@ -7,6 +7,8 @@ once, is therefore stored outward), signs the cells' face lists (``-(f + 1)``: f
 names the boundary faces from a label per appearance. No Python loop over cells or faces: a face is
 recognised by its sorted vertex list (rows padded with -1, sorted lexicographically), and two
 appearances run the same way when the vertex after the smallest one is the same.
+``from_numbered_soup`` does the same for a soup whose faces are already known by a number per
+appearance (the refinement of polyhedra, which knows where every face comes from).
 """
 
 from __future__ import annotations

@@ -1,24 +1,26 @@
 """Local refinement of polyhedral meshes with hanging vertices: boxes and tetrahedra split into 8.
 
 A marked cell that is an axis-aligned box (a hexahedron of the grid family, an octree cell, possibly
-with hanging vertices already on its faces) becomes the 8 boxes of half its size. Its new vertices
-are the 27-point lattice of half steps that is not there yet: the 12 edge midpoints, the 6 face
-centres and the body centre (a point shared with a marked neighbour is made once: an edge midpoint is
-named by the edge's two corners, a face centre by the side's four corners).
+with hanging vertices already on its faces) becomes the 8 boxes of half its size
+(``vemkit.mesh.refine_boxes``: its new vertices are the 27-point lattice of half steps that is not
+there yet, a point shared with a marked neighbour made once). Tetrahedra follow the same scheme by
+the red rule (``vemkit.mesh.refine_tetrahedra``), prisms of extruded bodies by the 2D rule on their
+base (``vemkit.mesh.refine_prisms``). Other cells (Voronoi polyhedra) are refused in one line naming
+the families that refine (``REFINABLE_FAMILIES``).
 
 The mesh stays conforming in the VEM sense (docs/reference/files.md):
 - a new edge midpoint is inserted between the edge's two corners into every face listing them in a
   row, so every cell around that edge (refined or not) gains it as a hanging vertex;
-- a whole side of a marked cell (a face without vertices inside it) is split into its 4 quarter faces,
-  and the neighbour across it lists those 4 faces instead of the old one;
+- a whole side of a marked cell (a face without vertices inside it) is split into its pieces (4
+  quarters of a box's side), and the neighbour across it lists those pieces instead of the old face;
 - a side already split by smaller neighbours keeps its faces, each going to the child under it.
-A child's face is the planar polygon of every vertex on its rectangle's perimeter, in order. All
-faces are then stored once (``polyhedral_build.from_face_soup``); boundary faces keep their part's
-name (a quarter face the name of the face it comes from).
+A child's face is the planar polygon of every vertex on its perimeter, in order. Boundary faces keep
+their part's name (a piece the name of the face it comes from).
 
-Tetrahedra follow the same scheme by the red rule (``vemkit.mesh.refine_tetrahedra``). Other cells
-(prisms over triangles or polygons, Voronoi polyhedra) are refused in one line naming the families
-that refine (``REFINABLE_FAMILIES``; a prism over a rectangle is a box and refines).
+The refined mesh is built from a table of vertex cycles (the faces with their midpoints, the pieces of
+split faces, the children's new faces): an unmarked cell's faces are copied in bulk over the CSR arrays
+(no Python loop over cells), a marked cell's replaced by its children's, and every face is stored once
+(``polyhedral_build.from_numbered_soup``: known by its cycle, a rule's new face by its vertices).
 ``predict_refinement`` counts the cells, vertices and faces of a refinement before it is built.
 """
 
