@@ -37,7 +37,7 @@ from vemkit.mesh.polyhedral_build import from_numbered_soup, same_faces, segment
 from vemkit.mesh.refine import RefinedMesh
 from vemkit.mesh.refine_boxes import box_children, cycles_of, plan_boxes, split_box_sides
 from vemkit.mesh.refine_prisms import plan_prisms, prism_children, split_prism_sides
-from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, tetrahedron_children, whole_sides
+from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, split_tetrahedra_sides, tetrahedra_children
 
 #: the families whose cells this module splits
 REFINABLE_FAMILIES = ("hex", "octree", "tet (box and gmsh tetrahedra)", "the extruded ones over convex polygons")
@@ -141,10 +141,10 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     x = np.concatenate([mesh.vertices, plan.points])
     if plan.kind == "box":
         split = split_box_sides(mesh, plan, face_offsets, face_vertices, x)
+    elif plan.kind == "tet":
+        split = split_tetrahedra_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
     else:
-        split = _split_by(
-            mesh, plan, whole_sides if plan.kind == "tet" else split_prism_sides, face_offsets, face_vertices, x
-        )
+        split = _split_by(mesh, plan, split_prism_sides, face_offsets, face_vertices, x)
     new, children = _refined_mesh(mesh, plan, labels, _cycle_table(mesh, face_offsets, face_vertices, *split), x)
     parent = np.repeat(np.arange(mesh.n_cells), children)
     return RefinedMesh(new, parent, _prolongation(mesh, plan), cells, np.zeros(0, np.int64))
@@ -252,7 +252,8 @@ def _box_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices
 def _rule_pieces(mesh, plan, row, cycle, reverse, labels, table_offsets, table_vertices, x):
     """The table with the children's faces of the tetrahedra or prisms added (their rule, cell by
     marked cell), and the children's faces; ``labels`` per appearance."""
-    rule = tetrahedron_children if plan.kind == "tet" else prism_children
+    if plan.kind == "tet":
+        return _tetrahedra_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices, x)
     sizes, flat = cycles_of(table_offsets, table_vertices, cycle, reverse)
     per_row = np.bincount(row, minlength=plan.cells.size)
     row_start = np.concatenate([[0], np.cumsum(per_row)])
@@ -260,7 +261,7 @@ def _rule_pieces(mesh, plan, row, cycle, reverse, labels, table_offsets, table_v
     out_rows, out_child, out_labels, faces = [], [], [], []
     for r in range(plan.cells.size):
         mine = [(k, cycles[k]) for k in range(row_start[r], row_start[r + 1])]
-        for k, (child_faces, child_labels) in enumerate(rule(mesh, plan.lattice[r], mine, labels, x)):
+        for k, (child_faces, child_labels) in enumerate(prism_children(mesh, plan.lattice[r], mine, labels, x)):
             faces.extend(child_faces)
             out_labels.extend(child_labels)
             out_rows.extend([r] * len(child_faces))
@@ -273,6 +274,22 @@ def _rule_pieces(mesh, plan, row, cycle, reverse, labels, table_offsets, table_v
     )
     out = (np.array(out_rows, np.int64), np.array(out_child, np.int64), base + np.arange(len(faces)))
     return table, (*out, np.zeros(len(faces), dtype=bool), np.array(out_labels, dtype=np.int64))
+
+
+def _tetrahedra_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices, x):
+    """The table with the new faces of the tetrahedra's children added, and the children's faces
+    (``refine_tetrahedra.tetrahedra_children``, all marked cells at once)."""
+    sizes, flat = cycles_of(table_offsets, table_vertices, cycle, reverse)
+    row_start = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=plan.cells.size))])
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    rows, child, source, new_sizes, new_flat = tetrahedra_children(plan.lattice, x, row_start, offsets, flat)
+    new = source < 0
+    cycle = np.where(new, table_offsets.size - 2 + np.cumsum(new), cycle[source])
+    table = (
+        np.concatenate([table_offsets, table_offsets[-1] + np.cumsum(new_sizes)]),
+        np.concatenate([table_vertices, new_flat]),
+    )
+    return table, (rows, child, cycle, np.where(new, False, reverse[source]), np.where(new, -1, labels[source]))
 
 
 def _split_by(mesh, plan: _Plan, sides_of, face_offsets, face_vertices, x):

@@ -16,6 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from vemkit.exceptions import MeshError
+from vemkit.mesh.polyhedral_build import segments
+from vemkit.mesh.refine_polyhedra_kernels import tetrahedra_children as children_kernel
+from vemkit.mesh.refine_polyhedra_kernels import tetrahedra_sides as sides_kernel
 
 #: the 6 edges of a tetrahedron as corner pairs; lattice point 4 + k is the midpoint of _EDGES[k]
 _EDGES = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
@@ -144,12 +147,42 @@ def whole_sides(mesh, lattice_row, cell: int, face_offsets, face_vertices, x):
         yield f, rings
 
 
-def _children_corners(x, lattice_row):
-    """The 8 children as lattice positions (4 each): the corner tetrahedra and the octahedron's 4."""
+_DIAGONALS = [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]  # the octahedron's, as edge pairs
+
+
+_MID_TABLE = np.full((4, 4), -1, dtype=np.int64)
+for (_i, _j), _k in _MID.items():
+    _MID_TABLE[_i, _j] = _k
+
+
+def split_tetrahedra_sides(mesh, lattice, cells, face_offsets, face_vertices, x):
+    """(faces, (sizes, flat vertices, 4 per face) of their triangles, as stored) of the whole sides of
+    the marked tetrahedra (``refine_polyhedra_kernels.tetrahedra_sides``; its twin: ``whole_sides``
+    cell by cell), each split once (by the first marked tetrahedron it is a side of)."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    cell_start = np.concatenate([[0], np.cumsum(sizes)])
+    args = (cell_start, faces, face_offsets, face_vertices, mesh.face_vector_areas, x, TOL)
+    _, found, piece_sizes, flat = sides_kernel(lattice, _MID_TABLE, *args)
+    first = np.sort(np.unique(found, return_index=True)[1])
+    pieces = segments(4 * first, np.full(first.size, 4))
+    piece_offsets = np.concatenate([[0], np.cumsum(piece_sizes)])
+    flat = flat[segments(piece_offsets[pieces], piece_sizes[pieces])]
+    return found[first], (piece_sizes[pieces], flat, np.full(first.size, 4, dtype=np.int64))
+
+
+def _shortest_diagonal(x, lattice_row) -> int:
+    """The octahedron's shortest diagonal (the first of equal ones), an index into _DIAGONALS."""
+    length = [np.linalg.norm(x[lattice_row[_MID[a]]] - x[lattice_row[_MID[b]]]) for a, b in _DIAGONALS]
+    return int(np.argmin(length))
+
+
+def _children_of(diagonal: int) -> list:
+    """The 8 children as lattice positions (4 each): the corner tetrahedra and the octahedron's 4
+    around the given diagonal."""
     out = [[i] + [_MID[i, j] for j in range(4) if j != i] for i in range(4)]
-    diagonals = [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]
-    length = [np.linalg.norm(x[lattice_row[_MID[a]]] - x[lattice_row[_MID[b]]]) for a, b in diagonals]
-    a, b = diagonals[int(np.argmin(length))]
+    a, b = _DIAGONALS[diagonal]
     ring = [_MID[p] for p in _EDGES if p not in (a, b)]
     ordered = [ring[0]]  # the ring around the diagonal: neighbours share a corner
     while len(ordered) < 4:
@@ -157,6 +190,32 @@ def _children_corners(x, lattice_row):
         ordered.append(next(q for q in ring if q not in ordered and last & set(_EDGES[q - 4])))
     out += [[_MID[a], _MID[b], ordered[k], ordered[(k + 1) % 4]] for k in range(4)]
     return out
+
+
+def _children_corners(x, lattice_row):
+    """The 8 children as lattice positions (4 each), the octahedron cut along its shortest diagonal."""
+    return _children_of(_shortest_diagonal(x, lattice_row))
+
+
+#: per diagonal and child: its lattice positions, the map from the parent's barycentric coordinates
+#: to its own, and per left-out corner whether the face opposite is new (not on a side of the parent)
+_CHILDREN = np.array([_children_of(k) for k in range(3)], dtype=np.int64)
+_TO_CHILD = np.linalg.inv(np.swapaxes(_BARY[_CHILDREN], -1, -2))
+_NEW_FACE = np.array(
+    [
+        [[not (np.abs(_BARY[np.delete(child, skip)]) < TOL).all(axis=0).any() for skip in range(4)] for child in row]
+        for row in _CHILDREN
+    ]
+)
+
+
+def tetrahedra_children(lattice, x, row_start, cycle_offsets, cycle_vertices):
+    """The children of all marked tetrahedra at once (``refine_polyhedra_kernels.tetrahedra_children``;
+    its twin: ``tetrahedron_children`` cell by cell): per face of a child (row, child, the parent's
+    cycle it is or -1), and the new faces' (sizes, flat vertices)."""
+    diagonal = np.array([_shortest_diagonal(x, row) for row in lattice], dtype=np.int64)
+    args = (_CHILDREN, _TO_CHILD, _NEW_FACE, row_start, cycle_offsets, cycle_vertices, x, TOL)
+    return children_kernel(lattice, diagonal, *args)
 
 
 def tetrahedron_children(mesh, lattice_row, cycles: list, labels, x):
