@@ -38,63 +38,95 @@ def plane_labels(normals: np.ndarray) -> np.ndarray:
     return labels
 
 
-def tetrahedron_corners(mesh, c: int) -> np.ndarray | None:
-    """The 4 corners of cell c (positively oriented), or None when it is not a tetrahedron."""
-    signed = mesh.cell_face_list(c)
+def _cell_entries(mesh, cells: np.ndarray):
+    """(row, signed face) of every face of the given cells, cell after cell."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    return np.repeat(np.arange(cells.size), sizes), mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
+
+
+def _plane_numbers(row, normals, m: int):
+    """Per face of the marked cells (rows in order), ``plane_labels`` of its cell's unit outward normals,
+    and the number of planes of each cell."""
+    start = np.searchsorted(row, np.arange(m))
+    column = np.arange(row.size) - start[row]
+    width = int(column.max()) + 1
+    padded = np.full((m, width, 3), np.nan)
+    padded[row, column] = normals
+    close = np.einsum("rjc,rkc->rjk", padded, padded) > 1 - 1e-9
+    labels, count = np.full((m, width), -1, dtype=np.int64), np.zeros(m, dtype=np.int64)
+    for j in range(width):  # the first face without a plane starts the next one (plane_labels)
+        leads = labels[:, j] < 0
+        leads &= ~np.isnan(padded[:, j, 0])
+        labels = np.where(leads[:, None] & (labels < 0) & close[:, j, :], count[:, None], labels)
+        count += leads
+    return labels[row, column], count
+
+
+def _tetrahedra_corners(mesh, cells: np.ndarray, refinable: str) -> np.ndarray:
+    """(m, 4) corners of the marked cells (the vertices on 3 of the 4 planes of its faces, in order of
+    first appearance along its faces), positively oriented; a MeshError names the first cell that is
+    not a tetrahedron."""
+    m = cells.size
+    row, signed = _cell_entries(mesh, cells)
     faces = np.where(signed >= 0, signed, -signed - 1)
     normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    planes = plane_labels(normals)
-    if planes.max() != 3:
-        return None
-    on = {}
-    for f, plane in zip(faces, planes):
-        for v in mesh.face(f).tolist():
-            on.setdefault(v, set()).add(int(plane))
-    corners = np.array([v for v, p in on.items() if len(p) == 3])
-    if corners.size != 4:
-        return None
+    plane, planes = _plane_numbers(row, normals, m)
+    counts = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
+    vertex = mesh.face_vertex_ids(faces)
+    owner = np.repeat(row, counts)
+    scale = np.int64(mesh.n_vertices)
+    incidence = np.unique((owner * scale + vertex) * 4 + np.repeat(plane, counts).clip(0, 3))
+    keys, on_planes = np.unique(incidence // 4, return_counts=True)
+    first = np.unique(owner * scale + vertex, return_index=True)[1]  # first appearance of each (row, vertex)
+    corner = on_planes == 3
+    order = np.argsort(first[corner], kind="stable")
+    corners = (keys[corner] % scale)[order]
+    corner_rows = (keys[corner] // scale)[order]
+    ok = (planes == 4) & (np.bincount(corner_rows, minlength=m) == 4)
+    if not ok.all():
+        raise MeshError(
+            f"cell {cells[np.argmin(ok)]} of the {mesh.meta.get('family', 'given')} mesh is neither an axis-aligned "
+            f"box nor a tetrahedron; 3D refinement splits the cells of the families {refinable}"
+        )
+    corners = corners[np.argsort(corner_rows, kind="stable")].reshape(m, 4)
     x = mesh.vertices[corners]
-    if np.linalg.det(x[1:] - x[0]) < 0:
-        corners = corners[[1, 0, 2, 3]]
+    turned = np.linalg.det(x[:, 1:] - x[:, :1]) < 0
+    corners[turned] = corners[turned][:, [1, 0, 2, 3]]
     return corners
 
 
 def plan_tetrahedra(mesh, cells: np.ndarray, refinable: str):
     """(lattice (m, 10) vertex ids, new points, sources, split edges, number of whole sides) of the
-    marked tetrahedra (``refine_polyhedra._Plan``'s fields)."""
-    n = mesh.n_vertices
+    marked tetrahedra (``refine_polyhedra._Plan``'s fields): an edge midpoint is a vertex of the cell
+    there already, else new, numbered in order of first request (row by row, edge by edge)."""
+    n, vertices = mesh.n_vertices, mesh.vertices
+    corners = _tetrahedra_corners(mesh, cells, refinable)
     offsets, ids = mesh.cell_vertex_lists
-    lattice = np.full((cells.size, 10), -1, dtype=np.int64)
-    new_of: dict = {}
-    for row, c in enumerate(cells.tolist()):
-        corners = tetrahedron_corners(mesh, c)
-        if corners is None:
-            raise MeshError(
-                f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is neither an axis-aligned box nor a "
-                f"tetrahedron; 3D refinement splits the cells of the families {refinable}"
-            )
-        lattice[row, :4] = corners
-        own = ids[offsets[c] : offsets[c + 1]]
-        for k, (i, j) in enumerate(_EDGES):
-            mid = 0.5 * (mesh.vertices[corners[i]] + mesh.vertices[corners[j]])
-            length = np.linalg.norm(mesh.vertices[corners[i]] - mesh.vertices[corners[j]])
-            near = own[np.linalg.norm(mesh.vertices[own] - mid, axis=1) < TOL * length]
-            key = (min(corners[i], corners[j]), max(corners[i], corners[j]))
-            lattice[row, 4 + k] = near[0] if near.size else new_of.setdefault(key, n + len(new_of))
-    ends = np.array(sorted(new_of, key=new_of.get), dtype=np.int64).reshape(-1, 2)
+    sizes = offsets[cells + 1] - offsets[cells]
+    owner, own = np.repeat(np.arange(cells.size), sizes), ids[segments(offsets[cells], sizes)]
+    lattice = np.concatenate([corners, np.full((cells.size, 6), -1, dtype=np.int64)], axis=1)
+    for k, (i, j) in enumerate(_EDGES):
+        a, b = vertices[corners[:, i]], vertices[corners[:, j]]
+        mid, length = 0.5 * (a + b), np.linalg.norm(a - b, axis=1)
+        near = np.flatnonzero(np.linalg.norm(vertices[own] - mid[owner], axis=1) < TOL * length[owner])
+        rows, at = np.unique(owner[near], return_index=True)
+        lattice[rows, 4 + k] = own[near[at]]
+    pairs = np.stack([corners[:, [i for i, _ in _EDGES]], corners[:, [j for _, j in _EDGES]]], axis=-1)
+    keys = (pairs.min(axis=-1) * np.int64(n) + pairs.max(axis=-1))[lattice[:, 4:] < 0]  # row by row
+    unique, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    rank = np.empty(unique.size, dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(unique.size)
+    lattice[:, 4:][lattice[:, 4:] < 0] = n + rank[inverse.ravel()]
+    by_id = unique[np.argsort(first)]
+    ends = np.stack([by_id // n, by_id % n], axis=1).reshape(-1, 2)
     new_ids = n + np.arange(ends.shape[0])
-    points = mesh.vertices[ends].mean(axis=1)
-    split = (ends[:, 0] * np.int64(n) + ends[:, 1], new_ids)
-    order = np.argsort(split[0])
-    sides = set()
-    for row, c in enumerate(cells.tolist()):
-        corners = set(lattice[row, :4].tolist())
-        signed = mesh.cell_face_list(c)
-        for f in np.where(signed >= 0, signed, -signed - 1).tolist():
-            if len(corners.intersection(mesh.face(f).tolist())) == 3:
-                sides.add(f)
-    return lattice, points, [(new_ids, ends)], (split[0][order], split[1][order]), len(sides)
+    row, signed = _cell_entries(mesh, cells)
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    counts = mesh.face_offsets[faces + 1] - mesh.face_offsets[faces]
+    is_corner = (mesh.face_vertex_ids(faces)[:, None] == np.repeat(corners[row], counts, axis=0)).any(axis=1)
+    on_three = np.add.reduceat(is_corner.astype(np.int64), np.cumsum(counts) - counts) == 3
+    return lattice, vertices[ends].mean(axis=1), [(new_ids, ends)], (unique, n + rank), np.unique(faces[on_three]).size
 
 
 def _on_edges(corners, pool, x):
