@@ -1,8 +1,11 @@
-"""Numba kernels of the refinement of polyhedra (``vemkit.mesh.refine_boxes``, ``refine_polyhedra``).
+"""Numba kernels of the refinement of polyhedra (``refine_boxes``, ``refine_tetrahedra``), one loop over
+the marked cells each.
 
 ``rectangle_rings`` collects, per axis-aligned rectangle of a marked box, the box's pool vertices on
-its perimeter sorted by angle about its centre; its numpy twin is ``refine_boxes.rectangle_rings_numpy``
-(``tests/mesh3d/test_refine_polyhedra.py`` pins the kernel to it).
+its perimeter sorted by angle about its centre (numpy twin: ``refine_boxes.rectangle_rings_numpy``).
+``tetrahedra_sides`` splits the whole sides of the marked tetrahedra into 4 triangles and
+``tetrahedra_children`` makes their 8 children's faces (twins: ``refine_tetrahedra.whole_sides`` and
+``tetrahedron_children``, cell by cell). ``tests/mesh3d/test_refine_polyhedra.py`` pins them to the twins.
 """
 
 from __future__ import annotations

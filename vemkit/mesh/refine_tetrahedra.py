@@ -9,6 +9,10 @@ every face listing the two corners in a row; a whole side is split into its 4 tr
 corner ones and the middle one); a side already split keeps its faces, each going to the child it
 lies on. A child's face is the triangle of its corners with every vertex of the parent lying on
 its edges inserted in order (so hanging vertices of finer neighbours are kept).
+
+All marked tetrahedra are handled at once: the plan over flat arrays, the whole sides and the
+children by the Numba kernels of ``refine_polyhedra_kernels`` (``split_tetrahedra_sides``,
+``tetrahedra_children``), whose twins are the cell-by-cell ``whole_sides`` and ``tetrahedron_children``.
 """
 
 from __future__ import annotations
