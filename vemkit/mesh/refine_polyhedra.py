@@ -36,7 +36,7 @@ from vemkit.mesh.polyhedral import PolyhedralMesh
 from vemkit.mesh.polyhedral_build import from_numbered_soup, same_faces, segments
 from vemkit.mesh.refine import RefinedMesh
 from vemkit.mesh.refine_boxes import box_children, cycles_of, plan_boxes, split_box_sides
-from vemkit.mesh.refine_prisms import plan_prisms, prism_children, split_prism_sides
+from vemkit.mesh.refine_prisms import plan_prisms, prisms_children, split_prisms_sides
 from vemkit.mesh.refine_tetrahedra import plan_tetrahedra, split_tetrahedra_sides, tetrahedra_children
 
 #: the families whose cells this module splits
@@ -144,7 +144,7 @@ def refine_cells(mesh: PolyhedralMesh, marked, *, max_hanging: int | None = None
     elif plan.kind == "tet":
         split = split_tetrahedra_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
     else:
-        split = _split_by(mesh, plan, split_prism_sides, face_offsets, face_vertices, x)
+        split = split_prisms_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
     new, children = _refined_mesh(mesh, plan, labels, _cycle_table(mesh, face_offsets, face_vertices, *split), x)
     parent = np.repeat(np.arange(mesh.n_cells), children)
     return RefinedMesh(new, parent, _prolongation(mesh, plan), cells, np.zeros(0, np.int64))
@@ -167,7 +167,7 @@ def _refined_mesh(mesh, plan: _Plan, labels, cycles, x):
     known = table[0].size - 1  # cycles known by number; the rules' new faces by their vertices
     args = (row, cycle, reverse, labels[face], *table, x)
     table, (row, child, cycle, reverse, face_labels) = (
-        _box_pieces(plan, *args) if plan.kind == "box" else _rule_pieces(mesh, plan, *args)
+        _box_pieces(plan, *args) if plan.kind == "box" else _rule_pieces(plan, *args)
     )
     face_id = _face_numbers(table, known, args[1])
     new_cell = np.concatenate([first_child[np.flatnonzero(unmarked)][kept[0]], first_child[cells][row] + child])
@@ -249,40 +249,15 @@ def _box_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices
     return table, (row, child, cycle, reverse, labels)
 
 
-def _rule_pieces(mesh, plan, row, cycle, reverse, labels, table_offsets, table_vertices, x):
-    """The table with the children's faces of the tetrahedra or prisms added (their rule, cell by
-    marked cell), and the children's faces; ``labels`` per appearance."""
-    if plan.kind == "tet":
-        return _tetrahedra_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices, x)
-    sizes, flat = cycles_of(table_offsets, table_vertices, cycle, reverse)
-    per_row = np.bincount(row, minlength=plan.cells.size)
-    row_start = np.concatenate([[0], np.cumsum(per_row)])
-    cycles = np.split(flat, np.cumsum(sizes)[:-1])
-    out_rows, out_child, out_labels, faces = [], [], [], []
-    for r in range(plan.cells.size):
-        mine = [(k, cycles[k]) for k in range(row_start[r], row_start[r + 1])]
-        for k, (child_faces, child_labels) in enumerate(prism_children(mesh, plan.lattice[r], mine, labels, x)):
-            faces.extend(child_faces)
-            out_labels.extend(child_labels)
-            out_rows.extend([r] * len(child_faces))
-            out_child.extend([k] * len(child_faces))
-    base = table_offsets.size - 1
-    face_sizes = np.array([f.size for f in faces], dtype=np.int64)
-    table = (
-        np.concatenate([table_offsets, table_offsets[-1] + np.cumsum(face_sizes)]),
-        np.concatenate([table_vertices, *faces]) if faces else table_vertices,
-    )
-    out = (np.array(out_rows, np.int64), np.array(out_child, np.int64), base + np.arange(len(faces)))
-    return table, (*out, np.zeros(len(faces), dtype=bool), np.array(out_labels, dtype=np.int64))
-
-
-def _tetrahedra_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices, x):
-    """The table with the new faces of the tetrahedra's children added, and the children's faces
-    (``refine_tetrahedra.tetrahedra_children``, all marked cells at once)."""
+def _rule_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertices, x):
+    """The table with the new faces of the tetrahedra's or prisms' children added, and the children's
+    faces (``refine_tetrahedra.tetrahedra_children``, ``refine_prisms.prisms_children``: all marked
+    cells at once)."""
     sizes, flat = cycles_of(table_offsets, table_vertices, cycle, reverse)
     row_start = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=plan.cells.size))])
     offsets = np.concatenate([[0], np.cumsum(sizes)])
-    rows, child, source, new_sizes, new_flat = tetrahedra_children(plan.lattice, x, row_start, offsets, flat)
+    rule = tetrahedra_children if plan.kind == "tet" else prisms_children
+    rows, child, source, new_sizes, new_flat = rule(plan.lattice, x, row_start, offsets, flat)
     new = source < 0
     cycle = np.where(new, table_offsets.size - 2 + np.cumsum(new), cycle[source])
     table = (

@@ -23,6 +23,9 @@ import numpy as np
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.curves import as_pieces, on_curves
+from vemkit.mesh.polyhedral_build import segments
+from vemkit.mesh.refine_polyhedra_kernels import prisms_children as children_kernel
+from vemkit.mesh.refine_polyhedra_kernels import prisms_sides as sides_kernel
 from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
 
 
@@ -292,3 +295,33 @@ def prism_children(mesh, lattice, cycles: list, labels, x):
                 face_labels.append(-1)
             out.append((faces, face_labels))
     return out
+
+
+def _lattice_table(lattices: list):
+    """(offsets, flat) of the prisms' lattices (6 m + 3 ids each)."""
+    offsets = np.concatenate([[0], np.cumsum([lattice.size for lattice in lattices])]).astype(np.int64)
+    return offsets, np.concatenate(lattices).astype(np.int64) if lattices else np.zeros(0, np.int64)
+
+
+def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices, x):
+    """(faces, (sizes, flat vertices, pieces per face) of their pieces, as stored) of the whole sides of
+    the marked prisms (``refine_polyhedra_kernels.prisms_sides``; its twin: ``split_prism_sides``
+    cell by cell), each split once (by the first marked prism it is a whole side of)."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    cell_start = np.concatenate([[0], np.cumsum(sizes)])
+    args = (cell_start, faces, face_offsets, face_vertices, mesh.face_vector_areas, x, TOL)
+    _, found, counts, piece_sizes, flat = sides_kernel(*_lattice_table(lattices), *args)
+    first = np.sort(np.unique(found, return_index=True)[1])
+    pieces = segments(np.concatenate([[0], np.cumsum(counts)])[first], counts[first])
+    piece_offsets = np.concatenate([[0], np.cumsum(piece_sizes)])
+    flat = flat[segments(piece_offsets[pieces], piece_sizes[pieces])]
+    return found[first], (piece_sizes[pieces], flat, counts[first])
+
+
+def prisms_children(lattices: list, x, row_start, cycle_offsets, cycle_vertices):
+    """The children of all marked prisms at once (``refine_polyhedra_kernels.prisms_children``; its
+    twin: ``prism_children`` cell by cell): per face of a child (row, child, the parent's cycle it is
+    or -1), and the new faces' (sizes, flat vertices)."""
+    return children_kernel(*_lattice_table(lattices), row_start, cycle_offsets, cycle_vertices, x, TOL)
