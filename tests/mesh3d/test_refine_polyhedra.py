@@ -263,40 +263,47 @@ def test_ring_kernel_equals_its_numpy_twin(monkeypatch):
         mesh = fast
 
 
-def test_tetrahedra_kernels_equal_their_cell_by_cell_twins():
-    """The whole sides and the children of all marked tetrahedra at once (Numba kernels) are those of
-    ``whole_sides`` and ``tetrahedron_children``, cell by cell, on a mesh with hanging vertices."""
+def _rule_kernels(kind):
+    """(mesh maker, kernel of the whole sides, its twin, kernel of the children, its twin) of a rule."""
+    from vemkit.mesh import refine_prisms as prisms
+    from vemkit.mesh import refine_tetrahedra as tets
+
+    if kind == "tet":
+        return tet, tets.split_tetrahedra_sides, tets.whole_sides, tets.tetrahedra_children, tets.tetrahedron_children
+    make = lambda n: _extruded("voronoi")  # noqa: E731
+    return make, prisms.split_prisms_sides, prisms.split_prism_sides, prisms.prisms_children, prisms.prism_children
+
+
+@pytest.mark.parametrize("kind", ["tet", "prism"])
+def test_rule_kernels_equal_their_cell_by_cell_twins(kind):
+    """The whole sides and the children of all marked tetrahedra or prisms at once (Numba kernels) are
+    those of the rule's functions cell by cell, on a mesh with hanging vertices."""
     from vemkit.mesh import refine_polyhedra as rp
     from vemkit.mesh.refine_boxes import cycles_of
-    from vemkit.mesh.refine_tetrahedra import (
-        split_tetrahedra_sides,
-        tetrahedra_children,
-        tetrahedron_children,
-        whole_sides,
-    )
 
+    make, split_sides, sides_twin, children, children_twin = _rule_kernels(kind)
     rng = np.random.default_rng(7)
-    mesh = refine_cells(tet(n=2), rng.choice(48, 12, replace=False)).mesh
+    mesh = make(2)
+    mesh = refine_cells(mesh, rng.choice(mesh.n_cells, mesh.n_cells // 4, replace=False)).mesh
     cells = np.sort(rng.choice(mesh.n_cells, mesh.n_cells // 4, replace=False))
     plan = rp._any_plan(mesh, cells)
     face_offsets, face_vertices = rp._with_midpoints(mesh, plan.split_edges)
     x = np.concatenate([mesh.vertices, plan.points])
-    faces, (sizes, flat, _) = split_tetrahedra_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
-    twin = rp._split_by(mesh, plan, whole_sides, face_offsets, face_vertices, x)
-    assert np.array_equal(faces, twin[0]) and np.array_equal(sizes, twin[1][0]) and np.array_equal(flat, twin[1][1])
-    table, face_cycles = rp._cycle_table(
-        mesh, face_offsets, face_vertices, faces, (sizes, flat, np.full(faces.size, 4))
-    )
+    faces, pieces = split_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
+    twin = rp._split_by(mesh, plan, sides_twin, face_offsets, face_vertices, x)
+    assert faces.size and np.array_equal(faces, twin[0])
+    assert all(np.array_equal(a, b) for a, b in zip(pieces, twin[1]))
+    table, face_cycles = rp._cycle_table(mesh, face_offsets, face_vertices, faces, pieces)
     row, cycle, reverse, face = rp._appearances(mesh, cells, face_cycles)
     sizes, flat = cycles_of(*table, cycle, reverse)
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     row_start = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=cells.size))])
-    rows, child, source, new_sizes, new_flat = tetrahedra_children(plan.lattice, x, row_start, offsets, flat)
+    rows, child, source, new_sizes, new_flat = children(plan.lattice, x, row_start, offsets, flat)
     new = np.split(new_flat, np.cumsum(new_sizes)[:-1])
     got = [flat[offsets[s] : offsets[s + 1]] if s >= 0 else new.pop(0) for s in source]
     for r in range(cells.size):
         cycles = [(k, flat[offsets[k] : offsets[k + 1]]) for k in range(row_start[r], row_start[r + 1])]
-        expected = tetrahedron_children(mesh, plan.lattice[r], cycles, np.arange(offsets.size), x)
+        expected = children_twin(mesh, plan.lattice[r], cycles, np.arange(offsets.size), x)
         for k, (child_faces, _) in enumerate(expected):
             mine = [got[i] for i in np.flatnonzero((rows == r) & (child == k))]
             assert len(mine) == len(child_faces) and all(np.array_equal(a, b) for a, b in zip(mine, child_faces))
