@@ -13,6 +13,10 @@ every vertex of the parent lying on its edges inserted in order. On a curved sid
 an arc of the base, ``vemkit.mesh.curves``) the new points of a whole lateral side move radially onto
 the circle, all three together, where every cell along its cap edges splits there too; otherwise they
 stay on the chord (so that no face bends).
+
+The whole sides and the children of all marked prisms are made at once by the Numba kernels of
+``refine_prisms_kernels`` (``split_prisms_sides``, ``prisms_children``), whose twins are the
+cell-by-cell ``split_prism_sides`` and ``prism_children``; the plan is still made cell by cell.
 """
 
 from __future__ import annotations
@@ -24,8 +28,8 @@ import numpy as np
 from vemkit.exceptions import MeshError
 from vemkit.mesh.curves import as_pieces, on_curves
 from vemkit.mesh.polyhedral_build import segments
-from vemkit.mesh.refine_polyhedra_kernels import prisms_children as children_kernel
-from vemkit.mesh.refine_polyhedra_kernels import prisms_sides as sides_kernel
+from vemkit.mesh.refine_prisms_kernels import prisms_children as children_kernel
+from vemkit.mesh.refine_prisms_kernels import prisms_sides as sides_kernel
 from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
 
 
@@ -305,7 +309,7 @@ def _lattice_table(lattices: list):
 
 def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices, x):
     """(faces, (sizes, flat vertices, pieces per face) of their pieces, as stored) of the whole sides of
-    the marked prisms (``refine_polyhedra_kernels.prisms_sides``; its twin: ``split_prism_sides``
+    the marked prisms (``refine_prisms_kernels.prisms_sides``; its twin: ``split_prism_sides``
     cell by cell), each split once (by the first marked prism it is a whole side of)."""
     sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
     signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
@@ -321,7 +325,7 @@ def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices,
 
 
 def prisms_children(lattices: list, x, row_start, cycle_offsets, cycle_vertices):
-    """The children of all marked prisms at once (``refine_polyhedra_kernels.prisms_children``; its
+    """The children of all marked prisms at once (``refine_prisms_kernels.prisms_children``; its
     twin: ``prism_children`` cell by cell): per face of a child (row, child, the parent's cycle it is
     or -1), and the new faces' (sizes, flat vertices)."""
     return children_kernel(*_lattice_table(lattices), row_start, cycle_offsets, cycle_vertices, x, TOL)

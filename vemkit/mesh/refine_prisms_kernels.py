@@ -1,0 +1,186 @@
+"""Numba kernels of the refinement of prisms (``refine_prisms``), one loop over the marked prisms each.
+
+``prisms_sides`` splits the whole sides of the marked prisms (a cap into the m quadrilaterals Q_i, a
+lateral side into 4 quarters) and ``prisms_children`` makes the faces of their 2m children; their
+twins are ``refine_prisms.split_prism_sides`` and ``prism_children``, cell by cell
+(``tests/mesh3d/test_refine_polyhedra.py`` pins the kernels to them).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from vemkit.mesh.refine_polyhedra_kernels import grown, insert_on_edges
+
+
+@numba.njit(cache=True)
+def _turned(ids, direction, x):
+    """The polygon ``ids``, reversed when its normal (Newell's) points against ``direction``."""
+    n = ids.shape[0]
+    normal = np.zeros(3)
+    for k in range(n):
+        p, q = x[ids[k]], x[ids[(k + 1) % n]]
+        normal[0] += (p[1] - q[1]) * (p[2] + q[2])
+        normal[1] += (p[2] - q[2]) * (p[0] + q[0])
+        normal[2] += (p[0] - q[0]) * (p[1] + q[1])
+    return ids if normal @ direction > 0 else ids[::-1].copy()
+
+
+@numba.njit(cache=True)
+def _ring(m, level, i):
+    """Lattice positions of Q_i (c_i, s_i, z, s_{i-1}) of a prism at level 0 (bottom), 1 (mid-depth), 2 (top)."""
+    corner, mid, centre = (
+        (0, 3 * m, 6 * m) if level == 0 else ((2 * m, 5 * m, 6 * m + 2) if level == 1 else (m, 4 * m, 6 * m + 1))
+    )
+    return np.array([corner + i, mid + i, centre, mid + (i - 1 + m) % m])
+
+
+@numba.njit(cache=True)
+def _pool(parts_offsets, parts, first, last, lattice):
+    """The sorted distinct vertices of the cycles first ... last - 1 and of ``lattice``."""
+    n = parts_offsets[last] - parts_offsets[first]
+    gathered = np.empty(n + lattice.shape[0], np.int64)
+    gathered[:n] = parts[parts_offsets[first] : parts_offsets[last]]
+    gathered[n:] = lattice
+    return np.unique(gathered)
+
+
+@numba.njit(cache=True)
+def prisms_children(lattice_offsets, lattices, row_start, cycle_offsets, cycle_vertices, x, tol):
+    """The children of the marked prisms (``refine_prisms``): per face of a child, child by child (Q_i
+    below mid-depth, then above), (row, child, the parent's cycle it is, or -1 for a new face), and the
+    new faces' (sizes, flat vertices). Per row r: its lattice (``lattice_offsets``, ``lattices``:
+    6 m + 3 points) and its outward cycles row_start[r] ... (whole sides split)."""
+    rows, kids, sources = np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64)
+    sizes, flat = np.empty(0, np.int64), np.empty(0, np.int64)
+    n_app, n_new, n_flat = 0, 0, 0
+    for r in range(row_start.shape[0] - 1):
+        lattice = lattices[lattice_offsets[r] : lattice_offsets[r + 1]]
+        m = (lattice.shape[0] - 3) // 6
+        c0, c1 = row_start[r], row_start[r + 1]
+        pool = _pool(cycle_offsets, cycle_vertices, c0, c1, lattice)
+        centres = np.zeros((c1 - c0, 3))
+        for c in range(c0, c1):
+            for i in range(cycle_offsets[c], cycle_offsets[c + 1]):
+                centres[c - c0] += x[cycle_vertices[i]]
+            centres[c - c0] /= cycle_offsets[c + 1] - cycle_offsets[c]
+        size = 0.0
+        for axis in range(3):
+            size = max(size, x[lattice, axis].max() - x[lattice, axis].min())
+        middle = x[lattice[6 * m + 2], 2]
+        need = n_app + 2 * m * (c1 - c0 + 3)
+        rows, kids, sources = grown(rows, need), grown(kids, need), grown(sources, need)
+        sizes = grown(sizes, n_new + 6 * m)
+        flat = grown(flat, n_flat + 6 * m * (4 + pool.shape[0]))
+        for layer in range(2):
+            for i in range(m):
+                child = layer * m + i
+                low, high = _ring(m, layer, i), _ring(m, layer + 1, i)
+                q = x[lattice[_ring(m, 0, i)], :2]
+                for c in range(c1 - c0):
+                    if (centres[c, 2] > middle) != (layer == 1):
+                        continue
+                    inside = True
+                    for k in range(4):
+                        d = q[(k + 1) % 4] - q[k]
+                        if not d[0] * (centres[c, 1] - q[k, 1]) - d[1] * (centres[c, 0] - q[k, 0]) > -tol * size * size:
+                            inside = False
+                    if inside:
+                        rows[n_app], kids[n_app], sources[n_app] = r, child, c0 + c
+                        n_app += 1
+                centre = np.zeros(3)
+                for k in range(4):
+                    centre += x[lattice[low[k]]] + x[lattice[high[k]]]
+                centre /= 8.0
+                polygons = np.empty((3, 4), np.int64)
+                polygons[0] = low if layer == 1 else high
+                for k in (1, 2):
+                    polygons[k] = np.array([low[k], low[k + 1], high[k + 1], high[k]])
+                for p in range(3):
+                    ids = lattice[polygons[p]]
+                    away = (x[ids[0]] + x[ids[1]] + x[ids[2]] + x[ids[3]]) / 4.0 - centre
+                    end = insert_on_edges(_turned(ids, away, x), pool, x, tol, flat, n_flat)
+                    sizes[n_new] = end - n_flat
+                    n_flat, n_new = end, n_new + 1
+                    rows[n_app], kids[n_app], sources[n_app] = r, child, -1
+                    n_app += 1
+    return rows[:n_app], kids[:n_app], sources[:n_app], sizes[:n_new], flat[:n_flat]
+
+
+@numba.njit(cache=True)
+def _all_in(wanted, cycle):
+    for v in wanted:
+        found = False
+        for w in cycle:
+            if w == v:
+                found = True
+                break
+        if not found:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def _side_pieces(lattice, m, cycle):
+    """The pieces (lattice positions, 4 per row) of the whole side ``cycle`` of a prism: the m Q_i of
+    a cap, or the 4 quarters of a lateral side; no rows when it is not a whole side."""
+    if _all_in(lattice[:m], cycle) or _all_in(lattice[m : 2 * m], cycle):
+        level = 0 if _all_in(lattice[:m], cycle) else 2
+        out = np.empty((m, 4), np.int64)
+        for i in range(m):
+            out[i] = _ring(m, level, i)
+        return out
+    for i in range(m):
+        j = (i + 1) % m
+        if _all_in(np.array([lattice[i], lattice[j], lattice[m + i], lattice[m + j]]), cycle):
+            B, T, V, SB, ST, SM = 0, m, 2 * m, 3 * m, 4 * m, 5 * m
+            return np.array(
+                [
+                    [B + i, SB + i, SM + i, V + i],
+                    [SB + i, B + j, V + j, SM + i],
+                    [SM + i, V + j, T + j, ST + i],
+                    [V + i, SM + i, ST + i, T + i],
+                ]
+            )
+    return np.empty((0, 4), np.int64)
+
+
+@numba.njit(cache=True)
+def prisms_sides(lattice_offsets, lattices, cell_start, faces, face_offsets, face_vertices, face_normals, x, tol):
+    """The whole sides of the marked prisms (``refine_prisms.split_prism_sides``): per side found (row,
+    face, number of pieces), row after row, and the pieces' (sizes, flat vertices), as stored (turned
+    along ``face_normals``) with the vertices of the cell inside their edges."""
+    rows, found, counts = np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64)
+    sizes, flat = np.empty(0, np.int64), np.empty(0, np.int64)
+    n_side, n_piece, n_flat = 0, 0, 0
+    for r in range(cell_start.shape[0] - 1):
+        lattice = lattices[lattice_offsets[r] : lattice_offsets[r + 1]]
+        m = (lattice.shape[0] - 3) // 6
+        f0, f1 = cell_start[r], cell_start[r + 1]
+        total = lattice.shape[0]
+        for f in faces[f0:f1]:
+            total += face_offsets[f + 1] - face_offsets[f]
+        gathered = np.empty(total, np.int64)
+        gathered[: lattice.shape[0]] = lattice
+        k = lattice.shape[0]
+        for f in faces[f0:f1]:
+            n = face_offsets[f + 1] - face_offsets[f]
+            gathered[k : k + n] = face_vertices[face_offsets[f] : face_offsets[f + 1]]
+            k += n
+        pool = np.unique(gathered)
+        need = n_side + f1 - f0
+        rows, found, counts = grown(rows, need), grown(found, need), grown(counts, need)
+        sizes = grown(sizes, n_piece + (f1 - f0) * max(m, 4))
+        flat = grown(flat, n_flat + (f1 - f0) * max(m, 4) * (4 + pool.shape[0]))
+        for f in faces[f0:f1]:
+            pieces = _side_pieces(lattice, m, face_vertices[face_offsets[f] : face_offsets[f + 1]])
+            if pieces.shape[0] == 0:
+                continue
+            for p in range(pieces.shape[0]):
+                end = insert_on_edges(_turned(lattice[pieces[p]], face_normals[f], x), pool, x, tol, flat, n_flat)
+                sizes[n_piece] = end - n_flat
+                n_flat, n_piece = end, n_piece + 1
+            rows[n_side], found[n_side], counts[n_side] = r, f, pieces.shape[0]
+            n_side += 1
+    return rows[:n_side], found[:n_side], counts[:n_side], sizes[:n_piece], flat[:n_flat]
