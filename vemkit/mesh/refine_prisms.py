@@ -28,7 +28,9 @@ import numpy as np
 from vemkit.exceptions import MeshError
 from vemkit.mesh.curves import as_pieces, on_curves
 from vemkit.mesh.polyhedral_build import segments
+from vemkit.mesh.refine_boxes import unique_rows
 from vemkit.mesh.refine_prisms_kernels import prisms_children as children_kernel
+from vemkit.mesh.refine_prisms_kernels import prisms_plan as plan_kernel
 from vemkit.mesh.refine_prisms_kernels import prisms_sides as sides_kernel
 from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
 
@@ -108,56 +110,87 @@ def _check_lateral_faces(mesh, c: int, b, t, tol: float) -> None:
 def plan_prisms(mesh, cells: np.ndarray, refinable: str, curves=None):
     """(lattices, new points, sources, split edges, faces added by splits, inner faces) of the marked
     prisms; a lattice is B, T, V, SB, ST, SM (m each: corners, vertical midpoints, edge midpoints
-    at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism)."""
+    at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism).
+    A point is a vertex of the cell there already, else new, named by its group of corners and
+    numbered in order of first request (``refine_prisms_kernels.prisms_plan``)."""
     n, vertices = mesh.n_vertices, mesh.vertices
+    status, corner_start, corners, near, keys, kind = _requests(mesh, cells)
+    if status.any():
+        row = int(np.flatnonzero(status)[0])
+        raise MeshError(
+            f"cell {cells[row]} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box, a "
+            f"tetrahedron or a prism along z over a convex polygon; 3D refinement splits the cells of the families "
+            f"{refinable}"
+            if status[row] == 1
+            else f"cell {cells[row]} has a lateral face across its mid-depth without being a whole side (the hanging "
+            "vertices of an extruded mesh with hanging nodes); 3D refinement splits prisms whose lateral faces are "
+            "whole sides or lie in one half of the depth"
+        )
+    m = np.diff(corner_start) // 2
+    new = near < 0
+    unique, inverse = unique_rows(keys[new])
+    first = np.full(unique.shape[0], near.size, dtype=np.int64)
+    np.minimum.at(first, inverse, np.flatnonzero(new))
+    rank = np.empty(unique.shape[0], dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(unique.shape[0])
+    values = near.copy()
+    values[new] = n + rank[inverse]
+    request_start = np.concatenate([[0], np.cumsum(4 * m + 3)])
+    lattices = [
+        np.concatenate(
+            [corners[corner_start[r] : corner_start[r + 1]], values[request_start[r] : request_start[r + 1]]]
+        )
+        for r in range(cells.size)
+    ]
+    created = np.sort(first)  # the requests that make the new points, in order
+    row_of = np.repeat(np.arange(cells.size), 4 * m + 3)
+    points, sources = _new_points(
+        vertices, corners, corner_start, row_of[created], created - request_start[row_of[created]], m, n
+    )
+    pairs = kind[created] == 0
+    edges = np.sort(keys[created[pairs], :2], axis=1)
+    mids = n + np.flatnonzero(pairs)
+    edge_keys = edges[:, 0] * np.int64(n) + edges[:, 1]
+    order = np.argsort(edge_keys)
+    pieces = np.where(kind[created] == 1, 3, np.where(kind[created] == 2, m[row_of[created]] - 1, 0))
+    points = _onto_curves(mesh, cells, lattices, points, curves)
+    return lattices, points, sources, (edge_keys[order], mids[order]), int(pieces.sum()), int(3 * m.sum())
+
+
+def _requests(mesh, cells):
+    """``refine_prisms_kernels.prisms_plan`` of the marked cells."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     offsets, ids = mesh.cell_vertex_lists
-    new_of, points, sources, lattices, extra, inner = {}, [], [], [], {}, 0
-    for c in cells.tolist():
-        found = prism_corners(mesh, c)
-        if found is None:
-            raise MeshError(
-                f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box, a tetrahedron "
-                f"or a prism along z over a convex polygon; 3D refinement splits the cells of the families {refinable}"
-            )
-        b, t = found
-        m = b.size
-        own = ids[offsets[c] : offsets[c + 1]]
-        size = np.ptp(vertices[own], axis=0).max()
-        _check_lateral_faces(mesh, c, b, t, TOL * size)
-        nb, nt = np.roll(b, -1), np.roll(t, -1)
-        groups = [[b[i], t[i]] for i in range(m)] + [[b[i], nb[i]] for i in range(m)]
-        groups += [[t[i], nt[i]] for i in range(m)] + [[b[i], nb[i], t[i], nt[i]] for i in range(m)]
-        groups += [list(b), list(t), list(b) + list(t) + [-1 - c]]
-        row = list(b) + list(t)
-        for k, group in enumerate(groups):
-            real = [g for g in group if g >= 0]
-            weights = np.full(len(real), 1.0 / len(real))
-            if k >= 4 * m:  # a centroid: of a cap, or between the caps
-                w = _centroid_weights(vertices[real[:m], :2])
-                weights = w if len(real) == m else np.concatenate([w, w]) / 2
-            point = weights @ vertices[real]
-            near = own[np.linalg.norm(vertices[own] - point, axis=1) < TOL * size]
-            key = tuple(sorted(group))
-            if near.size:
-                row.append(int(near[0]))
-                continue
-            if key not in new_of:
-                new_of[key] = n + len(points)
-                points.append(point)
-                sources.append((np.array([new_of[key]]), np.array([real]), weights[None, :]))
-            row.append(new_of[key])
-        lattices.append(np.array(row, dtype=np.int64))
-        inner += 3 * m
-        for key, pieces in ((tuple(sorted([b[i], nb[i], t[i], nt[i]])), 4) for i in range(m)):
-            extra[key] = pieces - 1
-        extra[tuple(sorted(b))] = extra[tuple(sorted(t))] = m - 1
-    edges = np.array([k for k in new_of if len(k) == 2], dtype=np.int64).reshape(-1, 2)
-    mids = np.array([new_of[tuple(k)] for k in edges.tolist()], dtype=np.int64)
-    keys = edges[:, 0] * np.int64(n) + edges[:, 1]
-    order = np.argsort(keys)
-    added = sum(v for k, v in extra.items() if tuple(k) in new_of)  # a whole side has a new centre
-    points = _onto_curves(mesh, cells, lattices, np.array(points).reshape(-1, 3), curves)
-    return lattices, points, sources, (keys[order], mids[order]), added, inner
+    own_sizes = offsets[cells + 1] - offsets[cells]
+    own = ids[segments(offsets[cells], own_sizes)]
+    width = 2 * int(own_sizes.max(initial=1)) + 1
+    args = (mesh.face_offsets, mesh.face_vertices, np.concatenate([[0], np.cumsum(own_sizes)]), own)
+    cell_start = np.concatenate([[0], np.cumsum(sizes)])
+    return plan_kernel(cells.astype(np.int64), cell_start, faces, normals, *args, mesh.vertices, width, TOL)
+
+
+def _new_points(vertices, corners, corner_start, rows, positions, m, n):
+    """(points, sources) of the new points, made by the requests (row, position after the corners):
+    the mean of a group's corners, or the area centroid of a cap or of the prism (as ``weights @ x``)."""
+    points, sources = [], []
+    for k, (r, q) in enumerate(zip(rows.tolist(), positions.tolist())):
+        mr = int(m[r])
+        b = corners[corner_start[r] : corner_start[r] + mr]
+        t = corners[corner_start[r] + mr : corner_start[r + 1]]
+        i, j = q % mr, (q % mr + 1) % mr
+        real = [[b[i], t[i]], [b[i], b[j]], [t[i], t[j]], [b[i], b[j], t[i], t[j]]][q // mr] if q < 4 * mr else None
+        weights = np.full(len(real), 1.0 / len(real)) if real is not None else None
+        if real is None:
+            real = list(b) if q == 4 * mr else (list(t) if q == 4 * mr + 1 else list(b) + list(t))
+            w = _centroid_weights(vertices[real[:mr], :2])
+            weights = w if len(real) == mr else np.concatenate([w, w]) / 2
+        points.append(weights @ vertices[real])
+        sources.append((np.array([n + k]), np.array([real]), weights[None, :]))
+    return np.array(points).reshape(-1, 3), sources
 
 
 def _onto_curves(mesh, cells: np.ndarray, lattices: list, points: np.ndarray, curves) -> np.ndarray:

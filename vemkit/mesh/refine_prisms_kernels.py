@@ -8,6 +8,8 @@ twins are ``refine_prisms.split_prism_sides`` and ``prism_children``, cell by ce
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -184,3 +186,163 @@ def prisms_sides(lattice_offsets, lattices, cell_start, faces, face_offsets, fac
             rows[n_side], found[n_side], counts[n_side] = r, f, pieces.shape[0]
             n_side += 1
     return rows[:n_side], found[:n_side], counts[:n_side], sizes[:n_piece], flat[:n_flat]
+
+
+@numba.njit(cache=True)
+def _plane_labels(normals):
+    """``refine_tetrahedra.plane_labels``: the first face without a plane starts the next one."""
+    labels = np.full(normals.shape[0], -1, np.int64)
+    count = 0
+    for k in range(normals.shape[0]):
+        if labels[k] < 0:
+            for j in range(normals.shape[0]):
+                if labels[j] < 0 and normals[j] @ normals[k] > 1 - 1e-9:
+                    labels[j] = count
+            count += 1
+    return labels, count
+
+
+@numba.njit(cache=True)
+def _prism_corners(faces, normals, face_offsets, face_vertices, x):
+    """(bottom, top) corners of a cell (``refine_prisms.prism_corners``), or empty arrays."""
+    none = np.empty(0, np.int64)
+    labels, count = _plane_labels(normals)
+    cap_planes = np.zeros(count, np.bool_)
+    for k in range(faces.shape[0]):
+        if abs(normals[k, 2]) > 1 - 1e-9:
+            cap_planes[labels[k]] = True
+        elif abs(normals[k, 2]) > 1e-9:
+            return none, none
+    if cap_planes.sum() != 2:
+        return none, none
+    seen = np.empty(0, np.int64)
+    on = np.zeros((0, count), np.bool_)
+    for k in range(faces.shape[0]):
+        for v in face_vertices[face_offsets[faces[k]] : face_offsets[faces[k] + 1]]:
+            at = np.flatnonzero(seen == v)
+            if at.size == 0:
+                seen = np.append(seen, v)
+                on = np.concatenate((on, np.zeros((1, count), np.bool_)))
+                at = np.array([seen.shape[0] - 1])
+            on[at[0], labels[k]] = True
+    corners = seen[on.sum(axis=1) >= 3]
+    z = x[corners, 2]
+    low = z < z.mean()
+    bottom, top = corners[low], corners[~low]
+    if bottom.shape[0] < 3 or bottom.shape[0] != top.shape[0]:
+        return none, none
+    centre = np.zeros(2)
+    for v in bottom:
+        centre += x[v, :2]
+    centre /= bottom.shape[0]
+    angle = np.array([math.atan2(x[v, 1] - centre[1], x[v, 0] - centre[0]) for v in bottom])
+    bottom = bottom[np.argsort(angle)]
+    match = np.empty(bottom.shape[0], np.int64)
+    for j in range(bottom.shape[0]):
+        d = (x[top, 0] - x[bottom[j], 0]) ** 2 + (x[top, 1] - x[bottom[j], 1]) ** 2
+        match[j] = np.argmin(d)
+    if np.unique(match).shape[0] != top.shape[0]:
+        return none, none
+    m = bottom.shape[0]
+    for i in range(m):
+        p, q, r = x[bottom[i], :2], x[bottom[(i + 1) % m], :2], x[bottom[(i + 2) % m], :2]
+        if (q[0] - p[0]) * (r[1] - q[1]) - (q[1] - p[1]) * (r[0] - q[0]) <= 0:
+            return none, none
+    return bottom, top[match]
+
+
+@numba.njit(cache=True)
+def _cap_centroid(ids, x):
+    """The area centroid (xy) of the convex polygon x[ids] by the fan from its first corner."""
+    area, cx, cy = 0.0, 0.0, 0.0
+    for i in range(1, ids.shape[0] - 1):
+        a, b, c = x[ids[0]], x[ids[i]], x[ids[i + 1]]
+        w = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+        area += w
+        cx += w * (a[0] + b[0] + c[0]) / 3.0
+        cy += w * (a[1] + b[1] + c[1]) / 3.0
+    return cx / area, cy / area
+
+
+@numba.njit(cache=True)
+def prisms_plan(cells, cell_start, faces, normals, face_offsets, face_vertices, own_start, own, x, width, tol):
+    """The lattices of the marked prisms (``refine_prisms.plan_prisms``), before new points are named:
+    per row its status (0, 1 not a prism over a convex polygon, 2 a lateral face across its mid-depth)
+    and corners (bottom then top, m each: ``corner_start``), and per lattice point after the corners,
+    row by row (V, SB, ST, SM, ZB, ZT, ZM), the vertex of the cell there already or -1, its group's
+    vertices sorted (padded with -1 at the end to ``width``; the prism's centroid also names its cell
+    as -1 - c) and its kind (0 a pair's midpoint, 1 a lateral side's centre, 2 a cap's, 3 the body's)."""
+    m_rows = cells.shape[0]
+    status = np.zeros(m_rows, np.int64)
+    corner_start = np.zeros(m_rows + 1, np.int64)
+    corners = np.empty(0, np.int64)
+    near, kind = np.empty(0, np.int64), np.empty(0, np.int64)
+    keys = np.empty((0, width), np.int64)
+    n_req = 0
+    for r in range(m_rows):
+        f0, f1 = cell_start[r], cell_start[r + 1]
+        b, t = _prism_corners(faces[f0:f1], normals[f0:f1], face_offsets, face_vertices, x)
+        mine = own[own_start[r] : own_start[r + 1]]
+        m = b.shape[0]
+        corner_start[r + 1] = corner_start[r] + 2 * m
+        if m == 0:
+            status[r] = 1
+            continue
+        corners = np.concatenate((corners, b, t))
+        size = 0.0
+        for axis in range(3):
+            size = max(size, x[mine, axis].max() - x[mine, axis].min())
+        zm = 0.5 * (x[b, 2].mean() + x[t, 2].mean())
+        for f in faces[f0:f1]:
+            z = x[face_vertices[face_offsets[f] : face_offsets[f + 1]], 2]
+            hits = 0
+            for v in face_vertices[face_offsets[f] : face_offsets[f + 1]]:
+                hits += (b == v).sum() + (t == v).sum()
+            if z.min() < zm - tol * size and z.max() > zm + tol * size and z.max() > z.min() and hits < 4:
+                status[r] = 2
+        if status[r]:
+            continue
+        n_new = 4 * m + 3
+        near, kind = grown(near, n_req + n_new), grown(kind, n_req + n_new)
+        if keys.shape[0] < n_req + n_new:
+            bigger = np.empty((max(n_req + n_new, 2 * keys.shape[0]), width), np.int64)
+            bigger[: keys.shape[0]] = keys
+            keys = bigger
+        for k in range(n_new):
+            i, j = k % m, (k % m + 1) % m
+            group = np.empty(0, np.int64)
+            point = np.zeros(3)
+            if k < 3 * m:
+                group = (
+                    np.array([b[i], t[i]])
+                    if k < m
+                    else (np.array([b[i], b[j]]) if k < 2 * m else np.array([t[i], t[j]]))
+                )
+                point = 0.5 * (x[group[0]] + x[group[1]])
+                kind[n_req] = 0
+            elif k < 4 * m:
+                group = np.array([b[i], b[j], t[i], t[j]])
+                point = 0.25 * (x[b[i]] + x[b[j]] + x[t[i]] + x[t[j]])
+                kind[n_req] = 1
+            else:
+                cap = b if k == 4 * m else t
+                cx, cy = _cap_centroid(cap, x)
+                point[0], point[1] = cx, cy
+                if k < 4 * m + 2:
+                    group = cap.copy()
+                    point[2] = x[cap, 2].mean()
+                    kind[n_req] = 2
+                else:
+                    group = np.concatenate((np.array([-1 - cells[r]]), b, t))
+                    point[2] = zm
+                    kind[n_req] = 3
+            near[n_req] = -1
+            for v in mine:
+                d = x[v] - point
+                if math.sqrt(d @ d) < tol * size:
+                    near[n_req] = v
+                    break
+            keys[n_req] = -1
+            keys[n_req, : group.shape[0]] = np.sort(group)
+            n_req += 1
+    return status, corner_start, corners, near[:n_req], keys[:n_req], kind[:n_req]
