@@ -266,12 +266,13 @@ def test_ring_kernel_equals_its_numpy_twin(monkeypatch):
 def _rule_kernels(kind):
     """(mesh maker, kernel of the whole sides, its twin, kernel of the children, its twin) of a rule."""
     from vemkit.mesh import refine_prisms as prisms
+    from vemkit.mesh import refine_prisms_reference as twins
     from vemkit.mesh import refine_tetrahedra as tets
 
     if kind == "tet":
         return tet, tets.split_tetrahedra_sides, tets.whole_sides, tets.tetrahedra_children, tets.tetrahedron_children
     make = lambda n: _extruded("voronoi")  # noqa: E731
-    return make, prisms.split_prisms_sides, prisms.split_prism_sides, prisms.prisms_children, prisms.prism_children
+    return make, prisms.split_prisms_sides, twins.split_prism_sides, prisms.prisms_children, twins.prism_children
 
 
 @pytest.mark.parametrize("kind", ["tet", "prism"])
@@ -307,3 +308,22 @@ def test_rule_kernels_equal_their_cell_by_cell_twins(kind):
         for k, (child_faces, _) in enumerate(expected):
             mine = [got[i] for i in np.flatnonzero((rows == r) & (child == k))]
             assert len(mine) == len(child_faces) and all(np.array_equal(a, b) for a, b in zip(mine, child_faces))
+
+
+@pytest.mark.parametrize("name", ["prism-triangle", "prism-voronoi"])
+def test_prism_plan_kernel_equals_its_cell_by_cell_twin(name):
+    """The plan of all marked prisms at once (``refine_prisms_kernels.prisms_plan``) is the one made
+    prism by prism (``refine_prisms_reference.plan_prisms_reference``): lattices, points, sources."""
+    from vemkit.mesh.refine_prisms import plan_prisms
+    from vemkit.mesh.refine_prisms_reference import plan_prisms_reference
+
+    rng = np.random.default_rng(8)
+    mesh = MESHES[name]()
+    for _ in range(2):
+        marked = np.sort(_random_marking(mesh, rng))
+        got, twin = plan_prisms(mesh, marked, ""), plan_prisms_reference(mesh, marked, "")
+        assert all(np.array_equal(a, b) for a, b in zip(got[0], twin[0])) and len(got[0]) == len(twin[0])
+        assert np.array_equal(got[1], twin[1]) and len(got[2]) == len(twin[2])
+        assert all(np.array_equal(a, b) for pair in zip(got[2], twin[2]) for a, b in zip(*pair))
+        assert all(np.array_equal(a, b) for a, b in zip(got[3], twin[3])) and got[4:] == twin[4:]
+        mesh = refine_cells(mesh, marked).mesh

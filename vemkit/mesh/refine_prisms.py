@@ -14,9 +14,8 @@ an arc of the base, ``vemkit.mesh.curves``) the new points of a whole lateral si
 the circle, all three together, where every cell along its cap edges splits there too; otherwise they
 stay on the chord (so that no face bends).
 
-The whole sides and the children of all marked prisms are made at once by the Numba kernels of
-``refine_prisms_kernels`` (``split_prisms_sides``, ``prisms_children``), whose twins are the
-cell-by-cell ``split_prism_sides`` and ``prism_children``; the plan is still made cell by cell.
+The plan, the whole sides and the children of all marked prisms are made at once by the Numba kernels
+of ``refine_prisms_kernels``, whose twins are the cell-by-cell functions of ``refine_prisms_reference``.
 """
 
 from __future__ import annotations
@@ -32,52 +31,7 @@ from vemkit.mesh.refine_boxes import unique_rows
 from vemkit.mesh.refine_prisms_kernels import prisms_children as children_kernel
 from vemkit.mesh.refine_prisms_kernels import prisms_plan as plan_kernel
 from vemkit.mesh.refine_prisms_kernels import prisms_sides as sides_kernel
-from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
-
-
-def _newell(x, ids):
-    """The normal (times twice the area) of the polygon x[ids] by Newell's formula."""
-    p, q = x[ids], x[np.append(ids[1:], ids[0])]
-    return np.array(
-        [
-            ((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),
-            ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
-            ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum(),
-        ]
-    )
-
-
-def prism_corners(mesh, c: int):
-    """(bottom corners, top corners) of cell c, counter-clockwise from +z and matched, or None when
-    it is not a prism along z over a convex polygon."""
-    signed = mesh.cell_face_list(c)
-    faces = np.where(signed >= 0, signed, -signed - 1)
-    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    planes = plane_labels(normals)
-    caps = np.abs(normals[:, 2]) > 1 - 1e-9
-    if np.abs(normals[~caps, 2]).max(initial=0) > 1e-9 or np.unique(planes[caps]).size != 2:
-        return None
-    on = {}
-    for f, plane in zip(faces, planes):
-        for v in mesh.face(f).tolist():
-            on.setdefault(v, set()).add(int(plane))
-    corners = np.array([v for v, p in on.items() if len(p) >= 3])
-    x = mesh.vertices[corners]
-    low = x[:, 2] < x[:, 2].mean()
-    bottom, top = corners[low], corners[~low]
-    if bottom.size < 3 or bottom.size != top.size:
-        return None
-    centre = mesh.vertices[bottom, :2].mean(axis=0)
-    bottom = bottom[np.argsort(np.arctan2(*(mesh.vertices[bottom, :2] - centre).T[::-1]))]
-    match = np.linalg.norm(mesh.vertices[top, None, :2] - mesh.vertices[None, bottom, :2], axis=2).argmin(axis=0)
-    top = top[match]
-    p = mesh.vertices[bottom, :2]
-    e, f = np.roll(p, -1, axis=0) - p, np.roll(p, -2, axis=0) - np.roll(p, -1, axis=0)
-    turn = e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]
-    if (turn <= 0).any() or np.unique(match).size != top.size:
-        return None
-    return bottom, top
+from vemkit.mesh.refine_tetrahedra import TOL
 
 
 def _centroid_weights(x2):
@@ -90,21 +44,6 @@ def _centroid_weights(x2):
     w[1:-1] += area
     w[2:] += area
     return w / (3.0 * area.sum())
-
-
-def _check_lateral_faces(mesh, c: int, b, t, tol: float) -> None:
-    """Every lateral face of a marked prism is a whole side or lies in one half of its depth."""
-    zm = 0.5 * (mesh.vertices[b, 2].mean() + mesh.vertices[t, 2].mean())
-    corners = set(b.tolist()) | set(t.tolist())
-    for s in mesh.cell_face_list(c).tolist():
-        face = mesh.face(s if s >= 0 else -s - 1)
-        z = mesh.vertices[face, 2]
-        if z.min() < zm - tol and z.max() > zm + tol and np.ptp(z) > 0 and len(corners.intersection(face.tolist())) < 4:
-            raise MeshError(
-                f"cell {c} has a lateral face across its mid-depth without being a whole side (the hanging "
-                "vertices of an extruded mesh with hanging nodes); 3D refinement splits prisms whose lateral faces "
-                "are whole sides or lie in one half of the depth"
-            )
 
 
 def plan_prisms(mesh, cells: np.ndarray, refinable: str, curves=None):
@@ -268,72 +207,6 @@ def _cells_around(mesh, caps: np.ndarray) -> np.ndarray:
     return out
 
 
-def _ring(m: int, level: int, i: int) -> list:
-    """Lattice positions of Q_i (c_i, s_i, z, s_{i-1}) at level 0 (bottom), 1 (mid-depth) or 2 (top)."""
-    corner, mid, centre = [(0, 3 * m, 6 * m), (2 * m, 5 * m, 6 * m + 2), (m, 4 * m, 6 * m + 1)][level]
-    return [corner + i, mid + i, centre, mid + (i - 1) % m]
-
-
-def _oriented(x, ids, direction):
-    return ids if _newell(x, ids) @ direction > 0 else ids[::-1]
-
-
-def split_prism_sides(mesh, lattice, cell: int, face_offsets, face_vertices, x):
-    """(face, pieces as stored) of the sides of a marked prism that are one face."""
-    m = (lattice.size - 3) // 6
-    signed = mesh.cell_face_list(cell)
-    faces = np.where(signed >= 0, signed, -signed - 1)
-    cycles = [face_vertices[face_offsets[f] : face_offsets[f + 1]] for f in faces]
-    pool = np.union1d(np.concatenate(cycles), lattice)
-    for f, cycle in zip(faces.tolist(), cycles):
-        if np.isin(lattice[:m], cycle).all():
-            pieces = [_ring(m, 0, i) for i in range(m)]
-        elif np.isin(lattice[m : 2 * m], cycle).all():
-            pieces = [_ring(m, 2, i) for i in range(m)]
-        else:
-            i = next(
-                (i for i in range(m) if np.isin(lattice[[i, (i + 1) % m, m + i, m + (i + 1) % m]], cycle).all()), None
-            )
-            if i is None:
-                continue
-            j = (i + 1) % m
-            B, T, V, SB, ST, SM = (k * m for k in range(6))
-            pieces = [[B + i, SB + i, SM + i, V + i], [SB + i, B + j, V + j, SM + i]]
-            pieces += [[SM + i, V + j, T + j, ST + i], [V + i, SM + i, ST + i, T + i]]
-        direction = mesh.face_vector_areas[f]
-        yield f, [_on_edges(_oriented(x, lattice[p], direction), pool, x) for p in pieces]
-
-
-def prism_children(mesh, lattice, cycles: list, labels, x):
-    """The outward faces and labels of the 2m children of a marked prism; ``cycles``: its (face,
-    outward cycle) with its whole sides already split."""
-    m = (lattice.size - 3) // 6
-    pool = np.union1d(np.concatenate([cycle for _, cycle in cycles]), lattice)
-    centres = np.array([x[cycle].mean(axis=0) for _, cycle in cycles])
-    size = np.ptp(x[lattice], axis=0).max()
-    upper = centres[:, 2] > x[lattice[6 * m + 2], 2]
-    out = []
-    for layer in (0, 1):
-        for i in range(m):
-            low, high = _ring(m, layer, i), _ring(m, layer + 1, i)
-            q = x[lattice[_ring(m, 0, i)], :2]
-            d, r = np.roll(q, -1, axis=0) - q, centres[:, None, :2] - q[None]
-            cross = d[None, :, 0] * r[:, :, 1] - d[None, :, 1] * r[:, :, 0]
-            mine = np.flatnonzero((cross > -TOL * size * size).all(axis=1) & (upper == bool(layer)))
-            faces = [cycles[k][1] for k in mine]
-            face_labels = [labels[cycles[k][0]] for k in mine]
-            child_centre = x[lattice[low + high]].mean(axis=0)
-            polygons = [] if layer == 0 else [low]
-            polygons += [] if layer == 1 else [high]
-            polygons += [[low[k], low[k + 1], high[k + 1], high[k]] for k in (1, 2)]
-            for polygon in polygons:
-                ids = lattice[polygon]
-                faces.append(_on_edges(_oriented(x, ids, x[ids].mean(axis=0) - child_centre), pool, x))
-                face_labels.append(-1)
-            out.append((faces, face_labels))
-    return out
-
-
 def _lattice_table(lattices: list):
     """(offsets, flat) of the prisms' lattices (6 m + 3 ids each)."""
     offsets = np.concatenate([[0], np.cumsum([lattice.size for lattice in lattices])]).astype(np.int64)
@@ -342,7 +215,8 @@ def _lattice_table(lattices: list):
 
 def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices, x):
     """(faces, (sizes, flat vertices, pieces per face) of their pieces, as stored) of the whole sides of
-    the marked prisms (``refine_prisms_kernels.prisms_sides``; its twin: ``split_prism_sides``
+    the marked prisms (``refine_prisms_kernels.prisms_sides``; its twin:
+    ``refine_prisms_reference.split_prism_sides``
     cell by cell), each split once (by the first marked prism it is a whole side of)."""
     sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
     signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
@@ -359,6 +233,6 @@ def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices,
 
 def prisms_children(lattices: list, x, row_start, cycle_offsets, cycle_vertices):
     """The children of all marked prisms at once (``refine_prisms_kernels.prisms_children``; its
-    twin: ``prism_children`` cell by cell): per face of a child (row, child, the parent's cycle it is
+    twin: ``refine_prisms_reference.prism_children``): per face of a child (row, child, the parent's cycle it is
     or -1), and the new faces' (sizes, flat vertices)."""
     return children_kernel(*_lattice_table(lattices), row_start, cycle_offsets, cycle_vertices, x, TOL)

@@ -1,9 +1,10 @@
 """Numba kernels of the refinement of prisms (``refine_prisms``), one loop over the marked prisms each.
 
-``prisms_sides`` splits the whole sides of the marked prisms (a cap into the m quadrilaterals Q_i, a
-lateral side into 4 quarters) and ``prisms_children`` makes the faces of their 2m children; their
-twins are ``refine_prisms.split_prism_sides`` and ``prism_children``, cell by cell
-(``tests/mesh3d/test_refine_polyhedra.py`` pins the kernels to them).
+``prisms_plan`` finds every marked prism's corners and the vertices its lattice points name (the
+vertex there already, or the group of corners naming a new one), ``prisms_sides`` splits the whole
+sides (a cap into the m quadrilaterals Q_i, a lateral side into 4 quarters) and ``prisms_children``
+makes the faces of the 2m children. Their twins are the cell-by-cell functions of
+``refine_prisms_reference`` (``tests/mesh3d/test_refine_polyhedra.py`` pins the kernels to them).
 """
 
 from __future__ import annotations
@@ -150,7 +151,7 @@ def _side_pieces(lattice, m, cycle):
 
 @numba.njit(cache=True)
 def prisms_sides(lattice_offsets, lattices, cell_start, faces, face_offsets, face_vertices, face_normals, x, tol):
-    """The whole sides of the marked prisms (``refine_prisms.split_prism_sides``): per side found (row,
+    """The whole sides of the marked prisms (``refine_prisms_reference.split_prism_sides``): per side (row,
     face, number of pieces), row after row, and the pieces' (sizes, flat vertices), as stored (turned
     along ``face_normals``) with the vertices of the cell inside their edges."""
     rows, found, counts = np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64)
@@ -204,7 +205,7 @@ def _plane_labels(normals):
 
 @numba.njit(cache=True)
 def _prism_corners(faces, normals, face_offsets, face_vertices, x):
-    """(bottom, top) corners of a cell (``refine_prisms.prism_corners``), or empty arrays."""
+    """(bottom, top) corners of a cell (``refine_prisms_reference.prism_corners``), or empty arrays."""
     none = np.empty(0, np.int64)
     labels, count = _plane_labels(normals)
     cap_planes = np.zeros(count, np.bool_)
