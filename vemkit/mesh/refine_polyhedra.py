@@ -103,24 +103,30 @@ def predict_refinement(mesh: PolyhedralMesh, marked, circles=None) -> Refinement
 
 
 def _with_midpoints(mesh: PolyhedralMesh, split_edges: tuple):
-    """(offsets, vertices) of the faces with every new edge midpoint inserted between its corners."""
+    """(offsets, vertices) of the faces with every new edge midpoint inserted between its corners
+    (looked up only for the face edges whose two ends are ends of split edges)."""
     offsets, ids = mesh.face_offsets, mesh.face_vertices
     following = np.arange(1, ids.size + 1, dtype=np.int64)
     following[offsets[1:] - 1] = offsets[:-1]
     n = np.int64(mesh.n_vertices)
-    a, b = ids, ids[following]
-    keys = np.minimum(a, b) * n + np.maximum(a, b)
     split_keys, mids = split_edges
     order = np.argsort(split_keys)
     split_keys, mids = split_keys[order], mids[order]
+    ends = np.zeros(mesh.n_vertices, dtype=bool)
+    ends[split_keys // n], ends[split_keys % n] = True, True
+    near = np.flatnonzero(ends[ids] & ends[ids[following]])
+    a, b = ids[near], ids[following[near]]
+    keys = np.minimum(a, b) * n + np.maximum(a, b)
     at = np.clip(np.searchsorted(split_keys, keys), 0, max(split_keys.size - 1, 0))
-    hit = split_keys[at] == keys if split_keys.size else np.zeros(keys.size, dtype=bool)
-    out = np.empty(ids.size + int(hit.sum()), dtype=np.int64)
+    found = split_keys[at] == keys if split_keys.size else np.zeros(keys.size, dtype=bool)
+    hit = np.zeros(ids.size, dtype=bool)
+    hit[near[found]] = True
+    out = np.empty(ids.size + int(found.sum()), dtype=np.int64)
     position = np.arange(ids.size) + np.concatenate([[0], np.cumsum(hit)[:-1]])
     out[position] = ids
-    out[position[hit] + 1] = mids[at[hit]]
+    out[position[near[found]] + 1] = mids[at[found]]
     owner = np.repeat(np.arange(mesh.n_faces), np.diff(offsets))
-    sizes = np.diff(offsets) + np.bincount(owner, weights=hit, minlength=mesh.n_faces).astype(np.int64)
+    sizes = np.diff(offsets) + np.bincount(owner[hit], minlength=mesh.n_faces)
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), out
 
 
