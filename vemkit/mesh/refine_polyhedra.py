@@ -276,7 +276,7 @@ def _rule_pieces(plan, row, cycle, reverse, labels, table_offsets, table_vertice
 def _split_by(mesh, plan: _Plan, sides_of, face_offsets, face_vertices, x):
     """(faces, (sizes, flat, pieces per face)) of the whole sides split by a rule's ``sides_of(mesh,
     lattice, cell, face_offsets, face_vertices, x)`` (pairs of a face and its pieces as stored), each
-    face split once."""
+    face split once: the cell-by-cell twin of the rules' kernels of whole sides (the tests run it)."""
     out: dict = {}
     for row, c in enumerate(plan.cells.tolist()):
         for f, rings in sides_of(mesh, plan.lattice[row], c, face_offsets, face_vertices, x):
