@@ -216,17 +216,22 @@ def _prism_corners(faces, normals, face_offsets, face_vertices, x):
             return none, none
     if cap_planes.sum() != 2:
         return none, none
-    seen = np.empty(0, np.int64)
-    on = np.zeros((0, count), np.bool_)
+    total = 0
+    for f in faces:
+        total += face_offsets[f + 1] - face_offsets[f]
+    seen = np.empty(total, np.int64)
+    on = np.zeros((total, count), np.bool_)
+    n_seen = 0
     for k in range(faces.shape[0]):
         for v in face_vertices[face_offsets[faces[k]] : face_offsets[faces[k] + 1]]:
-            at = np.flatnonzero(seen == v)
-            if at.size == 0:
-                seen = np.append(seen, v)
-                on = np.concatenate((on, np.zeros((1, count), np.bool_)))
-                at = np.array([seen.shape[0] - 1])
-            on[at[0], labels[k]] = True
-    corners = seen[on.sum(axis=1) >= 3]
+            at = 0
+            while at < n_seen and seen[at] != v:
+                at += 1
+            if at == n_seen:
+                seen[at] = v
+                n_seen += 1
+            on[at, labels[k]] = True
+    corners = seen[:n_seen][on[:n_seen].sum(axis=1) >= 3]
     z = x[corners, 2]
     low = z < z.mean()
     bottom, top = corners[low], corners[~low]
@@ -289,7 +294,9 @@ def prisms_plan(cells, cell_start, faces, normals, face_offsets, face_vertices, 
         if m == 0:
             status[r] = 1
             continue
-        corners = np.concatenate((corners, b, t))
+        corners = grown(corners, corner_start[r + 1])
+        corners[corner_start[r] : corner_start[r] + m] = b
+        corners[corner_start[r] + m : corner_start[r + 1]] = t
         size = 0.0
         for axis in range(3):
             size = max(size, x[mine, axis].max() - x[mine, axis].min())
@@ -346,4 +353,4 @@ def prisms_plan(cells, cell_start, faces, normals, face_offsets, face_vertices, 
             keys[n_req] = -1
             keys[n_req, : group.shape[0]] = np.sort(group)
             n_req += 1
-    return status, corner_start, corners, near[:n_req], keys[:n_req], kind[:n_req]
+    return status, corner_start, corners[: corner_start[m_rows]], near[:n_req], keys[:n_req], kind[:n_req]
