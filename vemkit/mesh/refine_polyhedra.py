@@ -175,7 +175,7 @@ def _refined_mesh(mesh, plan: _Plan, labels, cycles, x):
     table, (row, child, cycle, reverse, face_labels) = (
         _box_pieces(plan, *args) if plan.kind == "box" else _rule_pieces(plan, *args)
     )
-    face_id = _face_numbers(table, known, args[1])
+    face_id = _face_numbers(table, known)
     new_cell = np.concatenate([first_child[np.flatnonzero(unmarked)][kept[0]], first_child[cells][row] + child])
     order = np.argsort(new_cell, kind="stable")
     cycle = np.concatenate([kept[1], cycle])[order]
@@ -193,21 +193,13 @@ def _refined_mesh(mesh, plan: _Plan, labels, cycles, x):
     return new, children
 
 
-def _face_numbers(table, known: int, touched: np.ndarray) -> np.ndarray:
+def _face_numbers(table, known: int) -> np.ndarray:
     """A number per cycle of the table, equal for cycles of one face: its own for the ``known`` first
-    ones (the old faces and their pieces), a known one's for a rule's face of the same vertices as one
-    of the ``touched`` known cycles (the marked cells' faces), else one per vertex set."""
+    ones (the old faces and their pieces), one per vertex set for the rest (the children's new faces,
+    inside their parents: the two sides of a face between siblings)."""
     offsets, vertices = table
     out = np.arange(offsets.size - 1)
-    if known == out.size:
-        return out
-    touched = np.unique(touched)
-    ids = np.concatenate([touched, out[known:]])
-    sizes, flat = cycles_of(offsets, vertices, ids, np.zeros(ids.size, dtype=bool))
-    group = same_faces(np.concatenate([[0], np.cumsum(sizes)]), flat)
-    number = known + np.arange(group.max() + 1)
-    number[group[: touched.size]] = touched
-    out[known:] = number[group[touched.size :]]
+    out[known:] = known + same_faces(offsets[known:] - offsets[known], vertices[offsets[known] :])
     return out
 
 
