@@ -114,34 +114,53 @@ def _requests(mesh, cells):
 
 def _new_points(vertices, corners, corner_start, rows, positions, m, n):
     """(points, sources) of the new points, made by the requests (row, position after the corners):
-    the mean of a group's corners, or the area centroid of a cap or of the prism (as ``weights @ x``;
-    a pair's mean as 0.5 a + 0.5 b, the same number, all at once)."""
-    mr, start = m[rows], corner_start[rows]
-    i = positions % np.maximum(mr, 1)
-    j, which = (i + 1) % np.maximum(mr, 1), positions // np.maximum(mr, 1)
-    pair = positions < 3 * mr
-    bi, ti = corners[start + i], corners[np.minimum(start + mr + i, corners.size - 1)]
-    bj, tj = corners[start + j], corners[np.minimum(start + mr + j, corners.size - 1)]
-    ends = np.stack([np.where(which == 2, ti, bi), np.where(which == 0, ti, np.where(which == 1, bj, tj))], axis=1)[
-        pair
-    ]
+    the mean of a group's corners, or the area centroid of a cap or of the prism, as ``weights @ x``
+    (batched: the same numbers as point by point; a pair's mean as 0.5 a + 0.5 b, the same number)."""
+    size, start = m[rows], corner_start[rows]
+    i = positions % np.maximum(size, 1)
+    j, which = (i + 1) % np.maximum(size, 1), positions // np.maximum(size, 1)
+    lower = corners[np.minimum(start[:, None] + np.stack([i, j], axis=1), corners.size - 1)]
+    upper = corners[np.minimum((start + size)[:, None] + np.stack([i, j], axis=1), corners.size - 1)]
     points = np.empty((rows.size, 3))
+    pair = positions < 3 * size
+    ends = np.stack(
+        [
+            np.where(which == 2, upper[:, 0], lower[:, 0]),
+            np.choose(which.clip(0, 2), [upper[:, 0], lower[:, 1], upper[:, 1]]),
+        ],
+        axis=1,
+    )[pair]
     points[pair] = 0.5 * vertices[ends[:, 0]] + 0.5 * vertices[ends[:, 1]]
     sources = [(n + np.flatnonzero(pair), ends, np.full(ends.shape, 0.5))]
-    for k in np.flatnonzero(~pair).tolist():
-        r, q, size = int(rows[k]), int(positions[k]), int(mr[k])
-        b = corners[corner_start[r] : corner_start[r] + size]
-        t = corners[corner_start[r] + size : corner_start[r + 1]]
-        if q < 4 * size:
-            real = [b[q % size], b[(q + 1) % size], t[q % size], t[(q + 1) % size]]
-            weights = np.full(4, 0.25)
-        else:
-            real = list(b) if q == 4 * size else (list(t) if q == 4 * size + 1 else list(b) + list(t))
-            w = _centroid_weights(vertices[real[:size], :2])
-            weights = w if len(real) == size else np.concatenate([w, w]) / 2
-        points[k] = weights @ vertices[real]
-        sources.append((np.array([n + k]), np.array([real]), weights[None, :]))
+    lateral = np.flatnonzero(~pair & (positions < 4 * size))
+    groups = [(lateral, np.concatenate([lower, upper], axis=1)[lateral], None)]
+    for mr in np.unique(size[positions >= 4 * size]).tolist():
+        for k in range(3):  # the bottom cap, the top cap, the prism
+            made = np.flatnonzero((size == mr) & (positions == 4 * mr + k))
+            bottom = corners[start[made, None] + np.arange(mr)]
+            top = corners[start[made, None] + mr + np.arange(mr)]
+            real = [bottom, top, np.concatenate([bottom, top], axis=1)][k]
+            groups.append((made, real, _centroid_weights_batched(vertices[real[:, :mr], :2])))
+    for made, real, w in groups:
+        weights = (
+            np.full(real.shape, 0.25)
+            if w is None
+            else (w if w.shape == real.shape else np.concatenate([w, w], axis=1) / 2)
+        )
+        points[made] = (weights[:, None, :] @ vertices[real])[:, 0]
+        sources.append((n + made, real, weights))
     return points, sources
+
+
+def _centroid_weights_batched(x2):
+    """``_centroid_weights`` of every polygon of x2 (N, k, 2) at once, the same numbers."""
+    e1, e2 = x2[:, 1:-1] - x2[:, :1], x2[:, 2:] - x2[:, :1]
+    area = 0.5 * (e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])
+    w = np.zeros(x2.shape[:2])
+    w[:, 0] = area.sum(axis=1)
+    w[:, 1:-1] += area
+    w[:, 2:] += area
+    return w / (3.0 * area.sum(axis=1))[:, None]
 
 
 def _onto_curves(mesh, cells: np.ndarray, lattices: list, points: np.ndarray, curves) -> np.ndarray:
