@@ -105,6 +105,7 @@ def plan_tetrahedra(mesh, cells: np.ndarray, refinable: str):
     marked tetrahedra (``refine_polyhedra._Plan``'s fields): an edge midpoint is a vertex of the cell
     there already, else new, numbered in order of first request (row by row, edge by edge)."""
     n, vertices = mesh.n_vertices, mesh.vertices
+    _tetrahedra_corners(mesh, cells[:1], refinable)  # the first cell first: most meshes refused by it
     corners = _tetrahedra_corners(mesh, cells, refinable)
     offsets, ids = mesh.cell_vertex_lists
     sizes = offsets[cells + 1] - offsets[cells]
