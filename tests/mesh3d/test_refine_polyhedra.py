@@ -336,3 +336,12 @@ def _by_point(sources):
         for ids, ends_of, weights_of in sources
         for point, ends, weights in zip(ids, ends_of, weights_of)
     }
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_nothing_marked_keeps_every_cell(name):
+    mesh = MESHES[name]()
+    refined = refine_cells(mesh, np.zeros(0, dtype=int))
+    assert refined.mesh.n_cells == mesh.n_cells and refined.mesh.n_vertices == mesh.n_vertices
+    assert np.array_equal(refined.parent, np.arange(mesh.n_cells)) and refined.refined.size == 0
+    assert np.allclose(refined.mesh.cell_volumes, mesh.cell_volumes, rtol=1e-13)

@@ -163,7 +163,7 @@ class _Pools:
         self.scale, self.rows = np.int64(x.shape[0]), lattice.shape[0]
         rows = np.concatenate([row, np.repeat(np.arange(lattice.shape[0]), lattice.shape[1])])
         keys = np.sort(rows * self.scale + np.concatenate([vertex, lattice.ravel()]))
-        self.keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
+        self.keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])[: keys.size]]
         self.row, self.vertex = self.keys // self.scale, self.keys % self.scale
         self.t = 2.0 * (x[self.vertex] - lower[self.row]) / (upper[self.row] - lower[self.row])
 
