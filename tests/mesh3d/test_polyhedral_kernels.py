@@ -1,12 +1,17 @@
 """PolyhedralMesh's Numba kernels (``vemkit.mesh.polyhedral_kernels``) against their numpy twins
-(``polyhedral_reference``) on every 3D family: the same vertex lists exactly, the same face areas
-and centroids to round-off."""
+(``polyhedral_reference``) on every 3D family: the same vertex lists and successors of the smallest
+vertex exactly, the same face areas and centroids to round-off."""
 
 import numpy as np
 import pytest
 
 from vemkit.mesh.families3d import build_mesh3d
-from vemkit.mesh.polyhedral_reference import cell_vertex_lists_reference, face_geometry_reference
+from vemkit.mesh.polyhedral_kernels import successor_of_min
+from vemkit.mesh.polyhedral_reference import (
+    cell_vertex_lists_reference,
+    face_geometry_reference,
+    successor_of_min_reference,
+)
 
 BOX = {"box": [[0, 0, 0], [1, 2, 1]]}
 PLATE = {"extrude": {"depth": 0.3}, "polygon": [[0, 0], [2, 0], [2, 1], [0, 1]], "sides": ["b", "r", "t", "l"]}
@@ -31,3 +36,7 @@ def test_kernels_equal_the_numpy_twins(family, domain, options):
     scale = np.abs(va).max()
     assert np.abs(mesh.face_vector_areas - va).max() <= 1e-14 * scale
     assert np.abs(mesh.face_centroids - centroids).max() <= 1e-14 * np.abs(mesh.vertices).max()
+    reversed_faces = mesh.face_vertices[::-1]  # the same faces run backwards, in reverse order
+    for vertices in (mesh.face_vertices, reversed_faces):
+        expected = successor_of_min_reference(mesh.face_offsets, vertices)
+        assert np.array_equal(successor_of_min(mesh.face_offsets, vertices), expected)

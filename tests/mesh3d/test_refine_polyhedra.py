@@ -222,3 +222,128 @@ def test_new_vertices_of_a_curved_side_stay_on_its_circle():
         validate_mesh3d(refined.mesh)
         assert radius(refined.mesh).max() < 0.25 + 1e-12
         mesh = refined.mesh
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_faces_numbered_by_the_refinement_are_the_faces_of_their_vertices(name):
+    """The refined mesh (faces known by the cycles they come from) is the mesh ``from_face_soup`` finds
+    from its cells' outward faces alone (faces matched by their vertices)."""
+    from vemkit.mesh.polyhedral_build import from_face_soup
+    from vemkit.mesh.refine_boxes import cycles_of
+
+    mesh = MESHES[name]()
+    rng = np.random.default_rng(4)
+    for _ in range(2):
+        mesh = refine_cells(mesh, _random_marking(mesh, rng)).mesh
+        faces = np.abs(mesh.cell_faces + (mesh.cell_faces < 0))
+        sizes, soup = cycles_of(mesh.face_offsets, mesh.face_vertices, faces, mesh.cell_faces < 0)
+        labels = np.full(mesh.n_faces, -1)
+        for k, part in enumerate(mesh.boundary.values()):
+            labels[part] = k
+        names = list(mesh.boundary)
+        again = from_face_soup(mesh.vertices, np.diff(mesh.cell_offsets), sizes, soup, labels[faces], names)
+        for key in ("face_offsets", "face_vertices", "cell_offsets", "cell_faces"):
+            assert np.array_equal(getattr(again, key), getattr(mesh, key))
+        assert all(np.array_equal(again.boundary[k], mesh.boundary[k]) for k in names)
+
+
+def test_ring_kernel_equals_its_numpy_twin(monkeypatch):
+    """The Numba kernel of the boxes' face polygons (``refine_polyhedra_kernels.rectangle_rings``) and
+    its numpy twin give the same refined meshes."""
+    from vemkit.mesh import refine_boxes
+
+    mesh = octree(n=3, rule="random", fraction=0.4, seed=3)
+    rng = np.random.default_rng(6)
+    for _ in range(2):
+        marked = _random_marking(mesh, rng)
+        fast = refine_cells(mesh, marked).mesh
+        with monkeypatch.context() as patch:
+            patch.setattr(refine_boxes, "_rectangle_rings", refine_boxes.rectangle_rings_numpy)
+            twin = refine_cells(mesh, marked).mesh
+        for key in ("face_offsets", "face_vertices", "cell_offsets", "cell_faces"):
+            assert np.array_equal(getattr(fast, key), getattr(twin, key))
+        mesh = fast
+
+
+def _rule_kernels(kind):
+    """(mesh maker, kernel of the whole sides, its twin, kernel of the children, its twin) of a rule."""
+    from vemkit.mesh import refine_prisms as prisms
+    from vemkit.mesh import refine_prisms_reference as twins
+    from vemkit.mesh import refine_tetrahedra as tets
+
+    if kind == "tet":
+        return tet, tets.split_tetrahedra_sides, tets.whole_sides, tets.tetrahedra_children, tets.tetrahedron_children
+    make = lambda n: _extruded("voronoi")  # noqa: E731
+    return make, prisms.split_prisms_sides, twins.split_prism_sides, prisms.prisms_children, twins.prism_children
+
+
+@pytest.mark.parametrize("kind", ["tet", "prism"])
+def test_rule_kernels_equal_their_cell_by_cell_twins(kind):
+    """The whole sides and the children of all marked tetrahedra or prisms at once (Numba kernels) are
+    those of the rule's functions cell by cell, on a mesh with hanging vertices."""
+    from vemkit.mesh import refine_polyhedra as rp
+    from vemkit.mesh.refine_boxes import cycles_of
+
+    make, split_sides, sides_twin, children, children_twin = _rule_kernels(kind)
+    rng = np.random.default_rng(7)
+    mesh = make(2)
+    mesh = refine_cells(mesh, rng.choice(mesh.n_cells, mesh.n_cells // 4, replace=False)).mesh
+    cells = np.sort(rng.choice(mesh.n_cells, mesh.n_cells // 4, replace=False))
+    plan = rp._any_plan(mesh, cells)
+    face_offsets, face_vertices = rp._with_midpoints(mesh, plan.split_edges)
+    x = np.concatenate([mesh.vertices, plan.points])
+    faces, pieces = split_sides(mesh, plan.lattice, cells, face_offsets, face_vertices, x)
+    twin = rp._split_by(mesh, plan, sides_twin, face_offsets, face_vertices, x)
+    assert faces.size and np.array_equal(faces, twin[0])
+    assert all(np.array_equal(a, b) for a, b in zip(pieces, twin[1]))
+    table, face_cycles = rp._cycle_table(mesh, face_offsets, face_vertices, faces, pieces)
+    row, cycle, reverse, face = rp._appearances(mesh, cells, face_cycles)
+    sizes, flat = cycles_of(*table, cycle, reverse)
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    row_start = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=cells.size))])
+    rows, child, source, new_sizes, new_flat = children(plan.lattice, x, row_start, offsets, flat)
+    new = np.split(new_flat, np.cumsum(new_sizes)[:-1])
+    got = [flat[offsets[s] : offsets[s + 1]] if s >= 0 else new.pop(0) for s in source]
+    for r in range(cells.size):
+        cycles = [(k, flat[offsets[k] : offsets[k + 1]]) for k in range(row_start[r], row_start[r + 1])]
+        expected = children_twin(mesh, plan.lattice[r], cycles, np.arange(offsets.size), x)
+        for k, (child_faces, _) in enumerate(expected):
+            mine = [got[i] for i in np.flatnonzero((rows == r) & (child == k))]
+            assert len(mine) == len(child_faces) and all(np.array_equal(a, b) for a, b in zip(mine, child_faces))
+
+
+@pytest.mark.parametrize("name", ["prism-triangle", "prism-voronoi"])
+def test_prism_plan_kernel_equals_its_cell_by_cell_twin(name):
+    """The plan of all marked prisms at once (``refine_prisms_kernels.prisms_plan``) is the one made
+    prism by prism (``refine_prisms_reference.plan_prisms_reference``): lattices, points, sources."""
+    from vemkit.mesh.refine_prisms import plan_prisms
+    from vemkit.mesh.refine_prisms_reference import plan_prisms_reference
+
+    rng = np.random.default_rng(8)
+    mesh = MESHES[name]()
+    for _ in range(2):
+        marked = np.sort(_random_marking(mesh, rng))
+        got, twin = plan_prisms(mesh, marked, ""), plan_prisms_reference(mesh, marked, "")
+        assert all(np.array_equal(a, b) for a, b in zip(got[0], twin[0])) and len(got[0]) == len(twin[0])
+        assert np.array_equal(got[1], twin[1])
+        assert _by_point(got[2]) == _by_point(twin[2])
+        assert all(np.array_equal(a, b) for a, b in zip(got[3], twin[3])) and got[4:] == twin[4:]
+        mesh = refine_cells(mesh, marked).mesh
+
+
+def _by_point(sources):
+    """New point -> (the old vertices it comes from, their weights), from a plan's sources."""
+    return {
+        int(point): (tuple(ends.tolist()), tuple(weights.tolist()))
+        for ids, ends_of, weights_of in sources
+        for point, ends, weights in zip(ids, ends_of, weights_of)
+    }
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_nothing_marked_keeps_every_cell(name):
+    mesh = MESHES[name]()
+    refined = refine_cells(mesh, np.zeros(0, dtype=int))
+    assert refined.mesh.n_cells == mesh.n_cells and refined.mesh.n_vertices == mesh.n_vertices
+    assert np.array_equal(refined.parent, np.arange(mesh.n_cells)) and refined.refined.size == 0
+    assert np.allclose(refined.mesh.cell_volumes, mesh.cell_volumes, rtol=1e-13)

@@ -7,6 +7,8 @@ once, is therefore stored outward), signs the cells' face lists (``-(f + 1)``: f
 names the boundary faces from a label per appearance. No Python loop over cells or faces: a face is
 recognised by its sorted vertex list (rows padded with -1, sorted lexicographically), and two
 appearances run the same way when the vertex after the smallest one is the same.
+``from_numbered_soup`` does the same for a soup whose faces are already known by a number per
+appearance (the refinement of polyhedra, which knows where every face comes from).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import replace
 import numpy as np
 
 from vemkit.mesh.polyhedral import PolyhedralMesh
+from vemkit.mesh.polyhedral_kernels import successor_of_min
 
 
 def csr_rows(offsets: np.ndarray, values: np.ndarray, fill: int = -1) -> np.ndarray:
@@ -28,11 +31,18 @@ def csr_rows(offsets: np.ndarray, values: np.ndarray, fill: int = -1) -> np.ndar
     return out
 
 
-def _successor_of_min(table: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """The vertex after the smallest one in every padded cycle."""
-    big = np.where(table >= 0, table, np.iinfo(np.int64).max)
-    at = np.argmin(big, axis=1)
-    return table[np.arange(table.shape[0]), (at + 1) % np.maximum(sizes, 1)]
+def same_faces(offsets: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """A number per CSR cycle, equal for cycles of the same vertices (the sorted vertex lists, padded
+    with -1, ranked lexicographically)."""
+    table = csr_rows(offsets, vertices)
+    ordered = np.sort(np.where(table >= 0, table, np.iinfo(np.int64).max), axis=1)
+    order = np.lexsort(ordered.T[::-1]) if ordered.shape[0] else np.zeros(0, np.int64)
+    s = ordered[order]
+    new = np.ones(order.size, dtype=bool)
+    new[1:] = (s[1:] != s[:-1]).any(axis=1)
+    group = np.empty(order.size, dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    return group
 
 
 def from_face_soup(
@@ -47,27 +57,31 @@ def from_face_soup(
     face_sizes = np.asarray(face_sizes, dtype=np.int64)
     flat = np.asarray(face_vertices, dtype=np.int64)
     offsets = np.concatenate([[0], np.cumsum(face_sizes)]).astype(np.int64)
-    table = csr_rows(offsets, flat)
-    ordered = np.sort(np.where(table >= 0, table, np.iinfo(np.int64).max), axis=1)
-    order = np.lexsort(ordered.T[::-1]) if ordered.shape[0] else np.zeros(0, np.int64)
-    s = ordered[order]
-    new = np.ones(order.size, dtype=bool)
-    new[1:] = (s[1:] != s[:-1]).any(axis=1)
-    group = np.cumsum(new) - 1
-    face_of = np.empty(order.size, dtype=np.int64)
-    face_of[order] = group
-    first = order[new]  # the first appearance of each face (lexsort is stable)
+    return from_numbered_soup(
+        vertices, cell_sizes, face_sizes, flat, same_faces(offsets, flat), labels, label_names, meta
+    )
+
+
+def from_numbered_soup(
+    vertices, cell_sizes, face_sizes, face_vertices, face_ids, labels=None, label_names=(), meta=None
+) -> PolyhedralMesh:
+    """``from_face_soup`` of a soup whose faces are known: ``face_ids`` (O,) a number per appearance,
+    equal for the appearances of one face (the same vertices, in the same or the opposite order)."""
+    face_sizes = np.asarray(face_sizes, dtype=np.int64)
+    flat = np.asarray(face_vertices, dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(face_sizes)]).astype(np.int64)
+    _, first, face_of = np.unique(np.asarray(face_ids, dtype=np.int64), return_index=True, return_inverse=True)
     # number the faces by first appearance, so that the numbering follows the cells
     rank = np.empty(first.size, dtype=np.int64)
     by_appearance = np.argsort(first, kind="stable")
     rank[by_appearance] = np.arange(first.size)
-    face_of = rank[face_of]
+    face_of = rank[face_of.ravel()]
     first = first[by_appearance]
-    succ = _successor_of_min(table, face_sizes)
+    succ = successor_of_min(offsets, flat)
     same = succ == succ[first][face_of]
     signed = np.where(same, face_of, -face_of - 1)
     stored_sizes = face_sizes[first]
-    stored = table[first][table[first] >= 0] if first.size else np.zeros(0, np.int64)
+    stored = flat[segments(offsets[first], stored_sizes)]
     uses = np.bincount(face_of, minlength=first.size)
     boundary = {}
     if labels is not None:
@@ -87,6 +101,13 @@ def from_face_soup(
         {k: np.sort(v) for k, v in boundary.items()},
         meta or {},
     )
+
+
+def segments(starts: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """The indices start, ..., start + size - 1 of every segment, one after the other."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    total = int(sizes.sum())
+    return np.repeat(np.asarray(starts, dtype=np.int64) - np.cumsum(sizes) + sizes, sizes) + np.arange(total)
 
 
 def tag_box_faces(mesh: PolyhedralMesh, lower, upper, sides, tol: float = 1e-10) -> PolyhedralMesh:

@@ -1,5 +1,6 @@
 """Numba kernels of :class:`~vemkit.mesh.polyhedral.PolyhedralMesh`'s derived topology and face
-geometry: one pass over the cells or faces, no sort, no (entries x 3) temporaries. Their numpy
+geometry, and of the orientation test of ``polyhedral_build`` (the vertex after the smallest one of
+every face): one pass over the cells or faces, no sort, no (entries x 3) temporaries. Their numpy
 twins are ``polyhedral_reference``."""
 
 from __future__ import annotations
@@ -82,3 +83,20 @@ def face_geometry(vertices, face_offsets, face_vertices):
             centroid[f, 1] += m1 / total
             centroid[f, 2] += m2 / total
     return va, centroid
+
+
+@numba.njit(cache=True)
+def successor_of_min(offsets, vertices):
+    """The vertex after the smallest one (its first place) in every CSR cycle."""
+    out = np.empty(offsets.shape[0] - 1, dtype=np.int64)
+    for c in range(out.shape[0]):
+        s, n = offsets[c], offsets[c + 1] - offsets[c]
+        if n == 0:
+            out[c] = -1
+            continue
+        at = 0
+        for i in range(1, n):
+            if vertices[s + i] < vertices[s + at]:
+                at = i
+        out[c] = vertices[s + (at + 1) % n]
+    return out

@@ -53,3 +53,13 @@ def face_geometry_reference(vertices, face_offsets, face_vertices) -> tuple[np.n
     shift = np.zeros_like(mean)
     shift[ok] = moment[ok] / total[ok, None]
     return va, mean + shift
+
+
+def successor_of_min_reference(offsets: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """The vertex after the smallest one in every CSR cycle (cycles padded to a table)."""
+    sizes = np.diff(offsets)
+    rows = np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
+    table = np.full((sizes.size, int(sizes.max()) if sizes.size else 0), -1, dtype=np.int64)
+    table[rows, np.arange(vertices.size, dtype=np.int64) - offsets[:-1][rows]] = vertices
+    at = np.argmin(np.where(table >= 0, table, np.iinfo(np.int64).max), axis=1)
+    return table[np.arange(table.shape[0]), (at + 1) % np.maximum(sizes, 1)]

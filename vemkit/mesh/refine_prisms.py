@@ -13,6 +13,9 @@ every vertex of the parent lying on its edges inserted in order. On a curved sid
 an arc of the base, ``vemkit.mesh.curves``) the new points of a whole lateral side move radially onto
 the circle, all three together, where every cell along its cap edges splits there too; otherwise they
 stay on the chord (so that no face bends).
+
+The plan, the whole sides and the children of all marked prisms are made at once by the Numba kernels
+of ``refine_prisms_kernels``, whose twins are the cell-by-cell functions of ``refine_prisms_reference``.
 """
 
 from __future__ import annotations
@@ -23,52 +26,12 @@ import numpy as np
 
 from vemkit.exceptions import MeshError
 from vemkit.mesh.curves import as_pieces, on_curves
-from vemkit.mesh.refine_tetrahedra import TOL, _on_edges, plane_labels
-
-
-def _newell(x, ids):
-    """The normal (times twice the area) of the polygon x[ids] by Newell's formula."""
-    p, q = x[ids], x[np.append(ids[1:], ids[0])]
-    return np.array(
-        [
-            ((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),
-            ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
-            ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum(),
-        ]
-    )
-
-
-def prism_corners(mesh, c: int):
-    """(bottom corners, top corners) of cell c, counter-clockwise from +z and matched, or None when
-    it is not a prism along z over a convex polygon."""
-    signed = mesh.cell_face_list(c)
-    faces = np.where(signed >= 0, signed, -signed - 1)
-    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    planes = plane_labels(normals)
-    caps = np.abs(normals[:, 2]) > 1 - 1e-9
-    if np.abs(normals[~caps, 2]).max(initial=0) > 1e-9 or np.unique(planes[caps]).size != 2:
-        return None
-    on = {}
-    for f, plane in zip(faces, planes):
-        for v in mesh.face(f).tolist():
-            on.setdefault(v, set()).add(int(plane))
-    corners = np.array([v for v, p in on.items() if len(p) >= 3])
-    x = mesh.vertices[corners]
-    low = x[:, 2] < x[:, 2].mean()
-    bottom, top = corners[low], corners[~low]
-    if bottom.size < 3 or bottom.size != top.size:
-        return None
-    centre = mesh.vertices[bottom, :2].mean(axis=0)
-    bottom = bottom[np.argsort(np.arctan2(*(mesh.vertices[bottom, :2] - centre).T[::-1]))]
-    match = np.linalg.norm(mesh.vertices[top, None, :2] - mesh.vertices[None, bottom, :2], axis=2).argmin(axis=0)
-    top = top[match]
-    p = mesh.vertices[bottom, :2]
-    e, f = np.roll(p, -1, axis=0) - p, np.roll(p, -2, axis=0) - np.roll(p, -1, axis=0)
-    turn = e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]
-    if (turn <= 0).any() or np.unique(match).size != top.size:
-        return None
-    return bottom, top
+from vemkit.mesh.polyhedral_build import segments
+from vemkit.mesh.refine_boxes import unique_rows
+from vemkit.mesh.refine_prisms_kernels import prisms_children as children_kernel
+from vemkit.mesh.refine_prisms_kernels import prisms_plan as plan_kernel
+from vemkit.mesh.refine_prisms_kernels import prisms_sides as sides_kernel
+from vemkit.mesh.refine_tetrahedra import TOL
 
 
 def _centroid_weights(x2):
@@ -83,74 +46,121 @@ def _centroid_weights(x2):
     return w / (3.0 * area.sum())
 
 
-def _check_lateral_faces(mesh, c: int, b, t, tol: float) -> None:
-    """Every lateral face of a marked prism is a whole side or lies in one half of its depth."""
-    zm = 0.5 * (mesh.vertices[b, 2].mean() + mesh.vertices[t, 2].mean())
-    corners = set(b.tolist()) | set(t.tolist())
-    for s in mesh.cell_face_list(c).tolist():
-        face = mesh.face(s if s >= 0 else -s - 1)
-        z = mesh.vertices[face, 2]
-        if z.min() < zm - tol and z.max() > zm + tol and np.ptp(z) > 0 and len(corners.intersection(face.tolist())) < 4:
-            raise MeshError(
-                f"cell {c} has a lateral face across its mid-depth without being a whole side (the hanging "
-                "vertices of an extruded mesh with hanging nodes); 3D refinement splits prisms whose lateral faces "
-                "are whole sides or lie in one half of the depth"
-            )
-
-
 def plan_prisms(mesh, cells: np.ndarray, refinable: str, curves=None):
     """(lattices, new points, sources, split edges, faces added by splits, inner faces) of the marked
     prisms; a lattice is B, T, V, SB, ST, SM (m each: corners, vertical midpoints, edge midpoints
-    at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism)."""
+    at the bottom, top and mid-depth) then ZB, ZT, ZM (the centroids of the caps and of the prism).
+    A point is a vertex of the cell there already, else new, named by its group of corners and
+    numbered in order of first request (``refine_prisms_kernels.prisms_plan``)."""
     n, vertices = mesh.n_vertices, mesh.vertices
+    status, corner_start, corners, near, keys, kind = _requests(mesh, cells)
+    if status.any():
+        row = int(np.flatnonzero(status)[0])
+        raise MeshError(
+            f"cell {cells[row]} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box, a "
+            f"tetrahedron or a prism along z over a convex polygon; 3D refinement splits the cells of the families "
+            f"{refinable}"
+            if status[row] == 1
+            else f"cell {cells[row]} has a lateral face across its mid-depth without being a whole side (the hanging "
+            "vertices of an extruded mesh with hanging nodes); 3D refinement splits prisms whose lateral faces are "
+            "whole sides or lie in one half of the depth"
+        )
+    m = np.diff(corner_start) // 2
+    new = near < 0
+    unique, inverse = unique_rows(keys[new])
+    first = np.full(unique.shape[0], near.size, dtype=np.int64)
+    np.minimum.at(first, inverse, np.flatnonzero(new))
+    rank = np.empty(unique.shape[0], dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(unique.shape[0])
+    values = near.copy()
+    values[new] = n + rank[inverse]
+    request_start = np.concatenate([[0], np.cumsum(4 * m + 3)])
+    lattices = [
+        np.concatenate(
+            [corners[corner_start[r] : corner_start[r + 1]], values[request_start[r] : request_start[r + 1]]]
+        )
+        for r in range(cells.size)
+    ]
+    created = np.sort(first)  # the requests that make the new points, in order
+    row_of = np.repeat(np.arange(cells.size), 4 * m + 3)
+    points, sources = _new_points(
+        vertices, corners, corner_start, row_of[created], created - request_start[row_of[created]], m, n
+    )
+    pairs = kind[created] == 0
+    edges = np.sort(keys[created[pairs], :2], axis=1)
+    mids = n + np.flatnonzero(pairs)
+    edge_keys = edges[:, 0] * np.int64(n) + edges[:, 1]
+    order = np.argsort(edge_keys)
+    pieces = np.where(kind[created] == 1, 3, np.where(kind[created] == 2, m[row_of[created]] - 1, 0))
+    points = _onto_curves(mesh, cells, lattices, points, curves)
+    return lattices, points, sources, (edge_keys[order], mids[order]), int(pieces.sum()), int(3 * m.sum())
+
+
+def _requests(mesh, cells):
+    """``refine_prisms_kernels.prisms_plan`` of the marked cells."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
+    faces = np.where(signed >= 0, signed, -signed - 1)
+    normals = mesh.face_vector_areas[faces] * np.where(signed >= 0, 1.0, -1.0)[:, None]
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     offsets, ids = mesh.cell_vertex_lists
-    new_of, points, sources, lattices, extra, inner = {}, [], [], [], {}, 0
-    for c in cells.tolist():
-        found = prism_corners(mesh, c)
-        if found is None:
-            raise MeshError(
-                f"cell {c} of the {mesh.meta.get('family', 'given')} mesh is not an axis-aligned box, a tetrahedron "
-                f"or a prism along z over a convex polygon; 3D refinement splits the cells of the families {refinable}"
-            )
-        b, t = found
-        m = b.size
-        own = ids[offsets[c] : offsets[c + 1]]
-        size = np.ptp(vertices[own], axis=0).max()
-        _check_lateral_faces(mesh, c, b, t, TOL * size)
-        nb, nt = np.roll(b, -1), np.roll(t, -1)
-        groups = [[b[i], t[i]] for i in range(m)] + [[b[i], nb[i]] for i in range(m)]
-        groups += [[t[i], nt[i]] for i in range(m)] + [[b[i], nb[i], t[i], nt[i]] for i in range(m)]
-        groups += [list(b), list(t), list(b) + list(t) + [-1 - c]]
-        row = list(b) + list(t)
-        for k, group in enumerate(groups):
-            real = [g for g in group if g >= 0]
-            weights = np.full(len(real), 1.0 / len(real))
-            if k >= 4 * m:  # a centroid: of a cap, or between the caps
-                w = _centroid_weights(vertices[real[:m], :2])
-                weights = w if len(real) == m else np.concatenate([w, w]) / 2
-            point = weights @ vertices[real]
-            near = own[np.linalg.norm(vertices[own] - point, axis=1) < TOL * size]
-            key = tuple(sorted(group))
-            if near.size:
-                row.append(int(near[0]))
-                continue
-            if key not in new_of:
-                new_of[key] = n + len(points)
-                points.append(point)
-                sources.append((np.array([new_of[key]]), np.array([real]), weights[None, :]))
-            row.append(new_of[key])
-        lattices.append(np.array(row, dtype=np.int64))
-        inner += 3 * m
-        for key, pieces in ((tuple(sorted([b[i], nb[i], t[i], nt[i]])), 4) for i in range(m)):
-            extra[key] = pieces - 1
-        extra[tuple(sorted(b))] = extra[tuple(sorted(t))] = m - 1
-    edges = np.array([k for k in new_of if len(k) == 2], dtype=np.int64).reshape(-1, 2)
-    mids = np.array([new_of[tuple(k)] for k in edges.tolist()], dtype=np.int64)
-    keys = edges[:, 0] * np.int64(n) + edges[:, 1]
-    order = np.argsort(keys)
-    added = sum(v for k, v in extra.items() if tuple(k) in new_of)  # a whole side has a new centre
-    points = _onto_curves(mesh, cells, lattices, np.array(points).reshape(-1, 3), curves)
-    return lattices, points, sources, (keys[order], mids[order]), added, inner
+    own_sizes = offsets[cells + 1] - offsets[cells]
+    own = ids[segments(offsets[cells], own_sizes)]
+    width = 2 * int(own_sizes.max(initial=1)) + 1
+    args = (mesh.face_offsets, mesh.face_vertices, np.concatenate([[0], np.cumsum(own_sizes)]), own)
+    cell_start = np.concatenate([[0], np.cumsum(sizes)])
+    return plan_kernel(cells.astype(np.int64), cell_start, faces, normals, *args, mesh.vertices, width, TOL)
+
+
+def _new_points(vertices, corners, corner_start, rows, positions, m, n):
+    """(points, sources) of the new points, made by the requests (row, position after the corners):
+    the mean of a group's corners, or the area centroid of a cap or of the prism, as ``weights @ x``
+    (batched: the same numbers as point by point; a pair's mean as 0.5 a + 0.5 b, the same number)."""
+    size, start = m[rows], corner_start[rows]
+    i = positions % np.maximum(size, 1)
+    j, which = (i + 1) % np.maximum(size, 1), positions // np.maximum(size, 1)
+    lower = corners[np.minimum(start[:, None] + np.stack([i, j], axis=1), corners.size - 1)]
+    upper = corners[np.minimum((start + size)[:, None] + np.stack([i, j], axis=1), corners.size - 1)]
+    points = np.empty((rows.size, 3))
+    pair = positions < 3 * size
+    ends = np.stack(
+        [
+            np.where(which == 2, upper[:, 0], lower[:, 0]),
+            np.choose(which.clip(0, 2), [upper[:, 0], lower[:, 1], upper[:, 1]]),
+        ],
+        axis=1,
+    )[pair]
+    points[pair] = 0.5 * vertices[ends[:, 0]] + 0.5 * vertices[ends[:, 1]]
+    sources = [(n + np.flatnonzero(pair), ends, np.full(ends.shape, 0.5))]
+    lateral = np.flatnonzero(~pair & (positions < 4 * size))
+    groups = [(lateral, np.concatenate([lower, upper], axis=1)[lateral], None)]
+    for mr in np.unique(size[positions >= 4 * size]).tolist():
+        for k in range(3):  # the bottom cap, the top cap, the prism
+            made = np.flatnonzero((size == mr) & (positions == 4 * mr + k))
+            bottom = corners[start[made, None] + np.arange(mr)]
+            top = corners[start[made, None] + mr + np.arange(mr)]
+            real = [bottom, top, np.concatenate([bottom, top], axis=1)][k]
+            groups.append((made, real, _centroid_weights_batched(vertices[real[:, :mr], :2])))
+    for made, real, w in groups:
+        weights = (
+            np.full(real.shape, 0.25)
+            if w is None
+            else (w if w.shape == real.shape else np.concatenate([w, w], axis=1) / 2)
+        )
+        points[made] = (weights[:, None, :] @ vertices[real])[:, 0]
+        sources.append((n + made, real, weights))
+    return points, sources
+
+
+def _centroid_weights_batched(x2):
+    """``_centroid_weights`` of every polygon of x2 (N, k, 2) at once, the same numbers."""
+    e1, e2 = x2[:, 1:-1] - x2[:, :1], x2[:, 2:] - x2[:, :1]
+    area = 0.5 * (e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])
+    w = np.zeros(x2.shape[:2])
+    w[:, 0] = area.sum(axis=1)
+    w[:, 1:-1] += area
+    w[:, 2:] += area
+    return w / (3.0 * area.sum(axis=1))[:, None]
 
 
 def _onto_curves(mesh, cells: np.ndarray, lattices: list, points: np.ndarray, curves) -> np.ndarray:
@@ -228,67 +238,32 @@ def _cells_around(mesh, caps: np.ndarray) -> np.ndarray:
     return out
 
 
-def _ring(m: int, level: int, i: int) -> list:
-    """Lattice positions of Q_i (c_i, s_i, z, s_{i-1}) at level 0 (bottom), 1 (mid-depth) or 2 (top)."""
-    corner, mid, centre = [(0, 3 * m, 6 * m), (2 * m, 5 * m, 6 * m + 2), (m, 4 * m, 6 * m + 1)][level]
-    return [corner + i, mid + i, centre, mid + (i - 1) % m]
+def _lattice_table(lattices: list):
+    """(offsets, flat) of the prisms' lattices (6 m + 3 ids each)."""
+    offsets = np.concatenate([[0], np.cumsum([lattice.size for lattice in lattices])]).astype(np.int64)
+    return offsets, np.concatenate(lattices).astype(np.int64) if lattices else np.zeros(0, np.int64)
 
 
-def _oriented(x, ids, direction):
-    return ids if _newell(x, ids) @ direction > 0 else ids[::-1]
-
-
-def split_prism_sides(mesh, lattice, cell: int, face_offsets, face_vertices, x):
-    """(face, pieces as stored) of the sides of a marked prism that are one face."""
-    m = (lattice.size - 3) // 6
-    signed = mesh.cell_face_list(cell)
+def split_prisms_sides(mesh, lattices: list, cells, face_offsets, face_vertices, x):
+    """(faces, (sizes, flat vertices, pieces per face) of their pieces, as stored) of the whole sides of
+    the marked prisms (``refine_prisms_kernels.prisms_sides``; its twin:
+    ``refine_prisms_reference.split_prism_sides``
+    cell by cell), each split once (by the first marked prism it is a whole side of)."""
+    sizes = mesh.cell_offsets[cells + 1] - mesh.cell_offsets[cells]
+    signed = mesh.cell_faces[segments(mesh.cell_offsets[cells], sizes)]
     faces = np.where(signed >= 0, signed, -signed - 1)
-    cycles = [face_vertices[face_offsets[f] : face_offsets[f + 1]] for f in faces]
-    pool = np.union1d(np.concatenate(cycles), lattice)
-    for f, cycle in zip(faces.tolist(), cycles):
-        if np.isin(lattice[:m], cycle).all():
-            pieces = [_ring(m, 0, i) for i in range(m)]
-        elif np.isin(lattice[m : 2 * m], cycle).all():
-            pieces = [_ring(m, 2, i) for i in range(m)]
-        else:
-            i = next(
-                (i for i in range(m) if np.isin(lattice[[i, (i + 1) % m, m + i, m + (i + 1) % m]], cycle).all()), None
-            )
-            if i is None:
-                continue
-            j = (i + 1) % m
-            B, T, V, SB, ST, SM = (k * m for k in range(6))
-            pieces = [[B + i, SB + i, SM + i, V + i], [SB + i, B + j, V + j, SM + i]]
-            pieces += [[SM + i, V + j, T + j, ST + i], [V + i, SM + i, ST + i, T + i]]
-        direction = mesh.face_vector_areas[f]
-        yield f, [_on_edges(_oriented(x, lattice[p], direction), pool, x) for p in pieces]
+    cell_start = np.concatenate([[0], np.cumsum(sizes)])
+    args = (cell_start, faces, face_offsets, face_vertices, mesh.face_vector_areas, x, TOL)
+    _, found, counts, piece_sizes, flat = sides_kernel(*_lattice_table(lattices), *args)
+    first = np.sort(np.unique(found, return_index=True)[1])
+    pieces = segments(np.concatenate([[0], np.cumsum(counts)])[first], counts[first])
+    piece_offsets = np.concatenate([[0], np.cumsum(piece_sizes)])
+    flat = flat[segments(piece_offsets[pieces], piece_sizes[pieces])]
+    return found[first], (piece_sizes[pieces], flat, counts[first])
 
 
-def prism_children(mesh, lattice, cycles: list, labels, x):
-    """The outward faces and labels of the 2m children of a marked prism; ``cycles``: its (face,
-    outward cycle) with its whole sides already split."""
-    m = (lattice.size - 3) // 6
-    pool = np.union1d(np.concatenate([cycle for _, cycle in cycles]), lattice)
-    centres = np.array([x[cycle].mean(axis=0) for _, cycle in cycles])
-    size = np.ptp(x[lattice], axis=0).max()
-    upper = centres[:, 2] > x[lattice[6 * m + 2], 2]
-    out = []
-    for layer in (0, 1):
-        for i in range(m):
-            low, high = _ring(m, layer, i), _ring(m, layer + 1, i)
-            q = x[lattice[_ring(m, 0, i)], :2]
-            d, r = np.roll(q, -1, axis=0) - q, centres[:, None, :2] - q[None]
-            cross = d[None, :, 0] * r[:, :, 1] - d[None, :, 1] * r[:, :, 0]
-            mine = np.flatnonzero((cross > -TOL * size * size).all(axis=1) & (upper == bool(layer)))
-            faces = [cycles[k][1] for k in mine]
-            face_labels = [labels[cycles[k][0]] for k in mine]
-            child_centre = x[lattice[low + high]].mean(axis=0)
-            polygons = [] if layer == 0 else [low]
-            polygons += [] if layer == 1 else [high]
-            polygons += [[low[k], low[k + 1], high[k + 1], high[k]] for k in (1, 2)]
-            for polygon in polygons:
-                ids = lattice[polygon]
-                faces.append(_on_edges(_oriented(x, ids, x[ids].mean(axis=0) - child_centre), pool, x))
-                face_labels.append(-1)
-            out.append((faces, face_labels))
-    return out
+def prisms_children(lattices: list, x, row_start, cycle_offsets, cycle_vertices):
+    """The children of all marked prisms at once (``refine_prisms_kernels.prisms_children``; its
+    twin: ``refine_prisms_reference.prism_children``): per face of a child (row, child, the parent's cycle it is
+    or -1), and the new faces' (sizes, flat vertices)."""
+    return children_kernel(*_lattice_table(lattices), row_start, cycle_offsets, cycle_vertices, x, TOL)
