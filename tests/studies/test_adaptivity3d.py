@@ -108,6 +108,7 @@ def test_the_cli_writes_the_3d_adaptive_file_and_its_vtu(tmp_path):
     [
         ("adaptivity.max_hanging=1", "adaptivity.max_hanging = 1: the refinement of 3D bodies"),
         ("discretization.mesh.family=voronoi", "vemkit adapt: cell "),
+        ("adaptivity.reference=any.nc", "adaptivity.reference: the true error against a reference solution"),
     ],
 )
 def test_what_3d_refinement_cannot_do_is_refused_in_one_line_before_solving(tmp_path, override, message):

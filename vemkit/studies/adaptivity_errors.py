@@ -92,12 +92,24 @@ def reference_path(scene) -> Path | None:
     return base / name
 
 
+#: the bodies whose adaptive runs measure a true error against a reference file (the common refinement
+#: of ``_common_quadrature`` locates points in polygons)
+REFERENCE_DIMENSIONS = (2,)
+
+
 def load_reference(scene) -> ReferenceSolution | None:
     """The reference solution of ``adaptivity.reference``, read as an input
     (:func:`vemkit.studies.reference_file.read_reference_file`) and checked to solve the scene's problem."""
     path = reference_path(scene)
     if path is None:
         return None
+    if scene.dimension not in REFERENCE_DIMENSIONS:
+        raise InputError(
+            f"adaptivity.reference: the true error against a reference solution is measured on plane bodies "
+            f"(the common refinement of two polygonal meshes), not on this {scene.dimension}D body; leave "
+            "adaptivity.reference out (a scene with exact: measures its true error against it)",
+            key="adaptivity.reference",
+        )
     if not path.exists():
         raise InputError(
             f"adaptivity.reference = {str(path)!r}: no such file; give a solution file written by "
