@@ -43,7 +43,9 @@ def require_petsc4py():
     try:
         import petsc4py
     except ImportError:
-        raise SceneError(f"solver.linear = petsc needs petsc4py, which is not installed; {INSTALL_FIX}", key="solver.linear") from None
+        raise SceneError(
+            f"solver.linear = petsc needs petsc4py, which is not installed; {INSTALL_FIX}", key="solver.linear"
+        ) from None
     if "petsc4py.PETSc" not in sys.modules:
         petsc4py.init([sys.argv[0] if sys.argv and sys.argv[0] else "vemkit"])
     from petsc4py import PETSc
