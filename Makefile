@@ -29,11 +29,11 @@ LOCK   := requirements.lock
 
 # The mpi extra (solver.linear: petsc) builds petsc and mpi4py from source against Debian's MPICH and
 # OpenBLAS/LAPACK, which tools/install_mpi_libs.sh installs when missing (as root; else one line says
-# what to install). PETSc without Fortran or C++ (no gfortran needed). mpi4py from source too: its
-# wheel carries another MPI than Debian's libmpich. The first build takes ~20 min on 2 cores; pip
-# caches the wheels (~/.cache/pip), so later installs take seconds.
+# what to install). PETSc without Fortran, C++ or CUDA (no gfortran; an nvcc on PATH is not used).
+# mpi4py from source too: its wheel carries another MPI than Debian's libmpich. The first build
+# takes ~20 min on 2 cores; pip caches the wheels (~/.cache/pip): later installs take seconds.
 export MPICC ?= mpicc
-export PETSC_CONFIGURE_OPTIONS ?= --with-fc=0 --with-cxx=0 --with-x=0
+export PETSC_CONFIGURE_OPTIONS ?= --with-fc=0 --with-cxx=0 --with-x=0 --with-cuda=0
 
 $(STAMP): pyproject.toml $(LOCK)
 	@bash tools/install_mpi_libs.sh
