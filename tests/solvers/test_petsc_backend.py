@@ -61,7 +61,7 @@ def test_a_3d_matrix_has_blocks_of_three_and_the_rigid_motions_as_near_nullspace
     solver = linear_solver(problem.stiffness, "petsc", near_nullspace=problem.near_nullspace, tol=1e-12)
     assert solver.matrix.getBlockSize() == 3
     near = solver.matrix.getNearNullSpace()
-    modes = np.column_stack([v.getArray() for v in near.getVecs()])
+    modes = np.column_stack([v.getArray(readonly=True) for v in near.getVecs()])
     assert modes.shape[1] == 6 and np.allclose(modes.T @ modes, np.eye(6))  # orthonormal
     x = solver.solve(problem.load)
     assert solver.iterations > 0 and solver.residual <= 1e-12

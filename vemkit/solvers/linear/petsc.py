@@ -47,7 +47,7 @@ def require_petsc4py():
             f"solver.linear = petsc needs petsc4py, which is not installed; {INSTALL_FIX}", key="solver.linear"
         ) from None
     if "petsc4py.PETSc" not in sys.modules:
-        petsc4py.init([sys.argv[0] if sys.argv and sys.argv[0] else "vemkit"])
+        petsc4py.init(["vemkit"])  # a program name, no option
     from petsc4py import PETSc
 
     return PETSc
@@ -67,7 +67,8 @@ def petsc_matrix(A, bs: int = 1, near_nullspace=None):
     if not A.has_sorted_indices:
         A = A.sorted_indices()
     csr = (A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data.astype(PETSc.ScalarType))
-    M = PETSc.Mat().createAIJ(size=A.shape, bs=bs, csr=csr, comm=PETSc.COMM_SELF)
+    M = PETSc.Mat().createAIJ(size=A.shape, bsize=bs, csr=csr, comm=PETSc.COMM_SELF)
+    M.assemble()
     if near_nullspace is not None:
         orthonormal, _ = np.linalg.qr(np.asarray(near_nullspace, dtype=float))
         vectors = []
@@ -97,9 +98,9 @@ def scene_options(prefix: str, options: dict):
         yield
     except PETSc.Error as error:
         shown = ", ".join(f"{name}: {_option_text(value)}" for name, value in options.items()) or "none"
+        said = str(error).strip().splitlines()[-1].split("] ", 1)[-1]  # PETSc's last line: the reason
         raise SceneError(
-            f"solver.petsc_options ({shown}): PETSc refused the set-up ({' '.join(str(error).split())}); "
-            "fix or remove the option",
+            f"solver.petsc_options ({shown}): PETSc refused the set-up ({said}); fix or remove the option",
             key="solver.petsc_options",
         ) from None
     finally:
