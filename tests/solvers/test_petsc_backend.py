@@ -1,7 +1,8 @@
 """solver.linear: petsc (vemkit/solvers/linear/petsc.py, issue 37 item 2, one process): PETSc's CG + GAMG
 gives the AMG backend's solution to 1e-8 (relative) on the paper scene and on 3D friction (hex and
-Voronoi), with ssn and uzawa; the scene's petsc_options reach PETSc, a bad one is refused in one line
-through the real command, and a missing petsc4py is one line naming solver.linear and the fix."""
+Voronoi), with ssn and uzawa, and on Coulomb's coupled law (GMRES); the scene's petsc_options reach
+PETSc, a bad one is refused in one line through the real command, and a missing petsc4py is one line
+naming solver.linear and the fix."""
 
 import subprocess
 import sys
@@ -51,6 +52,16 @@ def test_petsc_gives_the_amg_solution(path, mesh, method):
     assert petsc.info["linear"] == "petsc" and problem.contact.size > 0
     assert np.linalg.norm(petsc.u - amg.u) <= 1e-8 * np.linalg.norm(amg.u)
     assert np.linalg.norm(petsc.multiplier - amg.multiplier) <= 1e-8 * max(np.linalg.norm(amg.multiplier), 1.0)
+
+
+def test_the_unsymmetric_newton_steps_of_coulombs_coupled_law():
+    """m_tau = 1 (k_tau = 0.3 k_nu): GMRES on the Newton steps, the AMG backend's solution."""
+    pytest.importorskip("petsc4py")
+    coupled = ["contact.friction.k=60.0", "contact.friction.m=1.0", "discretization.mesh.n=4"]
+    _, amg = solved(BOX, coupled + SETTINGS["ssn"] + ["solver.linear=amg"])
+    problem, petsc = solved(BOX, coupled + SETTINGS["ssn"] + ["solver.linear=petsc"])
+    assert not problem.law.reduced and petsc.info.get("fallback") is None
+    assert np.linalg.norm(petsc.u - amg.u) <= 1e-8 * np.linalg.norm(amg.u)
 
 
 def test_a_3d_matrix_has_blocks_of_three_and_the_rigid_motions_as_near_nullspace():
