@@ -13,7 +13,7 @@ have_all() {
         { ldconfig -p | grep -q 'liblapack\.so ' || [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ]; }
 }
 if have_all; then
-    echo "mpi: mpicc, mpiexec, gcc and LAPACK found ($(mpichversion 2>/dev/null | head -1 | tr -s ' ' || mpicc -show | cut -d' ' -f1))"
+    echo "mpi: mpicc, mpiexec, gcc and LAPACK found ($(mpichversion 2>/dev/null | head -1 | tr -s ' \t' ' ' || mpicc -show | cut -d' ' -f1))"
 elif [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
     echo "mpi: a C compiler, MPI or LAPACK is missing; as root on Debian: apt-get install ${PKGS[*]}"
 else
