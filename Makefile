@@ -24,13 +24,24 @@ clean-numba-cache:
 # The tested versions: requirements.lock pins every package the extras below pull in (constraints:
 # a dependency added to pyproject.toml and not yet in the lock still installs, unpinned). `make lock`
 # refreshes the lock (see the lock block at the end).
-EXTRAS := report,workflow,slurm,test,lint
+EXTRAS := report,workflow,slurm,test,lint,mpi
 LOCK   := requirements.lock
 
+# The mpi extra (solver.linear: petsc) builds petsc and mpi4py from source against Debian's MPICH and
+# OpenBLAS/LAPACK, which tools/install_mpi_libs.sh installs when missing (as root; else one line says
+# what to install). PETSc without Fortran, C++ or CUDA (no gfortran; an nvcc on PATH is not used).
+# mpi4py from source too: its wheel carries another MPI than Debian's libmpich. The first build
+# takes ~20 min on 2 cores; pip caches the wheels (~/.cache/pip): later installs take seconds.
+# petsc is installed first: petsc4py's build environment needs it, and so finds its cached wheel.
+export MPICC ?= mpicc
+export PETSC_CONFIGURE_OPTIONS ?= --with-fc=0 --with-cxx=0 --with-x=0 --with-cuda=0
+
 $(STAMP): pyproject.toml $(LOCK)
+	@bash tools/install_mpi_libs.sh
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -c $(LOCK) -e ".[$(EXTRAS)]"
+	$(BIN)/python -m pip install --quiet -c $(LOCK) petsc
+	$(BIN)/python -m pip install --quiet --no-binary mpi4py -c $(LOCK) -e ".[$(EXTRAS)]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -132,7 +143,9 @@ lock:
 	rm -rf $(LOCK_VENV)
 	$(PYTHON) -m venv $(LOCK_VENV)
 	$(LOCK_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(LOCK_VENV)/bin/python -m pip install --quiet ".[$(EXTRAS),docs]"
+	@bash tools/install_mpi_libs.sh
+	$(LOCK_VENV)/bin/python -m pip install --quiet petsc
+	$(LOCK_VENV)/bin/python -m pip install --quiet --no-binary mpi4py ".[$(EXTRAS),docs]"
 	{ echo "# The tested dependency versions (make lock; make install installs with them as constraints)."; \
 	  echo "# $$($(LOCK_VENV)/bin/python -c 'import platform, sys; print(f"Python {platform.python_version()} on {sys.platform}")'), $$(date -u +%Y-%m-%d)"; \
 	  $(LOCK_VENV)/bin/python -m pip freeze --exclude vemkit; } > $(LOCK).tmp

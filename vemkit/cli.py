@@ -150,9 +150,15 @@ def solved_how(problem, solution) -> str:
 
 
 def _check_resources(scene, max_dofs):
-    """The predicted cells, DOFs and memory of the scene's solve, refused beyond the limits."""
+    """The predicted cells, DOFs and memory of the scene's solve, refused beyond the limits; the
+    packages of the chosen linear solver (solver.linear: petsc needs petsc4py)."""
     from vemkit.mesh.meshing import of_dimension
+    from vemkit.solvers.linear import backends
     from vemkit.vem.elements import element_for
+
+    backend = backends().get(scene.solver_options.get("linear"))
+    if backend is not None:
+        backend.check_available()
 
     layout = element_for(scene.order, scene.dimension).layout
     return of_dimension("check_resources", scene.dimension)(scene, max_dofs, layout)

@@ -25,9 +25,11 @@ def problem():
 
 
 def test_the_registry_maps_each_name_to_its_backend():
-    assert backends() == {"amg": AMGSolver, "direct": DirectSolver}
+    from vemkit.solvers.linear.petsc import PETScSolver  # petsc4py is imported only when it solves
+
+    assert backends() == {"amg": AMGSolver, "direct": DirectSolver, "petsc": PETScSolver}
     assert all(issubclass(backend, LinearSolver) for backend in backends().values())
-    with pytest.raises(SceneError, match="use amg, direct or auto"):
+    with pytest.raises(SceneError, match="use amg, direct, petsc or auto"):
         linear_solver(sp.identity(2, format="csr"), "cholesky")
 
 

@@ -151,7 +151,8 @@ def schema_error_message(error, fix=scene_fix, model: str | None = "plane_stress
         title = f" ({schema['title']})" if "title" in schema else ""
         return f"{key} = {show(value)}: must be {branch_names(error.validator_value)}{title}; {fix(key)}"
     if "propertyNames" in error.absolute_schema_path:
-        return f"{key}: {show(value)} is not a side name (letters, digits, _ and -); fix the scene"
+        what = schema.get("x-name", "a side name (letters, digits, _ and -)")  # the names' own words
+        return f"{key}: {show(value)} is not {what}; fix the scene"
     if keyword == "minProperties":
         return (
             f"{key} = {{}}: {NO_DIRICHLET}"

@@ -20,6 +20,7 @@ from contextlib import contextmanager, nullcontext
 import numpy as np
 
 from vemkit.exceptions import ConvergenceError, SceneError, TimeBudgetExceeded
+from vemkit.solvers.linear.base import BackendChoice
 from vemkit.solvers.solution import ContactSolution
 from vemkit.solvers.ssn import solve_ssn
 from vemkit.solvers.uzawa import solve_uzawa
@@ -110,7 +111,11 @@ def solve(problem, solver_options: dict, progress=None, initial=None, slip_refer
     opts = dict(solver_options)
     method = opts.pop("method")
     progress = _budgeted(progress, opts.pop("time_budget", None), method)
-    common = dict(linear=opts.pop("linear", "auto"), tol=opts.pop("tol"), progress=progress)
+    linear = opts.pop("linear", "auto")
+    backend_options = opts.get(f"{linear}_options") if isinstance(linear, str) else None
+    if backend_options:  # the chosen backend's own scene options (solver.petsc_options)
+        linear = BackendChoice(linear, dict(backend_options))
+    common = dict(linear=linear, tol=opts.pop("tol"), progress=progress)
     if method == "uzawa":
         uzawa_keys = ("rho", "eps_u", "eps_lambda", "stop", "max_iterations")
         kwargs = {k: opts[k] for k in uzawa_keys if opts.get(k) is not None}

@@ -13,7 +13,8 @@ A new backend is one module of this package with a ``LinearSolver`` subclass nam
 (its ``method`` the new value) plus that value in ``solver.linear``'s enum of the scene schema:
 :func:`backends` finds it.
 
-Modules: ``base`` (the interface), ``amg`` and ``direct`` (the backends), ``cycle`` (the V-cycle),
+Modules: ``base`` (the interface), ``amg``, ``direct`` and ``petsc`` (the backends; petsc4py is
+imported only when petsc is chosen), ``cycle`` (the V-cycle),
 ``reduced`` (the Newton-step solver on any backend).
 """
 
@@ -32,7 +33,7 @@ from vemkit.solvers.linear.amg import (
     AMGSolver,
     smoothed_aggregation,
 )
-from vemkit.solvers.linear.base import RIGID_MODES_3D, LinearSolver, NewtonSystems, three_d
+from vemkit.solvers.linear.base import RIGID_MODES_3D, BackendChoice, LinearSolver, NewtonSystems, three_d
 from vemkit.solvers.linear.cycle import (
     CYCLE_PRECISION,
     CycleLevel,
@@ -74,16 +75,20 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
     """One solver object for repeated solves with A: ``method`` is a backend's name (amg, direct) or auto.
 
     ``method`` may also be a solver built earlier for the same matrix (a sweep over contact
-    parameters keeps the stiffness matrix): it is returned as it is, set-up reused.
+    parameters keeps the stiffness matrix): it is returned as it is, set-up reused; or a
+    :class:`BackendChoice`, a backend's name with its scene options (``solver.petsc_options``).
     """
     if isinstance(method, LinearSolver):
         if not method.made_for(A):
             raise InputError("the prebuilt linear solver was made for another stiffness matrix", key="linear")
         return method
+    options = {}
+    if isinstance(method, BackendChoice):
+        method, options = method.method, {"options": method.options}
     if method == "auto":
         method = DirectSolver.method if A.shape[0] <= direct_limit(near_nullspace) else AMGSolver.method
     backend = backends().get(method) if isinstance(method, str) else None
     if backend is None:
         names = ", ".join(sorted(backends()))
         raise SceneError(f"solver.linear = {method!r} is unknown; use {names} or auto", key="solver.linear")
-    return backend(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter)
+    return backend(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter, **options)

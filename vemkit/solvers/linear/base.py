@@ -4,7 +4,8 @@ A backend is a :class:`LinearSolver` subclass in a module of this package that n
 ``BACKEND``; its ``method`` is the value of the scene key ``solver.linear`` that chooses it. The
 contact solvers (ssn, uzawa) only call the members below, never a backend's name:
 
-- set-up: ``Backend(A, near_nullspace=B, tol=..., maxiter=...)`` (a hierarchy, a factorization);
+- set-up: ``Backend(A, near_nullspace=B, tol=..., maxiter=...)`` (a hierarchy, a factorization;
+  a backend with scene options, e.g. petsc, also takes ``options=``, from a :class:`BackendChoice`);
 - ``solve(b, x0=None, tol=None, A=None)``: the solution of A x = b from the start x0 to the
   relative tolerance tol (``A``: another matrix or operator of the same size, e.g. K + D, with the
   set-up of the first kept as it is or renewed); ``iterations`` and ``residual`` of the last solve;
@@ -16,6 +17,8 @@ contact solvers (ssn, uzawa) only call the members below, never a backend's name
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,6 +38,10 @@ class LinearSolver:
 
     def solve(self, b, x0=None, tol=None, A=None):  # pragma: no cover - the interface
         raise NotImplementedError
+
+    @classmethod
+    def check_available(cls) -> None:
+        """Raise SceneError with the fix when the backend's packages are missing (before any work)."""
 
     def made_for(self, A) -> bool:
         """Whether this solver was set up for a matrix of A's size and pattern (a prebuilt one reused)."""
@@ -65,6 +72,15 @@ class NewtonSystems:
     def fallback(self) -> NewtonSystems | None:
         """The Newton systems to switch to when these stall (an iterative backend: direct), or None."""
         return None
+
+
+@dataclass(frozen=True)
+class BackendChoice:
+    """A backend's solver.linear value with its scene options (``solver.petsc_options``), which
+    ``linear_solver`` hands to the backend as ``options``."""
+
+    method: str
+    options: dict
 
 
 def reduced_right_hand_side(Z, rhs):
