@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from vemkit.config.scene import scene_from_dict
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.contact.problem import scene_problem
-from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy, _summed, pattern_positions, widened
+from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy, _summed, block_positions, pattern_positions, widened
 from vemkit.solvers.linear import linear_solver
 
 
@@ -27,6 +27,23 @@ def test_widened_keeps_the_values_and_holds_the_new_pattern(seed):
     summed = wide.copy()
     summed.data[positions] += D.data
     assert abs(summed - (A + D)).max() < 1e-15
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_block_positions_find_every_entry_of_d_in_the_blocks(seed):
+    A = (sp.random(60, 60, density=0.05, format="csr", random_state=seed) + sp.eye(60)).tobsr(blocksize=(3, 3))
+    A.sort_indices()
+    scattered = _summed(sp.random(60, 60, density=0.03, format="csr", random_state=20 + seed))
+    inside = _summed(scattered.multiply(A.tocsr() != 0) + sp.eye(60))  # in A's blocks
+    for D in (scattered, inside):
+        positions = block_positions(A, D)
+        held = (abs(A.tocsr()) + abs(D)).tobsr(blocksize=(3, 3)).indices.size == A.indices.size
+        assert (positions is not None) == held and (D is scattered or held)
+        if positions is not None:
+            summed = A.copy()
+            summed.data.reshape(-1)[positions] += D.data
+            assert abs(summed - (A + D)).max() < 1e-15
+    assert block_positions(A, sp.csr_matrix(A.shape)).size == 0
 
 
 def _box_problem(n):

@@ -37,6 +37,21 @@ def test_the_sweep_is_pyamgs_block_gauss_seidel(forward):
     assert np.max(np.abs(ours - theirs)) <= 1e-10 * np.max(np.abs(theirs))
 
 
+@pytest.mark.parametrize("forward", [True, False])
+def test_the_block_sweep_is_the_scalar_one(forward):
+    """On the 3 x 3 BSR form (blocks filled with K's unstored zeros) the sweep is the CSR one to rounding."""
+    problem = _box_problem(5)
+    A = (problem.stiffness + _stiff_slip_term(problem, 1e4)).tocsr()
+    A.sort_indices()
+    rng = np.random.default_rng(5)
+    b, x0 = rng.normal(size=A.shape[0]), rng.normal(size=A.shape[0])
+    inverses = np.linalg.inv(diagonal_blocks(A))
+    scalar, blocks = x0.copy(), x0.copy()
+    nodal_gauss_seidel(A, scalar, b, inverses, forward=forward)
+    nodal_gauss_seidel(A.tobsr(blocksize=(3, 3)), blocks, b, inverses, forward=forward)
+    assert np.max(np.abs(scalar - blocks)) <= 1e-10 * np.max(np.abs(scalar))
+
+
 def test_the_blocks_of_k_plus_d_are_updated_where_d_lives():
     problem = _box_problem(4)
     K, D = problem.stiffness.tocsr(), _stiff_slip_term(problem, 10.0)

@@ -121,6 +121,68 @@ class _LevelOperator:
         return sp.csr_matrix((data, self.base.indices, self.base.indptr), shape=self.base.shape)
 
 
+def block_positions(B, D):
+    """Positions in ``B.data.ravel()`` (B BSR with 3 x 3 blocks, sorted) of the entries of D (CSR,
+    summed), or None when an entry of D lies in no block of B."""
+    rows = np.repeat(np.arange(D.shape[0]), np.diff(D.indptr))
+    block_rows, block_columns = rows // 3, D.indices // 3
+    touched = np.unique(block_rows)
+    starts = B.indptr[touched].astype(np.int64)
+    lengths = B.indptr[touched + 1] - starts
+    before = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+    flat = np.arange(int(lengths.sum()), dtype=np.int64) + np.repeat(starts - before, lengths)  # blocks of B
+    width = B.shape[1] // 3
+    keys = np.repeat(np.arange(touched.size, dtype=np.int64), lengths) * width + B.indices[flat]
+    local = np.searchsorted(touched, block_rows)
+    at = np.searchsorted(keys, local * width + block_columns)
+    clipped = np.minimum(at, max(keys.size - 1, 0))
+    if keys.size == 0 or not np.array_equal(keys[clipped], local * width + block_columns):
+        return None if D.nnz else np.zeros(0, dtype=np.int64)
+    return 9 * flat[clipped] + 3 * (rows % 3) + D.indices % 3
+
+
+class _NodalLevelOperator:
+    """The finest level's K + D as 3 x 3 BSR in ``precision``, what the nodal sweeps read (its values
+    K's, and D's added in place at each update; K's own values where D was, kept for the next one).
+    Replaces a float64 copy of K on a widened pattern and a CSR copy in ``precision``: at 10^6 DOFs
+    1.3 GB -> 0.36 GB in float32."""
+
+    def __init__(self, A, support, precision):
+        self.A = A.tocsr()  # K, float64 (read again only if a D falls outside the blocks)
+        self.precision = precision
+        self._build(support)
+
+    def _build(self, D=None):
+        """``current`` = K in blocks (a block holds its entries that K does not store as zeros), widened
+        when an entry of D lies in no block of K (never for contact blocks: K couples a vertex to itself)."""
+        self.current = self._blocks(self.A)
+        if D is not None and D.nnz and block_positions(self.current, D) is None:
+            self.current = self._blocks(widened(self.A, D))
+        self.touched, self.saved, self.pattern = np.zeros(0, dtype=np.int64), np.zeros(0, self.precision), None
+
+    def _blocks(self, K):
+        values = sp.csr_matrix((K.data.astype(self.precision), K.indices, K.indptr), shape=K.shape)
+        blocks = values.tobsr(blocksize=(3, 3))
+        blocks.sort_indices()
+        return blocks
+
+    def update(self, D):
+        """K + D as ``current`` (D summed, explicit zeros dropped)."""
+        data = self.current.data.reshape(-1)
+        data[self.touched] = self.saved
+        same = self.pattern is not None and _same_pattern(self.pattern, D)
+        positions = self.touched if same else block_positions(self.current, D)
+        if positions is None:  # an entry of D in no block of K: the blocks widened once
+            self._build(D)
+            data = self.current.data.reshape(-1)
+            positions = block_positions(self.current, D)
+        self.pattern = (D.indptr.copy(), D.indices.copy())
+        self.saved = data[positions]
+        data[positions] += D.data  # one position per entry
+        self.touched = positions
+        return self.current
+
+
 class BoundaryUpdatedHierarchy:
     """The V-cycle of a hierarchy of K (vemkit.solvers.linear.AMGSolver's, levels already in CSR) as
     the preconditioner of K + D, for any boundary term D (see the module docstring)."""
@@ -132,14 +194,18 @@ class BoundaryUpdatedHierarchy:
         hierarchy's own smoothers). ``precision``: the floating type of the cycle (its operators,
         transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way)."""
         self.levels = hierarchy.levels
+        nodal = nodal and len(self.levels) > 1  # one level: its LU, no smoother
         self.precision = precision
         self.nodal_blocks = NodalBlocks(hierarchy.levels[0].A) if nodal else None
         self.presmoother = [level.presmoother for level in self.levels[:-1]]
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
         self.transfers = [transfers_in_precision(level, precision) for level in self.levels[:-1]]  # on P's index arrays
-        self.operators = [_LevelOperator(level.A, precision) for level in self.levels]
-        if support is not None and pattern_positions(self.operators[0].base, _summed(support)) is None:
-            self.operators[0].widen(_summed(support))
+        support = None if support is None else _summed(support)
+        self.operators = [_LevelOperator(level.A, precision) for level in self.levels[1 if nodal else 0 :]]
+        if nodal:  # the finest level in 3 x 3 blocks, for the nodal sweeps
+            self.operators.insert(0, _NodalLevelOperator(self.levels[0].A, support, precision))
+        elif support is not None and pattern_positions(self.operators[0].base, support) is None:
+            self.operators[0].widen(support)
 
     def preconditioner(self, D):
         """A LinearOperator: one V-cycle for K + D (D square CSR, supported near the boundary)."""
