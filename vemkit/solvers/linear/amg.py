@@ -104,6 +104,9 @@ def _block_hierarchy(A, near_nullspace, options):
     options = dict(options, max_coarse=BLOCK_MAX_COARSE)
     hierarchy = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(3, 3)), B=near_nullspace, **options)
     hierarchy.levels[0].A = A
+    for level in hierarchy.levels[:-1]:  # R = P^T as a view of P (CSC): pyamg's R is a copy of P^T's values
+        level.P = level.P.tocsr()
+        level.R = level.P.T
     return hierarchy
 
 
