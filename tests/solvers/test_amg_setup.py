@@ -36,3 +36,15 @@ def test_the_3d_finest_level_is_pyamgs_block_level():
     assert np.array_equal(R.toarray(), P.toarray().T)
     assert np.max(np.abs(A_coarse.toarray() - coarse_theirs)) <= 1e-13 * np.max(np.abs(coarse_theirs))
     assert np.array_equal(B_coarse, theirs.levels[1].B)
+
+
+def test_the_block_galerkin_operator_is_pt_a_p(monkeypatch):
+    from test_amg_update import _box_problem
+
+    A = _box_problem(8).stiffness.tocsr()
+    P, _, _, _ = amg_setup.block_finest_level(A, _box_problem(8).near_nullspace)
+    monkeypatch.setattr(amg_setup, "RAP_ROWS", A.shape[0] // 5)  # five row blocks
+    reference = (P.T @ A @ P).toarray()
+    blocks = amg_setup.block_galerkin(A, P, 6)
+    assert blocks.blocksize == (6, 6)
+    assert np.max(np.abs(blocks.toarray() - reference)) <= 1e-12 * np.max(np.abs(reference))
