@@ -12,7 +12,7 @@ from test_amg_update import _box_problem
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy
 from vemkit.solvers.linear import linear_solver
-from vemkit.solvers.nodal_smoother import NodalBlocks, diagonal_blocks, nodal_gauss_seidel
+from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, diagonal_blocks, nodal_gauss_seidel
 
 
 def _stiff_slip_term(problem, size, seed=0):
@@ -87,3 +87,12 @@ def test_the_nodal_cycle_is_symmetric_and_robust_to_stiff_slip_blocks():
     (mild_nodal, _), (stiff_nodal, stiff_scalar) = counts[1.0], counts[1e6]
     assert stiff_nodal <= mild_nodal + 3, counts
     assert stiff_scalar >= 2 * stiff_nodal, counts
+
+
+def test_the_block_residual_is_b_minus_a_x():
+    problem = _box_problem(5)
+    A = (problem.stiffness + _stiff_slip_term(problem, 1e4)).tocsr().tobsr(blocksize=(3, 3))
+    rng = np.random.default_rng(7)
+    x, b = rng.normal(size=A.shape[0]), rng.normal(size=A.shape[0])
+    expected = b - A @ x
+    assert np.max(np.abs(block_residual(A, x, b) - expected)) <= 1e-12 * np.max(np.abs(expected))

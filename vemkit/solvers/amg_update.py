@@ -31,7 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from vemkit.solvers.linear.cycle import transfers_in_precision, v_cycle
-from vemkit.solvers.nodal_smoother import NodalBlocks, nodal_smoothers
+from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, nodal_smoothers
 
 
 def _lookup(A, D):
@@ -236,6 +236,7 @@ class BoundaryUpdatedHierarchy:
                 if index == 0 and self.nodal_blocks is not None:
                     inverses = self.nodal_blocks.with_term(D).astype(self.precision)
                     here.presmoother, here.postsmoother = nodal_smoothers(inverses)
+                    here.residual = block_residual
                 D = coarse_term(level.P, D)
             levels.append(here)
         lu = spla.splu(levels[-1].A.tocsc())
@@ -257,4 +258,4 @@ class _Level:
 
     def __init__(self, A):
         self.A = A
-        self.P = self.R = self.presmoother = self.postsmoother = None
+        self.P = self.R = self.presmoother = self.postsmoother = self.residual = None

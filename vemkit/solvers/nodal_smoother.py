@@ -107,6 +107,29 @@ def _block_sweep(indptr, indices, data, x, b, inverses, forward):
         x[row + 2] += block[2, 0] * r0 + block[2, 1] * r1 + block[2, 2] * r2
 
 
+@numba.njit(cache=True)
+def _block_residual(indptr, indices, data, x, b, r):
+    for node in range(indptr.shape[0] - 1):
+        row = 3 * node
+        r0, r1, r2 = b[row], b[row + 1], b[row + 2]
+        for p in range(indptr[node], indptr[node + 1]):
+            j = 3 * indices[p]
+            x0, x1, x2 = x[j], x[j + 1], x[j + 2]
+            q = 9 * p
+            r0 -= data[q] * x0 + data[q + 1] * x1 + data[q + 2] * x2
+            r1 -= data[q + 3] * x0 + data[q + 4] * x1 + data[q + 5] * x2
+            r2 -= data[q + 6] * x0 + data[q + 7] * x1 + data[q + 8] * x2
+        r[row], r[row + 1], r[row + 2] = r0, r1, r2
+
+
+def block_residual(A, x, b):
+    """b - A x for A BSR with 3 x 3 blocks (the finest level's residual in the V-cycle: ~3 times
+    faster than scipy's BSR product in float32)."""
+    r = np.empty_like(b)
+    _block_residual(A.indptr, A.indices, A.data.reshape(-1), x, b, r)
+    return r
+
+
 def nodal_gauss_seidel(A, x, b, inverses, forward: bool = True) -> None:
     """One block Gauss-Seidel sweep on ``x`` in place (A CSR, or BSR with 3 x 3 blocks, with 3 dofs
     per vertex; ``inverses`` of its diagonal blocks)."""
