@@ -9,9 +9,11 @@ vertex one after the other and crawls along that block's null direction: on the 
 eta = 1e-3, and 35 and 57 at 10^6 DOFs. Relaxing the d unknowns of a vertex together (solving its
 diagonal block) removes that: 1 and 11 at n = 40.
 
-Here the block sweep reads the CSR rows of a vertex once (the same memory traffic as the scalar
-sweep; pyamg's BSR block smoother costs 3-4 times as much per nonzero) and applies the inverse of the
-vertex's diagonal block (:class:`NodalBlocks`: K's once, the contact vertices' at each step). The
+Here the block sweep reads the rows of a vertex once, CSR (the same memory traffic as the scalar
+sweep; pyamg's BSR block smoother costs 3-4 times as much per nonzero) or 3 x 3 BSR (x_j read once
+per block: the 3D Newton steps' finest level, vemkit.solvers.amg_update, ~8 times faster than CSR),
+and applies the inverse of the vertex's diagonal block (:class:`NodalBlocks`: K's once, the contact
+vertices' at each step); :func:`block_residual` is the cycle's b - A x on the BSR form. The
 dofs of vertex i are rows 3 i, 3 i + 1, 3 i + 2 (vemkit's interleaved numbering). ``nodal_gauss_seidel`` equals
 pyamg's ``block_gauss_seidel`` on the BSR form of the matrix (tests/solvers/test_nodal_smoother.py);
 a forward sweep before and a backward sweep after keep the V-cycle symmetric.
