@@ -134,3 +134,17 @@ def test_the_single_precision_cycle_is_the_double_one_to_its_rounding():
         x, info = spla.cg(K + D, b, rtol=1e-10, M=M, callback=counted)
         assert info == 0 and np.linalg.norm((K + D) @ x - b) <= 1e-10 * np.linalg.norm(b)
     assert abs(counts[0] - counts[1]) <= 1, counts
+
+
+@pytest.mark.parametrize("precision", [np.float64, np.float32])
+def test_the_block_transfers_are_p_and_its_transpose(precision):
+    from vemkit.solvers.amg_update import BlockTransfer
+
+    rng = np.random.default_rng(8)
+    P = sp.random(60, 48, density=0.2, format="csr", random_state=8, dtype=precision)
+    transfer = BlockTransfer(P.tobsr(blocksize=(3, 6)))
+    coarse, fine = rng.normal(size=48).astype(precision), rng.normal(size=60).astype(precision)
+    rounding = 1e-12 if precision == np.float64 else 1e-5
+    for ours, theirs in ((transfer @ coarse, P @ coarse), (transfer.T @ fine, P.T @ fine)):
+        assert ours.dtype == precision and ours.shape == theirs.shape
+        assert np.max(np.abs(ours - theirs)) <= rounding * np.max(np.abs(theirs))

