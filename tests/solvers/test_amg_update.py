@@ -148,3 +148,21 @@ def test_the_block_transfers_are_p_and_its_transpose(precision):
     for ours, theirs in ((transfer @ coarse, P @ coarse), (transfer.T @ fine, P.T @ fine)):
         assert ours.dtype == precision and ours.shape == theirs.shape
         assert np.max(np.abs(ours - theirs)) <= rounding * np.max(np.abs(theirs))
+
+
+def test_the_nodal_finest_level_is_k_plus_d_in_blocks_widened_where_d_leaves_them():
+    """nodal: the finest level is 3 x 3 BSR; a D coupling vertices that share no cell widens its
+    blocks, and the next D (back in the pattern) leaves K's values where the last one was."""
+    problem = _box_problem(12)
+    K, n = problem.stiffness.tocsr(), problem.n_dofs
+    hierarchy = linear_solver(K, "amg", near_nullspace=problem.near_nullspace).hierarchy
+    assert len(hierarchy.levels) >= 2
+    updated = BoundaryUpdatedHierarchy(hierarchy, nodal=True)
+    far = sp.csr_matrix(([5.0, 5.0], ([0, n - 1], [n - 1, 0])), shape=(n, n))  # corner to corner
+    near = _summed(rank_one_blocks(problem.contact, np.ones(problem.contact.size), problem.contact.normal, n))
+    for D in (_summed(far), near):
+        updated.preconditioner(D)
+        finest = updated.operators[0].current
+        assert finest.format == "bsr" and finest.blocksize == (3, 3)
+        expected = (K + D).toarray()
+        assert np.max(np.abs(finest.toarray() - expected)) <= 1e-6 * np.max(np.abs(expected))
