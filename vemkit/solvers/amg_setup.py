@@ -187,6 +187,14 @@ def block_finest_level(A, B, omega: float = 4.0 / 3.0):
     return P, P.T, A_coarse, B_coarse
 
 
+def _rows(A, lo: int, hi: int):
+    """The rows lo <= r < hi of the CSR matrix A on views of its arrays (``A[lo:hi]`` copies them)."""
+    start, stop = A.indptr[lo], A.indptr[hi]
+    return sp.csr_matrix(
+        (A.data[start:stop], A.indices[start:stop], A.indptr[lo : hi + 1] - start), shape=(hi - lo, A.shape[1])
+    )
+
+
 def _block_rows(M, lo: int, hi: int):
     """The block rows lo <= r < hi of the BSR matrix M (views of its arrays)."""
     start, stop = M.indptr[lo], M.indptr[hi]
@@ -203,7 +211,7 @@ def block_galerkin(A, P, k: int):
     total = None
     for c in range(chunks):
         lo, hi = c * nodes // chunks, (c + 1) * nodes // chunks
-        part = _block_rows(P_blocks, lo, hi).T @ (A[3 * lo : 3 * hi].tobsr(blocksize=(3, 3)) @ P_blocks)
+        part = _block_rows(P_blocks, lo, hi).T @ (_rows(A, 3 * lo, 3 * hi).tobsr(blocksize=(3, 3)) @ P_blocks)
         total = part if total is None else total + part
     return total
 
