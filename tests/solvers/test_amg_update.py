@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from vemkit.config.scene import scene_from_dict
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.contact.problem import scene_problem
-from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy, _summed, pattern_positions, widened
+from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy, _summed, block_positions, pattern_positions, widened
 from vemkit.solvers.linear import linear_solver
 
 
@@ -27,6 +27,23 @@ def test_widened_keeps_the_values_and_holds_the_new_pattern(seed):
     summed = wide.copy()
     summed.data[positions] += D.data
     assert abs(summed - (A + D)).max() < 1e-15
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_block_positions_find_every_entry_of_d_in_the_blocks(seed):
+    A = (sp.random(60, 60, density=0.05, format="csr", random_state=seed) + sp.eye(60)).tobsr(blocksize=(3, 3))
+    A.sort_indices()
+    scattered = _summed(sp.random(60, 60, density=0.03, format="csr", random_state=20 + seed))
+    inside = _summed(scattered.multiply(A.tocsr() != 0) + sp.eye(60))  # in A's blocks
+    for D in (scattered, inside):
+        positions = block_positions(A, D)
+        held = (abs(A.tocsr()) + abs(D)).tobsr(blocksize=(3, 3)).indices.size == A.indices.size
+        assert (positions is not None) == held and (D is scattered or held)
+        if positions is not None:
+            summed = A.copy()
+            summed.data.reshape(-1)[positions] += D.data
+            assert abs(summed - (A + D)).max() < 1e-15
+    assert block_positions(A, sp.csr_matrix(A.shape)).size == 0
 
 
 def _box_problem(n):
@@ -117,3 +134,35 @@ def test_the_single_precision_cycle_is_the_double_one_to_its_rounding():
         x, info = spla.cg(K + D, b, rtol=1e-10, M=M, callback=counted)
         assert info == 0 and np.linalg.norm((K + D) @ x - b) <= 1e-10 * np.linalg.norm(b)
     assert abs(counts[0] - counts[1]) <= 1, counts
+
+
+@pytest.mark.parametrize("precision", [np.float64, np.float32])
+def test_the_block_transfers_are_p_and_its_transpose(precision):
+    from vemkit.solvers.amg_update import BlockTransfer
+
+    rng = np.random.default_rng(8)
+    P = sp.random(60, 48, density=0.2, format="csr", random_state=8, dtype=precision)
+    transfer = BlockTransfer(P.tobsr(blocksize=(3, 6)))
+    coarse, fine = rng.normal(size=48).astype(precision), rng.normal(size=60).astype(precision)
+    rounding = 1e-12 if precision == np.float64 else 1e-5
+    for ours, theirs in ((transfer @ coarse, P @ coarse), (transfer.T @ fine, P.T @ fine)):
+        assert ours.dtype == precision and ours.shape == theirs.shape
+        assert np.max(np.abs(ours - theirs)) <= rounding * np.max(np.abs(theirs))
+
+
+def test_the_nodal_finest_level_is_k_plus_d_in_blocks_widened_where_d_leaves_them():
+    """nodal: the finest level is 3 x 3 BSR; a D coupling vertices that share no cell widens its
+    blocks, and the next D (back in the pattern) leaves K's values where the last one was."""
+    problem = _box_problem(12)
+    K, n = problem.stiffness.tocsr(), problem.n_dofs
+    hierarchy = linear_solver(K, "amg", near_nullspace=problem.near_nullspace).hierarchy
+    assert len(hierarchy.levels) >= 2
+    updated = BoundaryUpdatedHierarchy(hierarchy, nodal=True)
+    far = sp.csr_matrix(([5.0, 5.0], ([0, n - 1], [n - 1, 0])), shape=(n, n))  # corner to corner
+    near = _summed(rank_one_blocks(problem.contact, np.ones(problem.contact.size), problem.contact.normal, n))
+    for D in (_summed(far), near):
+        updated.preconditioner(D)
+        finest = updated.operators[0].current
+        assert finest.format == "bsr" and finest.blocksize == (3, 3)
+        expected = (K + D).toarray()
+        assert np.max(np.abs(finest.toarray() - expected)) <= 1e-6 * np.max(np.abs(expected))

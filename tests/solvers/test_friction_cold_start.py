@@ -67,11 +67,13 @@ def test_the_getfem_box_with_mu_03_converges_from_a_cold_start_at_14739_dofs():
 
 
 def test_a_stall_at_a_very_stiff_foundation_is_resolved_by_rescaling_gamma():
-    """The box at k_nu = 1e7 E (k_tau = 0.3 k_nu, n = 12): vertices that end barely in contact
+    """The box at k_nu = 1e8 E (k_tau = 0.3 k_nu, n = 12): vertices that end barely in contact
     (t ~ 1e-10) have bounds 1e-7 of the start's, so the coupled law's gamma_c, set at the start, left
-    q blind to their slip; ssn stalled at a merit of 6.5e-11 ... 3e-9 for 35 iterations. With gamma_c
-    rescaled at the stall (vemkit.solvers.ssn._rescaled_at_a_stall): 22 iterations, measured."""
-    problem = friction_box("tet", 12, 0.3, k_normal=1e10)
+    q blind to their slip; ssn stalled at a merit of 6.5e-11 ... 3e-9 for 35 iterations (at 1e7 E). With
+    gamma_c rescaled at the stall (vemkit.solvers.ssn._rescaled_at_a_stall): 21 iterations, measured.
+    Whether the path meets the stall depends on the AMG cycle's rounding: at 1e7 E it did until the
+    finest level became 3 x 3 BSR (vemkit.solvers.amg_update), at 1e8 E it does either way."""
+    problem = friction_box("tet", 12, 0.3, k_normal=1e11)
     solution = solve(problem, {"method": "ssn", "tol": 1e-12, "max_iterations": 50})
     assert verify_solution(problem, solution.u, solution.multiplier, tol=1e-10)["passed"]
     assert solution.info.get("gamma_rescaled", 0) >= 1

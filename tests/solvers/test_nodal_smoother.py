@@ -12,7 +12,7 @@ from test_amg_update import _box_problem
 from vemkit.contact.boundary import rank_one_blocks
 from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy
 from vemkit.solvers.linear import linear_solver
-from vemkit.solvers.nodal_smoother import NodalBlocks, diagonal_blocks, nodal_gauss_seidel
+from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, diagonal_blocks, nodal_gauss_seidel
 
 
 def _stiff_slip_term(problem, size, seed=0):
@@ -35,6 +35,21 @@ def test_the_sweep_is_pyamgs_block_gauss_seidel(forward):
     nodal_gauss_seidel(A, ours, b, np.linalg.inv(diagonal_blocks(A)), forward=forward)
     block_gauss_seidel(A.tobsr(blocksize=(3, 3)), theirs, b, sweep="forward" if forward else "backward", blocksize=3)
     assert np.max(np.abs(ours - theirs)) <= 1e-10 * np.max(np.abs(theirs))
+
+
+@pytest.mark.parametrize("forward", [True, False])
+def test_the_block_sweep_is_the_scalar_one(forward):
+    """On the 3 x 3 BSR form (blocks filled with K's unstored zeros) the sweep is the CSR one to rounding."""
+    problem = _box_problem(5)
+    A = (problem.stiffness + _stiff_slip_term(problem, 1e4)).tocsr()
+    A.sort_indices()
+    rng = np.random.default_rng(5)
+    b, x0 = rng.normal(size=A.shape[0]), rng.normal(size=A.shape[0])
+    inverses = np.linalg.inv(diagonal_blocks(A))
+    scalar, blocks = x0.copy(), x0.copy()
+    nodal_gauss_seidel(A, scalar, b, inverses, forward=forward)
+    nodal_gauss_seidel(A.tobsr(blocksize=(3, 3)), blocks, b, inverses, forward=forward)
+    assert np.max(np.abs(scalar - blocks)) <= 1e-10 * np.max(np.abs(scalar))
 
 
 def test_the_blocks_of_k_plus_d_are_updated_where_d_lives():
@@ -72,3 +87,12 @@ def test_the_nodal_cycle_is_symmetric_and_robust_to_stiff_slip_blocks():
     (mild_nodal, _), (stiff_nodal, stiff_scalar) = counts[1.0], counts[1e6]
     assert stiff_nodal <= mild_nodal + 3, counts
     assert stiff_scalar >= 2 * stiff_nodal, counts
+
+
+def test_the_block_residual_is_b_minus_a_x():
+    problem = _box_problem(5)
+    A = (problem.stiffness + _stiff_slip_term(problem, 1e4)).tocsr().tobsr(blocksize=(3, 3))
+    rng = np.random.default_rng(7)
+    x, b = rng.normal(size=A.shape[0]), rng.normal(size=A.shape[0])
+    expected = b - A @ x
+    assert np.max(np.abs(block_residual(A, x, b) - expected)) <= 1e-12 * np.max(np.abs(expected))

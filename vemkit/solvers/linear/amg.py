@@ -46,6 +46,10 @@ AMG_OPTIONS = dict(
 #: solve 0.45 -> 0.20 s; the contact solver refactors it at every Newton step, vemkit.solvers.amg_update)
 BLOCK_MAX_COARSE = 600
 FINEST_OWN = 2000  # above this many unknowns the finest level is vemkit.solvers.amg_setup's
+#: 3D: above this many unknowns the finest level is vemkit.solvers.amg_setup.block_finest_level (pyamg's
+#: aggregates and P, R A P to rounding; at 10^6 DOFs the set-up's peak 3.3 -> ~2 GiB); below it pyamg's
+#: own, bit for bit as before (tests/golden)
+BLOCK_FINEST_OWN = 100_000
 #: 2D: the strength on the levels below vemkit's finest (3 x 3 blocks). theta = 0 (every block strong)
 #: made the second level's aggregates too coarse: CG to 1e-12 on structured triangles at 5.3e5 DOFs
 #: took 64 iterations, with 0.08 38 (CG 7.7 -> 4.7 s CPU, set-up 1.3 -> 0.8 s; operator complexity
@@ -102,8 +106,33 @@ def _block_hierarchy(A, near_nullspace, options):
     import pyamg
 
     options = dict(options, max_coarse=BLOCK_MAX_COARSE)
-    hierarchy = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(3, 3)), B=near_nullspace, **options)
-    hierarchy.levels[0].A = A
+    if A.shape[0] > BLOCK_FINEST_OWN:
+        hierarchy = _own_finest_level(A, near_nullspace, options)
+    else:
+        hierarchy = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(3, 3)), B=near_nullspace, **options)
+        hierarchy.levels[0].A = A
+    for level in hierarchy.levels[:-1]:  # R = P^T as a view of P (CSC): pyamg's R is a copy of P^T's values
+        level.P = level.P.tocsr()
+        level.R = level.P.T
+    return hierarchy
+
+
+def _own_finest_level(A, near_nullspace, options):
+    """The block hierarchy with its finest level from ``vemkit.solvers.amg_setup.block_finest_level``
+    (pyamg's aggregates and P, no BSR copies of A) and pyamg's coarser levels, the same options."""
+    import pyamg
+    from pyamg.multilevel import MultilevelSolver
+    from pyamg.relaxation.smoothing import change_smoothers
+
+    from vemkit.solvers.amg_setup import block_finest_level
+
+    P, R, A_coarse, B_coarse = block_finest_level(A, near_nullspace, omega=options["smooth"][1]["omega"])
+    coarse = pyamg.smoothed_aggregation_solver(A_coarse, B=B_coarse, **options)
+    finest = MultilevelSolver.Level()
+    finest.A, finest.B, finest.P, finest.R = A, np.asarray(near_nullspace, dtype=float), P, R
+    A.symmetry = "hermitian"
+    hierarchy = MultilevelSolver([finest] + coarse.levels, coarse_solver=options["coarse_solver"])
+    change_smoothers(hierarchy, options["presmoother"], options["postsmoother"])
     return hierarchy
 
 
@@ -118,10 +147,26 @@ class AMGSolver(LinearSolver):
         self.tol = tol
         self.maxiter = maxiter
         self.hierarchy = smoothed_aggregation(self.A, near_nullspace)
-        # 2D: only the cycle reads the transfers after the set-up; 3D: vemkit.solvers.amg_update too
-        self.preconditioner = v_cycle_preconditioner(self.hierarchy, release=not three_d(near_nullspace))
+        self.three_d = three_d(near_nullspace)  # 2D: only the cycle reads the transfers after the set-up
+        self._preconditioner = v_cycle_preconditioner(self.hierarchy, release=not self.three_d)
         self.iterations = 0
         self.residual = 0.0
+
+    @property
+    def preconditioner(self):
+        """The V-cycle of the hierarchy (built again after :meth:`release_preconditioner`)."""
+        if self._preconditioner is None:
+            self._preconditioner = v_cycle_preconditioner(self.hierarchy, release=not self.three_d)
+        return self._preconditioner
+
+    @preconditioner.setter
+    def preconditioner(self, cycle):
+        self._preconditioner = cycle
+
+    def release_preconditioner(self):
+        """Free the cycle's single-precision copies of the levels (at 10^6 DOFs in 3D, K's values and
+        the finest P: ~0.6 GiB) while another cycle preconditions (vemkit.solvers.amg_update's)."""
+        self._preconditioner = None
 
     def solve(self, b, x0=None, tol=None, A=None):
         A = self.A if A is None else A
@@ -163,15 +208,16 @@ class AMGNewtonSystems(NewtonSystems):
 
     def __init__(self, problem, base, baseline):
         self.problem = problem
-        self.preconditioner = base.preconditioner
         self.rebuilds = 0
         self.baseline = baseline  # CG iterations per decade of residual reduction with K
         # 3D: the hierarchy of K follows every step's K + J + stick penalty (vemkit.solvers.amg_update)
         self.updated = None
         if problem.contact.dimension == 3:
+            base.release_preconditioner()  # every Newton step's cycle is the updated hierarchy's
             cb, ones = problem.contact, np.ones(problem.contact.normal.shape)
             support = rank_one_blocks(cb, np.ones(cb.size), ones, problem.n_dofs)  # every contact block
             self.updated = base.boundary_updated_hierarchy(support)
+        self.preconditioner = None if self.updated is not None else base.preconditioner
 
     def operator(self, K, *terms):
         """K x + D x: no copy of K's values (formed, on K's index arrays, only for a rebuilt hierarchy)."""

@@ -15,7 +15,8 @@ def v_cycle(levels, coarse_solver, level, b):
     here = levels[level]
     x = np.zeros_like(b)
     here.presmoother(here.A, x, b)
-    coarse_b = here.R @ (b - here.A @ x)
+    residual = b - here.A @ x if here.residual is None else here.residual(here.A, x, b)
+    coarse_b = here.R @ residual
     if level == len(levels) - 2:
         coarse_x = coarse_solver(levels[-1].A, coarse_b)
     else:
@@ -32,11 +33,13 @@ CYCLE_PRECISION = np.float32
 
 
 class CycleLevel:
-    """What :func:`v_cycle` reads of a level: A, the transfers P and R, the two smoothers."""
+    """What :func:`v_cycle` reads of a level: A, the transfers P and R, the two smoothers (and the
+    residual's own kernel, if any)."""
 
     def __init__(self, A, P=None, R=None, presmoother=None, postsmoother=None):
         self.A, self.P, self.R = A, P, R
         self.presmoother, self.postsmoother = presmoother, postsmoother
+        self.residual = None  # b - A x by A's product, or residual(A, x, b)
 
 
 def in_precision(M, precision):
