@@ -34,6 +34,18 @@ def targets_line(targets: dict, prefix: str = "Targets") -> str:
     return f"{prefix}: " + ", ".join(f"{k}: {'met' if v else 'NOT met'}" for k, v in targets.items())
 
 
+def shared_machine_lines(record: dict) -> list:
+    """The closing lines of a report timed in wall and CPU seconds on a shared machine: the load
+    average ``record["load_average"]`` and the targets ``record["targets"]`` (judged on wall time)."""
+    return [
+        "",
+        f"Load average at the end (1, 5, 15 min): {record['load_average']}. On a shared machine the wall time "
+        "includes waiting for a core; the CPU time is the process's own.",
+        "",
+        targets_line(record["targets"], "Targets (wall time)"),
+    ]
+
+
 def best_of(fn, repeat: int):
     """(the least wall time of ``repeat`` calls of fn, in seconds; the last call's result)."""
     times, result = [], None

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import time
 
-from _common import MACHINE, quick_parser, targets_line, write_report
+from _common import MACHINE, quick_parser, shared_machine_lines, write_report
 
 CUBE = {"box": [[0, 0, 0], [1, 1, 1]]}
 PLATE = {
@@ -92,13 +92,7 @@ def main():
             f"| {r['family']} | {r['domain']} | {r['cells']} | {r['vertices']} | {r['faces']} | {r['seconds']:.2f} | "
             f"{r['cpu_seconds']:.2f} | {r['validate_seconds']:.2f} | {guess} |"
         )
-    lines += [
-        "",
-        f"Load average at the end (1, 5, 15 min): {record['load_average']}. On a shared machine the wall time "
-        "includes waiting for a core; the CPU time is the process's own.",
-        "",
-        targets_line(record["targets"], "Targets (wall time)"),
-    ]
+    lines += shared_machine_lines(record)
     write_report("meshing3d", record, lines)
 
 

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from _common import MACHINE, quick_parser, targets_line, write_report
+from _common import MACHINE, quick_parser, shared_machine_lines, write_report
 
 RECTANGLE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "sides": ["bottom", "right", "top", "left"]}
 
@@ -121,13 +121,7 @@ def main():
             f"{r['vertices_before']} | {r['cells']} | {r['vertices']} | {r['seconds']:.2f} | {r['cpu_seconds']:.2f} | "
             f"{1e6 * r['seconds'] / r['cells']:.1f} |"
         )
-    lines += [
-        "",
-        f"Load average at the end (1, 5, 15 min): {record['load_average']}. On a shared machine the wall time "
-        "includes waiting for a core; the CPU time is the process's own.",
-        "",
-        targets_line(record["targets"], "Targets (wall time)"),
-    ]
+    lines += shared_machine_lines(record)
     write_report("refine3d", record, lines)
 
 

@@ -352,6 +352,19 @@ HISTORY_ATTRS = {
 _INTEGER_HISTORY = ("n_dofs", "n_cells", "marked", "skipped", "iterations", "linear_iterations", "warm_start")
 
 
+def error_indicator_variable(mesh, indicator) -> tuple:
+    """(dimension, values, attributes) of the file variable ``error_indicator``: η_K on the mesh's
+    cells (``mesh2d_nFaces`` or ``mesh3d_nVolumes``)."""
+    topology = mesh_topology(mesh)
+    attrs = {
+        "long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
+        "mesh": topology.name,
+        "location": topology.cell_location,
+        "units": "sqrt(energy)",
+    }
+    return topology.cell_dimension, indicator, attrs
+
+
 def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
     """The final solution file (docs/reference/files.md) plus ``error_indicator`` per face and the per-step history
     on the ``adapt_step`` dimension (docs/reference/files.md). Entries a step does not have are not stored."""
@@ -364,17 +377,7 @@ def adaptive_dataset(scene, run: AdaptiveRun, extra_attrs=None) -> xr.Dataset:
             f"the stresses of the solution overflow double precision ({error}); "
             "rescale the units of the scene (E, k, tractions)"
         ) from None
-    topology = mesh_topology(run.problem.mesh)
-    ds["error_indicator"] = (
-        topology.cell_dimension,
-        run.indicators["indicator"],
-        {
-            "long_name": "a posteriori error indicator eta_K (vemkit.vem.estimator)",
-            "mesh": topology.name,
-            "location": topology.cell_location,
-            "units": "sqrt(energy)",
-        },
-    )
+    ds["error_indicator"] = error_indicator_variable(run.problem.mesh, run.indicators["indicator"])
     steps = len(run.history)
     for name, (long_name, units) in HISTORY_ATTRS.items():
         values = [record.get(name, 0 if name in ("marked", "skipped") else None) for record in run.history]

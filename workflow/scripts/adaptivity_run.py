@@ -16,7 +16,7 @@ with logged(smk):
     from vemkit.config.scene import load_scene
     from vemkit.io.solution_file import write_netcdf
     from vemkit.mesh.ugrid import mesh_to_ugrid_dataset, mesh_topology
-    from vemkit.studies.adaptivity import adapt, adaptive_dataset
+    from vemkit.studies.adaptivity import adapt, adaptive_dataset, error_indicator_variable
     from vemkit.studies.adaptivity_compare import run_settings
     from vemkit.studies.adaptivity_errors import scene_true_error
 
@@ -51,15 +51,7 @@ with logged(smk):
     for path, k in zip(smk.output.snapshots, np.resize(chosen, len(smk.output.snapshots))):
         mesh, indicator, u, record = steps[k]
         ds, topology = mesh_to_ugrid_dataset(mesh), mesh_topology(mesh)
-        ds["error_indicator"] = (
-            topology.cell_dimension,
-            indicator,
-            {
-                "long_name": "a posteriori error indicator eta_K",
-                "mesh": topology.name,
-                "location": topology.cell_location,
-            },
-        )
+        ds["error_indicator"] = error_indicator_variable(mesh, indicator)
         for c in range(u.shape[1]):
             ds[f"u{c + 1}"] = (
                 topology.node_dimension,

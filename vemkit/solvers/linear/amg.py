@@ -18,6 +18,7 @@ from vemkit.contact.boundary import rank_one_blocks
 from vemkit.exceptions import LinearSolveError
 from vemkit.solvers.linear.base import LinearSolver, NewtonSystems, reduced_right_hand_side, three_d
 from vemkit.solvers.linear.cycle import CYCLE_PRECISION, v_cycle_preconditioner
+from vemkit.solvers.linear.direct import IterativeNewtonSystems
 from vemkit.solvers.sparse_ops import SumOperator, as_matrix, reduced_operator
 
 REBUILD_FACTOR = 3.0  # rebuild the AMG hierarchy when CG needs this many times the baseline iterations/decade
@@ -201,7 +202,7 @@ class AMGSolver(LinearSolver):
         return BoundaryUpdatedHierarchy(self.hierarchy, support, nodal=True, precision=CYCLE_PRECISION)
 
 
-class AMGNewtonSystems(NewtonSystems):
+class AMGNewtonSystems(IterativeNewtonSystems):
     """Krylov on Z^T (K + D) Z with the projected V-cycle of K's hierarchy (updated or rebuilt for K + D)."""
 
     method = AMGSolver.method
@@ -225,11 +226,6 @@ class AMGNewtonSystems(NewtonSystems):
         for term in terms[1:]:
             D = D + term
         return SumOperator(K, D)
-
-    def fallback(self) -> NewtonSystems:
-        from vemkit.solvers.linear.direct import DirectNewtonSystems
-
-        return DirectNewtonSystems()
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True, atol=0.0):
         b, lift = reduced_right_hand_side(Z, rhs)

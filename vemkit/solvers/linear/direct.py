@@ -84,3 +84,11 @@ class DirectNewtonSystems(NewtonSystems):
 
 
 BACKEND = DirectSolver
+
+
+class IterativeNewtonSystems(NewtonSystems):
+    """Newton systems solved to a tolerance (AMG, PETSc): when their inexact steps stall the line
+    search, ssn switches to :class:`DirectNewtonSystems`."""
+
+    def fallback(self) -> NewtonSystems:
+        return DirectNewtonSystems()

@@ -27,6 +27,7 @@ import numpy as np
 
 from vemkit.exceptions import LinearSolveError, SceneError
 from vemkit.solvers.linear.base import LinearSolver, NewtonSystems, reduced_right_hand_side
+from vemkit.solvers.linear.direct import IterativeNewtonSystems
 from vemkit.solvers.sparse_ops import as_matrix
 
 INSTALL_FIX = "run make install (it installs the mpi extra) or pip install -e '.[mpi]'"
@@ -207,7 +208,7 @@ class ProjectedPreconditioner:
         self.Z.multTranspose(self.full_out, y)
 
 
-class PETScNewtonSystems(NewtonSystems):
+class PETScNewtonSystems(IterativeNewtonSystems):
     """Krylov on Z^T (K + D) Z with Z^T M Z, M GAMG set up for K + D + penalty at every step."""
 
     method = PETScSolver.method
@@ -222,11 +223,6 @@ class PETScNewtonSystems(NewtonSystems):
         for term in terms:
             A = A + term
         return A.tocsr()
-
-    def fallback(self) -> NewtonSystems:
-        from vemkit.solvers.linear.direct import DirectNewtonSystems
-
-        return DirectNewtonSystems()
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True, atol=0.0):
         b, lift = reduced_right_hand_side(Z, rhs)
