@@ -33,6 +33,7 @@ from vemkit.mesh.components import mesh_pieces
 from vemkit.mesh.mesh import Mesh
 from vemkit.mesh.meshing import scene_mesh
 from vemkit.vem.condensation import condense_load, interior_load, recover_interior
+from vemkit.vem.distributed_assembly import distributed_stiffness
 from vemkit.vem.dofs import DofMap, apply_fixed_dofs
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes
 from vemkit.vem.space import VirtualElementSpace
@@ -43,7 +44,7 @@ from vemkit.vem.volumetric import cell_stress, stiffness_matrix
 class DiscreteProblem:
     space: VirtualElementSpace
     dofs: DofMap
-    stiffness: sp.csr_matrix
+    stiffness: sp.csr_matrix  # or a DistributedStiffness across MPI ranks (vemkit.vem.distributed_matrix)
     load: np.ndarray
     contact: ContactBoundary
     law: FoundationLaw
@@ -194,6 +195,7 @@ def discrete_problem(
     body_force_projection: str | None = None,
     model: str = "plane_stress",
     volumetric_strain: str = "auto",
+    comm=None,
 ) -> DiscreteProblem:
     """Assemble (3.16) without the contact terms plus the contact boundary data, with the element of
     order ``order``.
@@ -207,6 +209,8 @@ def discrete_problem(
     model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
     volumetric_strain: cell (the paper's), nodal_average (k = 1, ``vemkit.vem.volumetric``) or auto
     (the scene key's default: nodal_average for k = 1, plane strain or 3D, nu > 0.45; ``vemkit.config.volumetric``).
+    comm: an MPI communicator of several ranks (``vemkit.vem.parallel.world``): the stiffness is
+    split across them, each rank assembling its own cells (``vemkit.vem.distributed_assembly``).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     space = VirtualElementSpace(mesh, order)
@@ -214,7 +218,7 @@ def discrete_problem(
     lam, mu = lame_parameters(E, nu, model)
     volumetric_strain = resolved_volumetric_strain(volumetric_strain, space.order, model, nu)
     dofs = constrained(space, dirichlet)
-    K = stiffness_matrix(space, lam, mu, stabilization, dofs, volumetric_strain)
+    K = stiffness_matrix(space, lam, mu, stabilization, dofs, volumetric_strain) if comm is None else None
     projection = body_force_projection or space.element.default_body_force_projection
     full_load = problem_load(space, neumann, pressure, body_force, projection, lam, mu)
     if dofs.condensed:
@@ -224,8 +228,11 @@ def discrete_problem(
         f, interior = dofs.restrict(full_load), None
     # the Gamma_C edge nodes (k = 2 midpoints) as unknowns; none for an element without edge nodes
     dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
-    K, f = change_variables(K, f, dofs.change)
-    K, f = apply_fixed_dofs(K, f, dofs)
+    if comm is None:
+        K, f = change_variables(K, f, dofs.change)
+        K, f = apply_fixed_dofs(K, f, dofs)
+    else:
+        K, f = distributed_stiffness(space, lam, mu, stabilization, dofs, f, comm, volumetric_strain)
     cb = contact_boundary(space, contact, dofs, gap, contact_quadrature, contact_gauss_points)
     law = law or ContactLaw(0.0, 1.0, 0.0, 0.0)
     return DiscreteProblem(
@@ -269,12 +276,13 @@ def scene_problem_data(scene) -> dict:
     )
 
 
-def scene_problem(scene, mesh: Mesh | None = None) -> DiscreteProblem:
-    """Assemble the discrete problem (3.16) of a scene, on its own mesh unless one is given."""
+def scene_problem(scene, mesh: Mesh | None = None, comm=None) -> DiscreteProblem:
+    """Assemble the discrete problem (3.16) of a scene, on its own mesh unless one is given (``comm``:
+    split across MPI ranks, :func:`discrete_problem`)."""
     mesh = scene_mesh(scene) if mesh is None else mesh
     check_expressions_on_mesh(scene, mesh)  # a pole at a vertex: refused, not integrated around
     t0 = time.perf_counter()
-    problem = discrete_problem(mesh, scene.E, scene.nu, **scene_problem_data(scene))
+    problem = discrete_problem(mesh, scene.E, scene.nu, **scene_problem_data(scene), comm=comm)
     problem.info["assembly_time"] = time.perf_counter() - t0
     problem.info["order"] = scene.order
     problem.info["scene"] = scene  # the solution Dataset records it as the file of vemkit solve does

@@ -31,7 +31,10 @@ def _abs_matvec(indptr, indices, data, x, out):
 
 
 def abs_matvec(A, x) -> np.ndarray:
-    """|A| x for a CSR matrix A (entrywise absolute values; no copy of A)."""
+    """|A| x for a CSR matrix A (entrywise absolute values; no copy of A), or for a matrix split
+    across MPI ranks (``vemkit.vem.distributed_matrix``) by its own ``abs_matvec``."""
+    if getattr(A, "distributed", False):
+        return A.abs_matvec(x)
     A = A.tocsr()
     x = np.ascontiguousarray(x, dtype=float)
     if A.nnz < 1_000_000:  # small: scipy, no kernel to load

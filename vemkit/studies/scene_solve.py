@@ -81,15 +81,19 @@ def mesh_family(mesh) -> str:
     return family
 
 
-def solve_scene(scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False, dataset: bool = True):
+def solve_scene(
+    scene, progress=None, mesh: Mesh | None = None, *, verify: bool = False, dataset: bool = True, comm=None
+):
     """Solve a scene; returns (problem, solution, dataset).
 
     ``verify``: raise VerificationError unless the independent check meets
     :func:`check_tolerance`; the dataset then records ``check_worst`` and ``check_tolerance``.
     ``dataset=False``: the solution file's :class:`~vemkit.mesh.file_description.FileDescription`
     instead of its xarray Dataset (the command line: xarray and pandas are never imported).
+    ``comm``: the MPI communicator of a job on several ranks (``vemkit.vem.parallel.world``): the
+    problem is split across them; every rank returns the whole solution.
     """
-    problem = scene_problem(scene, mesh)
+    problem = scene_problem(scene, mesh, comm=comm)
     if problem.mesh.n_cells == 0 or problem.n_dofs == 0:
         raise MeshError(
             f"the mesh has {problem.mesh.n_cells} cells and {problem.n_dofs} free DOFs; "

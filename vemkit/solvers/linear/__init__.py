@@ -52,6 +52,7 @@ DIRECT_LIMIT = 20_000  # "auto" picks the direct solver up to this many unknowns
 #: the same in 3D, where LU's fill grows much faster: the sheared box (config/scenes/3d/sheared_box.yaml),
 #: ssn solve seconds direct / AMG: 1 254 DOFs 0.06 / 0.11, 3 198: 0.33 / 0.18, 13 629: 12.5 / 0.60
 DIRECT_LIMIT_3D = 2_000
+DISTRIBUTED_BACKEND = "petsc"  # the backend that solves across MPI ranks (and what auto picks there)
 
 
 @cache
@@ -85,10 +86,18 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
     options = {}
     if isinstance(method, BackendChoice):
         method, options = method.method, {"options": method.options}
+    distributed = getattr(A, "distributed", False)  # split across MPI ranks: only a backend that takes that
     if method == "auto":
-        method = DirectSolver.method if A.shape[0] <= direct_limit(near_nullspace) else AMGSolver.method
+        small = A.shape[0] <= direct_limit(near_nullspace)
+        method = DISTRIBUTED_BACKEND if distributed else DirectSolver.method if small else AMGSolver.method
     backend = backends().get(method) if isinstance(method, str) else None
     if backend is None:
         names = ", ".join(sorted(backends()))
         raise SceneError(f"solver.linear = {method!r} is unknown; use {names} or auto", key="solver.linear")
+    if distributed and not backend.distributed:
+        raise SceneError(
+            f"solver.linear = {method} solves in one process, but this job runs on several MPI ranks; "
+            f"use --set solver.linear={DISTRIBUTED_BACKEND}, or run without mpiexec",
+            key="solver.linear",
+        )
     return backend(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter, **options)

@@ -28,6 +28,7 @@ class LinearSolver:
 
     method: str = ""  # the value of solver.linear that chooses this backend
     iterative: bool = False  # solves stop at a tolerance (True) or are exact (False)
+    distributed: bool = False  # solves a matrix split across MPI ranks (vemkit.vem.distributed_matrix)
 
     A: object
     iterations: int = 0

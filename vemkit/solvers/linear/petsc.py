@@ -20,7 +20,6 @@ petsc4py is imported on first use; without it :func:`require_petsc4py` says how 
 from __future__ import annotations
 
 import itertools
-import sys
 from contextlib import contextmanager
 
 import numpy as np
@@ -29,29 +28,14 @@ from vemkit.exceptions import LinearSolveError, SceneError
 from vemkit.solvers.linear.base import LinearSolver, NewtonSystems, reduced_right_hand_side
 from vemkit.solvers.linear.direct import IterativeNewtonSystems
 from vemkit.solvers.sparse_ops import as_matrix
+from vemkit.vem.distributed_matrix import owned_rows, petsc_rows
+from vemkit.vem.parallel import require_petsc4py
 
-INSTALL_FIX = "run make install (it installs the mpi extra) or pip install -e '.[mpi]'"
 #: near-nullspace columns (the rigid motions) -> components per node, the matrix's block size
 BLOCK_SIZE_OF_MODES = {3: 2, 6: 3}
 NEWTON_MAXITER = 5000  # Krylov iterations of one Newton step (as the AMG backend's)
 GMRES_RESTART = 50
 _prefixes = itertools.count()  # every solver's options live under a prefix of its own
-
-
-def require_petsc4py():
-    """petsc4py's ``PETSc`` module, initialized without the command line's arguments (they are
-    vemkit's, not PETSc options); SceneError naming solver.linear and the fix when it is missing."""
-    try:
-        import petsc4py
-    except ImportError:
-        raise SceneError(
-            f"solver.linear = petsc needs petsc4py, which is not installed; {INSTALL_FIX}", key="solver.linear"
-        ) from None
-    if "petsc4py.PETSc" not in sys.modules:
-        petsc4py.init(["vemkit"])  # a program name, no option
-    from petsc4py import PETSc
-
-    return PETSc
 
 
 def block_size(near_nullspace, n: int) -> int:
@@ -60,25 +44,64 @@ def block_size(near_nullspace, n: int) -> int:
     return bs if n % bs == 0 else 1
 
 
+class OneProcess:
+    """The layout of a matrix in one process: PETSc's vectors hold the whole vectors
+    (``vemkit.vem.distributed_assembly.DofLayout`` is the layout across MPI ranks)."""
+
+    def __init__(self, n: int):
+        self.size = self.n_owned = n
+        self.comm = require_petsc4py().COMM_SELF
+
+    def local(self, x) -> np.ndarray:
+        return np.ascontiguousarray(x, dtype=float)
+
+    def gather(self, local) -> np.ndarray:
+        return np.array(local, dtype=float)
+
+
+def layout_of(A):
+    """How A's rows are split: its :class:`DofLayout` across ranks, or :class:`OneProcess`."""
+    layout = getattr(A, "layout", None)
+    return OneProcess(A.shape[0]) if layout is None else layout
+
+
 def petsc_matrix(A, bs: int = 1, near_nullspace=None):
-    """A (scipy sparse) as a PETSc AIJ matrix of block size ``bs``, with the orthonormalized columns
-    of ``near_nullspace`` as its near-nullspace."""
+    """A as a PETSc matrix: a distributed stiffness's own MPIAIJ matrix, or a scipy matrix as an AIJ
+    matrix of block size ``bs`` in this process; the orthonormalized columns of ``near_nullspace``
+    (whole vectors) its near-nullspace."""
     PETSc = require_petsc4py()
-    A = as_matrix(A).tocsr()
-    if not A.has_sorted_indices:
-        A = A.sorted_indices()
-    csr = (A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data.astype(PETSc.ScalarType))
-    M = PETSc.Mat().createAIJ(size=A.shape, bsize=bs, csr=csr, comm=PETSc.COMM_SELF)
-    M.assemble()
+    A = as_matrix(A)
+    if getattr(A, "distributed", False):
+        M = A.petsc
+    else:
+        A = A.tocsr()
+        if not A.has_sorted_indices:
+            A = A.sorted_indices()
+        csr = (A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data.astype(PETSc.ScalarType))
+        M = PETSc.Mat().createAIJ(size=A.shape, bsize=bs, csr=csr, comm=PETSc.COMM_SELF)
+        M.assemble()
     if near_nullspace is not None:
+        layout = layout_of(A)
         orthonormal, _ = np.linalg.qr(np.asarray(near_nullspace, dtype=float))
         vectors = []
         for column in orthonormal.T:
             v = M.createVecRight()
-            v.setArray(column)
+            v.setArray(layout.local(column))
             vectors.append(v)
-        M.setNearNullSpace(PETSc.NullSpace().create(constant=False, vectors=vectors, comm=PETSc.COMM_SELF))
+        M.setNearNullSpace(PETSc.NullSpace().create(constant=False, vectors=vectors, comm=layout.comm))
     return M
+
+
+def stick_basis_matrix(Z, layout):
+    """(Z as a PETSc matrix, the layout of its columns): in one process the scipy Z; across ranks
+    each column (one vertex's) owned with the rows it touches (``vemkit.vem.distributed_assembly.column_layout``)."""
+    if isinstance(layout, OneProcess):
+        return petsc_matrix(Z), OneProcess(Z.shape[1])
+    from vemkit.vem.distributed_assembly import column_layout
+
+    columns = column_layout(layout, Z)
+    rows = owned_rows(layout, Z, columns.position)
+    return petsc_rows(layout, rows, (columns.n_owned, columns.size)), columns
 
 
 def _option_text(value) -> str:
@@ -113,7 +136,7 @@ def _configured_ksp(matrix, prefix, options, *, krylov="cg", operator=None, prec
     """A KSP of ``operator`` (default ``matrix``) with GAMG on ``matrix`` (or the python-context
     ``preconditioner``), the scene's options applied, set up; residuals in the unpreconditioned norm."""
     PETSc = require_petsc4py()
-    ksp = PETSc.KSP().create(comm=PETSc.COMM_SELF)
+    ksp = PETSc.KSP().create(comm=matrix.getComm())
     ksp.setOperators(matrix if operator is None else operator, matrix)
     ksp.setType(krylov)
     if krylov == "gmres":
@@ -131,19 +154,20 @@ def _configured_ksp(matrix, prefix, options, *, krylov="cg", operator=None, prec
     return ksp
 
 
-def _krylov(ksp, b, x0, rtol, atol, maxiter):
-    """(x, iterations, converged) of ksp on b from x0 (None: zero)."""
+def _krylov(ksp, b, x0, rtol, atol, maxiter, layout):
+    """(x, iterations, converged) of ksp on b from x0 (None: zero); b, x0 and x whole vectors, each
+    rank giving PETSc its entries (``layout``)."""
     x = ksp.getOperators()[0].createVecRight()
     if x0 is None:
         x.set(0.0)
     else:
-        x.setArray(np.asarray(x0, dtype=float))
+        x.setArray(layout.local(x0))
     rhs = x.duplicate()
-    rhs.setArray(np.asarray(b, dtype=float))
+    rhs.setArray(layout.local(b))
     ksp.setInitialGuessNonzero(x0 is not None)
     ksp.setTolerances(rtol=rtol, atol=atol, max_it=maxiter)
     ksp.solve(rhs, x)
-    solution = x.getArray().copy()
+    solution = layout.gather(x.getArray())
     return solution, ksp.getIterationNumber(), ksp.getConvergedReason() > 0 and np.all(np.isfinite(solution))
 
 
@@ -152,9 +176,11 @@ class PETScSolver(LinearSolver):
 
     method = "petsc"
     iterative = True
+    distributed = True
 
     def __init__(self, A, near_nullspace=None, tol=1e-10, maxiter=2000, options=None):
-        self.A = A.tocsr()
+        self.A = A if getattr(A, "distributed", False) else A.tocsr()
+        self.layout = layout_of(A)
         self.tol, self.maxiter = tol, maxiter
         self.near_nullspace = near_nullspace
         self.options = dict(options or {})
@@ -178,14 +204,14 @@ class PETScSolver(LinearSolver):
             return np.zeros_like(b)
         operator = self.matrix if A is None or A is self.A else petsc_matrix(A, self.bs)
         self.ksp.setOperators(operator, self.matrix)  # K's preconditioner kept for another matrix
-        x, self.iterations, converged = _krylov(self.ksp, b, x0, tol, 0.0, self.maxiter)
+        x, self.iterations, converged = _krylov(self.ksp, b, x0, tol, 0.0, self.maxiter, self.layout)
         used = self.A if A is None else A
         self.residual = float(np.linalg.norm(b - used @ x) / bnorm)
         if not converged:
             raise LinearSolveError(
                 f"PETSc {self.ksp.getType()} stopped after {self.iterations} iterations at relative residual "
                 f"{self.residual:.2e} (asked {tol:.1e}, reason {self.ksp.getConvergedReason()}); "
-                "try solver.linear=amg or direct",
+                f"{failure_advice(self.layout)}",
                 solver=self.method,
                 iterations=self.iterations,
             )
@@ -218,11 +244,15 @@ class PETScNewtonSystems(IterativeNewtonSystems):
         self.rebuilds = 0
 
     def operator(self, K, *terms):
-        """K + the terms, formed (PETSc takes a matrix)."""
+        """K + the terms, formed (PETSc takes a matrix; across ranks each adds its rows)."""
         A = K
         for term in terms:
             A = A + term
-        return A.tocsr()
+        return A if getattr(A, "distributed", False) else A.tocsr()
+
+    def fallback(self) -> NewtonSystems | None:
+        """Direct solves in one process; none across ranks (SuperLU holds the whole matrix)."""
+        return super().fallback() if isinstance(self.base.layout, OneProcess) else None
 
     def solve(self, A, Z, rhs, eta, penalty, symmetric=True, atol=0.0):
         b, lift = reduced_right_hand_side(Z, rhs)
@@ -231,24 +261,40 @@ class PETScNewtonSystems(IterativeNewtonSystems):
         base = self.base
         full = petsc_matrix(as_matrix(A) + penalty(), base.bs, base.near_nullspace)
         krylov = "cg" if symmetric else "gmres"
+        layout = base.layout
         if Z is None:
             ksp = _configured_ksp(full, base.prefix, base.options, krylov=krylov, operator=petsc_matrix(A, base.bs))
         else:
             inner = _configured_ksp(full, base.prefix, base.options).getPC()
-            Zp = petsc_matrix(Z)
-            reduced = petsc_matrix((Z.T @ as_matrix(A) @ Z).tocsr())
+            Zp, layout = stick_basis_matrix(Z, base.layout)
+            reduced = _reduced_matrix(A, Z, Zp, base.bs)
             projected = ProjectedPreconditioner(Zp, inner)
             ksp = _configured_ksp(reduced, base.prefix, base.options, krylov=krylov, preconditioner=projected)
         self.rebuilds += 1
-        y, its, converged = _krylov(ksp, b, None, eta, atol, NEWTON_MAXITER)
+        y, its, converged = _krylov(ksp, b, None, eta, atol, NEWTON_MAXITER, layout)
         if not converged:
             raise LinearSolveError(
                 f"PETSc {ksp.getType()} of the Newton step stopped after {its} iterations "
-                f"(reason {ksp.getConvergedReason()}); try solver.linear=amg or direct",
+                f"(reason {ksp.getConvergedReason()}); {failure_advice(base.layout)}",
                 solver=self.method,
                 iterations=its,
             )
         return lift(y), its
+
+
+def _reduced_matrix(A, Z, Zp, bs):
+    """Z^T A Z as a PETSc matrix: scipy's product in one process, PETSc's PtAP across ranks."""
+    if getattr(A, "distributed", False):
+        return A.petsc.ptap(Zp)
+    return petsc_matrix((Z.T @ as_matrix(A) @ Z).tocsr())
+
+
+def failure_advice(layout) -> str:
+    """What to try when a PETSc solve stalls: another backend in one process; across ranks a
+    stronger preconditioner (the other backends hold the whole matrix)."""
+    if isinstance(layout, OneProcess):
+        return "try solver.linear=amg or direct"
+    return "try stronger GAMG options in solver.petsc_options, or one process with solver.linear=direct"
 
 
 BACKEND = PETScSolver

@@ -1,0 +1,227 @@
+"""The stiffness (3.9) assembled across MPI ranks: each rank computes its own cells only.
+
+The cells are split by METIS (``vemkit.mesh.partition``); a free node belongs to the rank of its
+lowest-numbered cell, and the unknowns are renumbered rank after rank, node by node
+(:class:`DofLayout`: PETSc's contiguous ownership, d components per node, so the matrix keeps its
+d x d blocks). Each rank computes the local matrices of its cells with the element's Numba kernels
+(``cell_entries``, specialized per element as ``vemkit.vem.assembly``'s templates are) and hands
+PETSc the entries as COO triplets (``MatSetPreallocationCOO``/``MatSetValuesCOO``); PETSc sends the
+entries of rows another rank owns to their owner and sums them there. Held components
+(``DofMap.fixed_dofs``) get the symmetric elimination of ``vemkit.vem.dofs.apply_fixed_dofs``
+entry by entry: their rows and columns dropped but for the diagonal, K_fh g moved to the load.
+
+Only what a cell's own matrix holds is distributed: the nodal-average volumetric term and the
+k = 2 change of variables on Gamma_C couple cells beyond one element and are refused here
+(:func:`check_distributable`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from vemkit.exceptions import SceneError
+from vemkit.mesh.partition import cell_partition
+from vemkit.vem.assembly import condense_interior, largest_cell, material_of, specialized
+from vemkit.vem.distributed_matrix import DistributedStiffness
+from vemkit.vem.pattern import ROW_CHUNKS, chunk_rows
+
+
+@dataclass(frozen=True)
+class DofLayout:
+    """The unknowns split across the ranks of ``comm``: ``order[p]`` is the unknown (in the serial
+    numbering of the DofMap) that PETSc numbers p; rank r owns p in [starts[r], starts[r + 1])."""
+
+    comm: object
+    order: np.ndarray
+    position: np.ndarray  # the inverse of order: PETSc's number of each serial unknown
+    starts: np.ndarray
+    dimension: int
+
+    @property
+    def rank(self) -> int:
+        return self.comm.Get_rank()
+
+    @property
+    def owned(self) -> slice:
+        return slice(int(self.starts[self.rank]), int(self.starts[self.rank + 1]))
+
+    @property
+    def n_owned(self) -> int:
+        return int(self.starts[self.rank + 1] - self.starts[self.rank])
+
+    @property
+    def size(self) -> int:
+        return int(self.starts[-1])
+
+    def local(self, x) -> np.ndarray:
+        """The owned entries of a whole vector x (serial numbering), in PETSc's order."""
+        return np.ascontiguousarray(np.asarray(x, dtype=float)[self.order[self.owned]])
+
+    def gather(self, local) -> np.ndarray:
+        """The whole vector (serial numbering) of every rank's owned entries (allgather)."""
+        from mpi4py import MPI
+
+        counts = np.diff(self.starts)
+        ordered = np.empty(self.size)
+        self.comm.Allgatherv(np.ascontiguousarray(local, dtype=float), [ordered, counts, self.starts[:-1], MPI.DOUBLE])
+        out = np.empty(self.size)
+        out[self.order] = ordered
+        return out
+
+    def sum(self, x) -> np.ndarray:
+        """The sum over the ranks of an array (allreduce)."""
+        from mpi4py import MPI
+
+        out = np.empty_like(np.asarray(x, dtype=float))
+        self.comm.Allreduce(np.ascontiguousarray(x, dtype=float), out, op=MPI.SUM)
+        return out
+
+
+def node_owners(offsets, nodes, cell_part, n_nodes) -> np.ndarray:
+    """(n_nodes,) the part of each node's lowest-numbered cell."""
+    first = np.full(n_nodes, offsets.shape[0], dtype=np.int64)
+    cells = np.repeat(np.arange(offsets.shape[0] - 1, dtype=np.int64), np.diff(offsets))
+    np.minimum.at(first, nodes, cells)
+    return cell_part[np.minimum(first, offsets.shape[0] - 2)]
+
+
+def dof_layout(comm, dofs, offsets, nodes, cell_part) -> DofLayout:
+    """The free nodes renumbered rank after rank (in their serial order within a rank)."""
+    d, size = dofs.dimension, comm.Get_size()
+    owner = node_owners(offsets, nodes, cell_part, dofs.n_nodes)[dofs.free_nodes]
+    node_order = np.argsort(owner, kind="stable")
+    order = (d * node_order[:, None] + np.arange(d)).ravel()
+    position = np.empty_like(order)
+    position[order] = np.arange(order.size)
+    starts = d * np.concatenate([[0], np.cumsum(np.bincount(owner, minlength=size))])
+    return DofLayout(comm, order, position, starts.astype(np.int64), d)
+
+
+def column_layout(layout: DofLayout, Z) -> DofLayout:
+    """The columns of Z (n x m, whole on every rank) split across the ranks: a column goes with
+    the first unknown it touches (Z's columns each touch one vertex: the stick basis)."""
+    csc = Z.tocsc()
+    csc.sort_indices()
+    first_row = csc.indices[csc.indptr[:-1]]
+    owner = np.searchsorted(layout.starts, layout.position[first_row], side="right") - 1
+    order = np.argsort(owner, kind="stable")
+    position = np.empty_like(order)
+    position[order] = np.arange(order.size)
+    counts = np.bincount(owner, minlength=layout.comm.Get_size())
+    return DofLayout(layout.comm, order, position, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), 1)
+
+
+def cell_entries(geometry, cells, owned, starts, free_index, material, max_nodes, rows, cols, vals):
+    """*Template* (parallel). The entries of the local stiffness (3.9) of every cell in ``owned``,
+    rows and columns of its free nodes (serial unknowns d r + a), from ``starts[t]`` on for the
+    t-th cell; each thread a contiguous share of the cells, its work arrays allocated once."""
+    offsets, nodes = cells
+    lam, mu, stab, condense = material
+    for chunk in numba.prange(ROW_CHUNKS):
+        lo, hi = chunk_rows(chunk, owned.shape[0])
+        work = workspace(max_nodes)  # noqa: F821 (bound by ``specialized``)
+        for t in range(lo, hi):
+            c = owned[t]
+            start, size = offsets[c], offsets[c + 1] - offsets[c]
+            K = cell_matrix(c, geometry, offsets, nodes, lam, mu, stab, work)  # noqa: F821
+            if condense:
+                condense_interior(K, size)
+            p = starts[t]
+            for i in range(size):
+                r = free_index[nodes[start + i]]
+                if r < 0:
+                    continue
+                for a in range(DIM):  # noqa: F821 (bound by ``specialized``)
+                    for j in range(size):
+                        s = free_index[nodes[start + j]]
+                        if s < 0:
+                            continue
+                        for b in range(DIM):  # noqa: F821
+                            rows[p] = DIM * r + a  # noqa: F821
+                            cols[p] = DIM * s + b  # noqa: F821
+                            vals[p] = K[DIM * i + a, DIM * j + b]  # noqa: F821
+                            p += 1
+
+
+def owned_cell_entries(space, lam, mu, stabilization, dofs, owned) -> tuple:
+    """(rows, cols, values) of the cells ``owned`` (serial unknowns)."""
+    offsets, nodes = cells = space.cell_nodes
+    d = space.element.dimension
+    free = (dofs.free_index[nodes] >= 0).astype(np.int64)
+    per_cell = np.add.reduceat(free, offsets[:-1]) if nodes.size else np.zeros(offsets.size - 1, np.int64)
+    sizes = (d * per_cell[owned]) ** 2
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    rows = np.empty(starts[-1], dtype=np.int64)
+    cols = np.empty(starts[-1], dtype=np.int64)
+    vals = np.empty(starts[-1])
+    kernel = specialized(cell_entries, space.element, parallel=True, chunk_rows=chunk_rows)
+    kernel(
+        space.element.geometry(space.mesh),
+        cells,
+        np.ascontiguousarray(owned, dtype=np.int64),
+        starts,
+        dofs.free_index,
+        material_of(lam, mu, stabilization, dofs),
+        largest_cell(offsets),
+        rows,
+        cols,
+        vals,
+    )
+    return rows, cols, vals
+
+
+def check_distributable(treatment: str, change) -> None:
+    """SceneError for what couples cells beyond one element's matrix (module docstring)."""
+    if treatment != "cell":
+        raise SceneError(
+            f"volumetric_strain = {treatment} is not split across MPI ranks yet; run in one process "
+            "(without mpiexec) or set discretization.volumetric_strain=cell",
+            key="discretization.volumetric_strain",
+        )
+    if change is not None:
+        raise SceneError(
+            "order 2 with a contact side is not split across MPI ranks yet; run in one process "
+            "(without mpiexec) or set discretization.order=1",
+            key="discretization.order",
+        )
+
+
+def held_elimination(rows, cols, vals, dofs, layout) -> tuple:
+    """The entries without the held rows and columns (their diagonal kept), the load's change
+    -K_fh g (serial numbering, this rank's part) and the held diagonal (summed over the ranks)."""
+    lift = np.zeros(layout.size)
+    fixed = dofs.fixed_dofs
+    if fixed.size == 0:
+        return rows, cols, vals, lift, np.zeros(0)
+    held = np.zeros(layout.size, dtype=bool)
+    held[fixed] = True
+    values = np.zeros(layout.size)
+    values[fixed] = dofs.fixed_values
+    into_held = held[cols] & ~held[rows]
+    np.add.at(lift, rows[into_held], -vals[into_held] * values[cols[into_held]])
+    diagonal = np.zeros(layout.size)
+    on_diagonal = held[rows] & (rows == cols)
+    np.add.at(diagonal, rows[on_diagonal], vals[on_diagonal])
+    keep = ~(held[rows] | held[cols]) | (rows == cols)
+    return rows[keep], cols[keep], vals[keep], lift, layout.sum(diagonal)[fixed]
+
+
+def distributed_stiffness(space, lam, mu, stabilization, dofs, load, comm, treatment="cell"):
+    """(K, f): the stiffness on the free unknowns split across the ranks of ``comm`` (a
+    :class:`DistributedStiffness`, every rank its own cells' entries) and the load with the held
+    components eliminated (``vemkit.vem.dofs.apply_fixed_dofs``), whole on every rank."""
+    check_distributable(treatment, dofs.change)
+    offsets, nodes = space.cell_nodes
+    part = comm.bcast(cell_partition(space.mesh, offsets, nodes, comm.Get_size()) if comm.Get_rank() == 0 else None)
+    layout = dof_layout(comm, dofs, offsets, nodes, part)
+    owned = np.flatnonzero(part == comm.Get_rank())
+    rows, cols, vals = owned_cell_entries(space, lam, mu, stabilization, dofs, owned)
+    rows, cols, vals, lift, held_diagonal = held_elimination(rows, cols, vals, dofs, layout)
+    K = DistributedStiffness.from_entries(layout, layout.position[rows], layout.position[cols], vals)
+    f = load + layout.sum(lift)
+    if dofs.fixed_dofs.size:
+        f[dofs.fixed_dofs] = held_diagonal * dofs.fixed_values
+    return K, f

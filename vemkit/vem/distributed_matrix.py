@@ -1,0 +1,132 @@
+"""The stiffness matrix split by rows across MPI ranks, seen by the contact solvers as a matrix.
+
+:class:`DistributedStiffness` holds a PETSc MPIAIJ matrix of block size d (each rank its own rows,
+:class:`vemkit.vem.distributed_assembly.DofLayout`) and answers what the contact solvers ask of a
+stiffness matrix with whole vectors in the serial numbering, which every rank holds: K x (PETSc's
+parallel product, then an allgather), |K| |x| (the rounding floor), K's entries at the contact
+vertices, its diagonal, and K + D for a Newton step (D, the contact terms, whole on every rank:
+each rank adds the rows it owns). The PETSc backend (``vemkit.solvers.linear.petsc``) solves with
+:attr:`DistributedStiffness.petsc` itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from vemkit.vem.parallel import require_petsc4py
+
+
+def owned_rows(layout, A, column_position=None) -> sp.csr_matrix:
+    """The rows of A (scipy, serial numbering, whole on every rank) that this rank owns, in PETSc's
+    order, columns renumbered by ``column_position`` (default: PETSc's numbering of the unknowns)."""
+    position = layout.position if column_position is None else column_position
+    rows = A.tocsr()[layout.order[layout.owned]]
+    rows = sp.csr_matrix((rows.data, position[rows.indices], rows.indptr), shape=(rows.shape[0], A.shape[1]))
+    rows.sum_duplicates()
+    rows.sort_indices()
+    return rows
+
+
+def petsc_rows(layout, rows: sp.csr_matrix, columns=None, bs: int = 1):
+    """A PETSc MPIAIJ matrix of this rank's ``rows`` (``owned_rows``); ``columns``: (local, global)
+    column sizes (default: the unknowns' layout)."""
+    PETSc = require_petsc4py()
+    columns = (layout.n_owned, layout.size) if columns is None else columns
+    csr = (rows.indptr.astype(PETSc.IntType), rows.indices.astype(PETSc.IntType), rows.data.astype(PETSc.ScalarType))
+    M = PETSc.Mat().createAIJ(size=((rows.shape[0], layout.size), columns), bsize=bs, csr=csr, comm=layout.comm)
+    M.assemble()
+    return M
+
+
+class DistributedStiffness:
+    """K split by rows across the ranks (module docstring); vectors whole, serial numbering."""
+
+    distributed = True
+    dtype = np.dtype(float)
+
+    def __init__(self, layout, petsc_matrix):
+        self.layout = layout
+        self.petsc = petsc_matrix
+        self._local = None
+
+    @classmethod
+    def from_entries(cls, layout, rows, cols, values):
+        """K from COO entries in PETSc's numbering (any rank's rows: PETSc sends them to their owner)."""
+        PETSc = require_petsc4py()
+        n, d = layout.size, layout.dimension
+        M = PETSc.Mat().createAIJ(size=((layout.n_owned, n), (layout.n_owned, n)), bsize=d, comm=layout.comm)
+        M.setPreallocationCOO(rows.astype(PETSc.IntType), cols.astype(PETSc.IntType))
+        M.setValuesCOO(values.astype(PETSc.ScalarType), addv=PETSc.InsertMode.ADD_VALUES)
+        M.assemble()
+        return cls(layout, M)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.layout.size, self.layout.size)
+
+    @property
+    def nnz(self) -> int:
+        return int(self.petsc.getInfo()["nz_used"])
+
+    @property
+    def T(self):  # noqa: N802 - scipy's name; K is symmetric
+        return self
+
+    @property
+    def local(self) -> sp.csr_matrix:
+        """This rank's rows as scipy CSR (PETSc's column numbering), copied once."""
+        if self._local is None:
+            indptr, indices, data = self.petsc.getValuesCSR()
+            self._local = sp.csr_matrix((data, indices, indptr), shape=(self.layout.n_owned, self.layout.size))
+        return self._local
+
+    def vector(self, x):
+        """A PETSc vector of this rank's entries of x (whole, serial numbering)."""
+        v = self.petsc.createVecRight()
+        v.setArray(self.layout.local(x))
+        return v
+
+    def whole(self, v) -> np.ndarray:
+        """The whole vector (serial numbering) of a PETSc vector of this layout."""
+        return self.layout.gather(v.getArray())
+
+    def __matmul__(self, x):
+        y = self.petsc.createVecLeft()
+        self.petsc.mult(self.vector(x), y)
+        return self.whole(y)
+
+    dot = __matmul__
+
+    def abs_matvec(self, x) -> np.ndarray:
+        """|K| x, entrywise absolute values."""
+        local = self.local
+        absolute = sp.csr_matrix((np.abs(local.data), local.indices, local.indptr), shape=local.shape)
+        return self.layout.gather(absolute @ np.asarray(x, dtype=float)[self.layout.order])
+
+    def diagonal(self) -> np.ndarray:
+        return self.whole(self.petsc.getDiagonal())
+
+    def __getitem__(self, index):
+        """K[i, j] for equally long arrays of unknowns i, j (serial numbering): the entries, whole."""
+        i, j = (np.asarray(a, dtype=np.int64).ravel() for a in index)
+        rows, cols = self.layout.position[i], self.layout.position[j]
+        mine = (rows >= self.layout.owned.start) & (rows < self.layout.owned.stop)
+        values = np.zeros(i.size)
+        if np.any(mine):
+            values[mine] = np.asarray(self.local[rows[mine] - self.layout.owned.start, cols[mine]]).ravel()
+        return self.layout.sum(values)
+
+    def __add__(self, other):
+        """K + D (D scipy, whole on every rank, on K's pattern): each rank adds its rows of D."""
+        PETSc = require_petsc4py()
+        M = self.petsc.duplicate(copy=True)
+        term = petsc_rows(self.layout, owned_rows(self.layout, other))
+        try:
+            M.axpy(1.0, term, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        except PETSc.Error:  # D reaches beyond K's pattern
+            M = self.petsc.duplicate(copy=True)
+            M.axpy(1.0, term, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return DistributedStiffness(self.layout, M)
+
+    __radd__ = __add__

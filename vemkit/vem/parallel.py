@@ -1,0 +1,91 @@
+"""One solve across MPI ranks: which rank this process is, the job's communicator, PETSc.
+
+A job launched by ``mpiexec -n N`` (MPICH, Open MPI) or ``srun`` (SLURM) tells every process its
+rank and the job's size in the environment (:data:`LAUNCHER_VARIABLES`): :func:`launched` reads
+them without starting MPI, so the command knows before any work that it runs as one rank of many
+(it then prints and writes from rank 0 only). :func:`world` starts MPI (mpi4py) on first use and
+returns the communicator of all the ranks, or None in a process of its own. :func:`require_petsc4py`
+is petsc4py's ``PETSc`` module, initialized once without vemkit's own command-line arguments.
+
+mpi4py and petsc4py are the ``mpi`` extra (``make install`` installs it); without them a scene
+that asks for them gets a SceneError naming ``solver.linear`` and the fix.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass
+
+from vemkit.exceptions import SceneError
+
+#: (rank, size) environment variables of the launchers: MPICH's Hydra and PMI (also srun's PMI-2),
+#: Open MPI's mpiexec, PMIx (srun --mpi=pmix), and SLURM's own (srun with any MPI plugin)
+LAUNCHER_VARIABLES = (
+    ("PMI_RANK", "PMI_SIZE"),
+    ("OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"),
+    ("PMIX_RANK", "PMIX_SIZE"),
+    ("SLURM_PROCID", "SLURM_NTASKS"),
+)
+INSTALL_FIX = "run make install (it installs the mpi extra) or pip install -e '.[mpi]'"
+
+
+@dataclass(frozen=True)
+class Launch:
+    """This process's place in the job: rank r of ``size`` (0 of 1 outside a launcher)."""
+
+    rank: int = 0
+    size: int = 1
+
+    @property
+    def distributed(self) -> bool:
+        """Whether the job has more than one rank (the solve is then split across them)."""
+        return self.size > 1
+
+    @property
+    def speaks(self) -> bool:
+        """Whether this rank prints and writes (rank 0 only)."""
+        return self.rank == 0
+
+
+def launched() -> Launch:
+    """The rank and size the launcher put in the environment (without starting MPI)."""
+    for rank, size in LAUNCHER_VARIABLES:
+        if rank in os.environ and size in os.environ:
+            try:
+                return Launch(int(os.environ[rank]), int(os.environ[size]))
+            except ValueError:
+                continue
+    return Launch()
+
+
+def world():
+    """The communicator of every rank of a launched job (mpi4py's COMM_WORLD, MPI started on first
+    use), or None when this process is alone."""
+    if not launched().distributed:
+        return None
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        raise SceneError(
+            f"this job runs on {launched().size} MPI ranks but mpi4py is not installed; {INSTALL_FIX}",
+            key="solver.linear",
+        ) from None
+    return MPI.COMM_WORLD
+
+
+def require_petsc4py():
+    """petsc4py's ``PETSc`` module, initialized without the command line's arguments (they are
+    vemkit's, not PETSc options); SceneError naming solver.linear and the fix when it is missing."""
+    try:
+        import petsc4py
+    except ImportError:
+        raise SceneError(
+            f"solver.linear = petsc needs petsc4py, which is not installed; {INSTALL_FIX}", key="solver.linear"
+        ) from None
+    if "petsc4py.PETSc" not in sys.modules:
+        world()  # MPI first (mpi4py's COMM_WORLD is PETSc's), then PETSc on it
+        petsc4py.init(["vemkit"])  # a program name, no option
+    from petsc4py import PETSc
+
+    return PETSc
