@@ -81,8 +81,9 @@ clean-docs:
 reproduce: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/snakemake -j$(JOBS) --quiet rules
 
+# VEMKIT_REQUIRE_MPI: the MPI tests (tests/mpi_jobs.py) fail instead of skipping without MPI
 test: $(STAMP) $(NUMBA_STAMP)
-	$(BIN)/python -m pytest -q
+	VEMKIT_REQUIRE_MPI=1 $(BIN)/python -m pytest -q
 
 bench: $(STAMP) $(NUMBA_STAMP)
 	$(BIN)/python benchmarks/assembly.py

@@ -21,7 +21,6 @@ import argparse
 import os
 import sys
 import warnings
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -42,28 +41,6 @@ EPILOG = (
 )
 
 
-class _Progress:
-    """A tqdm line on a terminal showing the contact iterations; silent otherwise."""
-
-    def __init__(self, enabled: bool, method: str):
-        self.bar = None
-        if enabled:
-            from tqdm import tqdm
-
-            self.bar = tqdm(desc=f"{method}", unit="it", leave=False, file=sys.stderr, dynamic_ncols=True)
-
-    def __call__(self, iteration: int, info: dict | None = None):
-        if self.bar is None:
-            return
-        self.bar.update(1)
-        if info:
-            self.bar.set_postfix({k: f"{v:.2e}" if isinstance(v, float) else v for k, v in info.items()}, refresh=False)
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
-
-
 def _outputs(args, inputs):
     """(output, vtu) targets checked before any work (vemkit.io.output_files.output_target)."""
     from vemkit.io.output_files import output_target, same_file, shown
@@ -76,27 +53,6 @@ def _outputs(args, inputs):
             key="--vtu",
         )
     return output, vtu
-
-
-@contextmanager
-def _writing(args):
-    """A failing writer (a full disk, a vanished directory) is an OutputError naming the outputs
-    and saying truly what was written (paths shortened, the reason whole)."""
-    try:
-        yield
-    except (OSError, RuntimeError) as error:
-        from vemkit.io.output_files import WRITTEN, shown
-
-        names = " and ".join(shown(p) for p in (args.output, args.vtu) if p)
-        reason = (
-            error.strerror
-            if isinstance(error, OSError) and error.strerror
-            else shown(" ".join(str(error).split()), 200)
-        )
-        done = f"only {', '.join(map(shown, WRITTEN))} was written" if WRITTEN else "nothing was written"
-        raise OutputError(
-            f"cannot write {names} ({reason}); {done}: check the disk space and permissions", key="-o"
-        ) from None
 
 
 def _name(path) -> str:
@@ -116,17 +72,22 @@ def cmd_solve(args) -> int:
 
     _check_resources(scene, args.max_dofs)  # before anything is built
 
+    from vemkit.io.command_line import ProgressLine, write_failures
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite, write_file, write_solution_vtu
     from vemkit.studies.scene_solve import solve_scene
+    from vemkit.vem.parallel import launched, world
 
-    progress = _Progress(not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
+    speaks = launched().speaks  # several MPI ranks: one solve, rank 0 prints and writes
+    progress = ProgressLine(speaks and not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
     try:
-        problem, solution, ds = solve_scene(scene, progress=progress, verify=True, dataset=False)
+        problem, solution, ds = solve_scene(scene, progress=progress, verify=True, dataset=False, comm=world())
     finally:
         progress.close()
     check_finite(ds, args.output)
-    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+    if not speaks:
+        return 0
+    with write_failures(args.output, args.vtu), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_file(ds, output_part)
         if vtu_part is not None:
             write_solution_vtu(problem, solution, ds, vtu_part)
@@ -153,10 +114,15 @@ def _check_resources(scene, max_dofs):
     """The predicted cells, DOFs and memory of the scene's solve, refused beyond the limits; the
     packages of the chosen linear solver (solver.linear: petsc needs petsc4py)."""
     from vemkit.mesh.meshing import of_dimension
-    from vemkit.solvers.linear import backends
+    from vemkit.solvers.linear import DISTRIBUTED_BACKEND, backends, check_distributed
     from vemkit.vem.elements import element_for
+    from vemkit.vem.parallel import launched
 
-    backend = backends().get(scene.solver_options.get("linear"))
+    method = scene.solver_options.get("linear")
+    if launched().distributed:  # several MPI ranks: petsc (auto picks it), nothing else
+        check_distributed(method)
+        method = DISTRIBUTED_BACKEND
+    backend = backends().get(method)
     if backend is not None:
         backend.check_available()
 
@@ -190,6 +156,7 @@ def _step_line(step: int, record: dict) -> str:
 def cmd_adapt(args) -> int:
     scene, settings, true_error, (output, vtu) = _adapt_inputs(args)
 
+    from vemkit.io.command_line import write_failures
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite
     from vemkit.mesh.vtu import write_vtu
@@ -201,7 +168,7 @@ def cmd_adapt(args) -> int:
     run = adapt(scene, settings, true_error=true_error, progress=None if args.quiet else progress)
     ds = adaptive_dataset(scene, run)
     check_finite(ds, args.output)
-    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+    with write_failures(args.output, args.vtu), atomic_outputs(output, vtu) as (output_part, vtu_part):
         ds.to_netcdf(output_part, format="NETCDF4", engine="netcdf4")
         if vtu_part is not None:
             write_vtu(
@@ -269,11 +236,12 @@ def cmd_mesh(args) -> int:
     output, vtu = _outputs(args, [args.scene] if args.scene else [])
     mesh, family = _scene_mesh(args) if args.scene else _family_mesh(args)
 
+    from vemkit.io.command_line import write_failures
     from vemkit.io.output_files import atomic_outputs
     from vemkit.mesh.ugrid import write_ugrid
     from vemkit.mesh.vtu import write_vtu
 
-    with _writing(args), atomic_outputs(output, vtu) as (output_part, vtu_part):
+    with write_failures(args.output, args.vtu), atomic_outputs(output, vtu) as (output_part, vtu_part):
         write_ugrid(mesh, output_part)
         if vtu_part is not None:
             write_vtu(mesh, vtu_part)
@@ -367,7 +335,12 @@ def _scene_command(command, func, limit: dict, *, scene, output, example, vtu, q
 MAX_MESSAGE = 1000  # characters of an error line: a 4000-character path or a list of cells is cut
 
 
-def _fail(message, status: int = EXIT_FAILURE) -> int:
+def _fail(message, status: int = EXIT_FAILURE, alone: bool = False) -> int:
+    """Print the failure (on MPI rank 0 only, unless this rank may have met it ``alone``)."""
+    from vemkit.vem.parallel import launched
+
+    if not (alone or launched().speaks):
+        return status
     text = " ".join(str(message).split())
     text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
     if len(text) > MAX_MESSAGE:  # cut the middle: the fix is at the end of the line
@@ -382,6 +355,7 @@ def _run(argv) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             args = build_parser().parse_args(argv)
+            _check_launch(args)
             status = args.func(args)
         if not args.quiet:  # what a user should see, one line each; not libraries' deprecations
             shown = [w for w in caught if issubclass(w.category, (RuntimeWarning, UserWarning))]
@@ -391,14 +365,37 @@ def _run(argv) -> int:
     except (InputError, SolveError, VemkitError) as error:
         return _fail(error)
     except MemoryError:
-        return _fail("out of memory although the estimate fitted (please report); use a coarser discretization.mesh")
+        return _fail_alone(
+            "out of memory although the estimate fitted (please report); use a coarser discretization.mesh"
+        )
     except OSError as error:  # the disk is full, a file vanished, a permission changed meanwhile
         from vemkit.io.output_files import shown as shown_path
 
         where = f"{shown_path(error.filename)}: " if error.filename else ""
         return _fail(f"{where}{error.strerror or error}; nothing was written")
     except Exception as error:  # noqa: BLE001 - a bug: one line, never a traceback
-        return _fail(f"internal error ({type(error).__name__}: {error}); please report", EXIT_INTERNAL)
+        return _fail_alone(f"internal error ({type(error).__name__}: {error}); please report", EXIT_INTERNAL)
+
+
+def _fail_alone(message, status: int = EXIT_FAILURE) -> int:
+    """A failure this rank may have met alone: printed here, and every rank of an MPI job ended."""
+    from vemkit.vem.parallel import end_job
+
+    _fail(message, status, alone=True)
+    end_job(status)
+    return status
+
+
+def _check_launch(args) -> None:
+    """Only ``solve`` splits a problem across the ranks of an MPI job."""
+    from vemkit.vem.parallel import launched
+
+    if launched().distributed and args.func is not cmd_solve:
+        raise InputError(
+            f"vemkit {args.command} runs in one process; run it without mpiexec (only vemkit solve "
+            "splits a problem across MPI ranks)",
+            key="mpiexec",
+        )
 
 
 def main(argv=None) -> int:
@@ -406,6 +403,10 @@ def main(argv=None) -> int:
     this process only handles signals, so that SIGINT/SIGTERM/SIGHUP end the run within a second
     even inside a long compiled kernel (``vemkit.io.supervisor``); it exits with the status.
     ``main(argv)`` (in-process) runs here, with signal handlers for the duration of the call."""
+    from vemkit.vem.parallel import agreed_status, launched
+
+    if launched().distributed:  # a rank of an MPI job: the launcher handles the signals
+        return agreed_status(_in_process(argv))
     if argv is None and hasattr(os, "fork"):
         from vemkit.io.supervisor import supervised
 

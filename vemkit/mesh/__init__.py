@@ -12,7 +12,8 @@ centroid, point binning; ``close_points``: pairs of points within a radius), mes
 ``files``, ``files3d``: UGRID netCDF, gmsh .msh; written, 2D and 3D alike: ``ugrid``, the one
 description of a mesh's UGRID topology and its writer, and ``vtu``, the one VTU writer) and the
 description of a netCDF file with its two sinks, netCDF4 and xarray (``file_description``: the mesh
-and solution files are spelled out there once).
+and solution files are spelled out there once), and the split of the cells for a solve across MPI
+ranks (``partition``, METIS).
 Imports from vemkit: ``exceptions`` and ``config`` only.
 """
 

@@ -14,5 +14,8 @@
   measures), ``interpolation`` (generalized barycentric coordinates, the paper's measure),
   ``estimator`` (a posteriori indicators, docs/reference/files.md), ``volumetric`` (the lambda part
   of the k = 1 stiffness per cell or averaged at the nodes, ``discretization.volumetric_strain``).
+- ``parallel`` (the MPI job: rank, communicator, PETSc), ``distributed_assembly`` (the stiffness
+  assembled across MPI ranks, each from its own cells) and ``distributed_matrix`` (the stiffness
+  split by rows, as the contact solvers see it).
 Imports from vemkit: ``exceptions``, ``config``, ``mesh``.
 """

@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import sys
 from dataclasses import dataclass
+from functools import cache
 
 from vemkit.exceptions import SceneError
 
@@ -59,6 +60,7 @@ def launched() -> Launch:
     return Launch()
 
 
+@cache
 def world():
     """The communicator of every rank of a launched job (mpi4py's COMM_WORLD, MPI started on first
     use), or None when this process is alone."""
@@ -71,7 +73,20 @@ def world():
             f"this job runs on {launched().size} MPI ranks but mpi4py is not installed; {INSTALL_FIX}",
             key="solver.linear",
         ) from None
+    _share_cores(MPI.COMM_WORLD)
     return MPI.COMM_WORLD
+
+
+def _share_cores(comm) -> None:
+    """The Numba threads of the ranks on one machine share its cores (unless NUMBA_NUM_THREADS
+    says otherwise): 2 ranks on 2 cores run one thread each, not two."""
+    if "NUMBA_NUM_THREADS" in os.environ:
+        return
+    import numba
+    from mpi4py import MPI
+
+    on_this_machine = comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
+    numba.set_num_threads(max(1, min(numba.config.NUMBA_NUM_THREADS, (os.cpu_count() or 1) // on_this_machine)))
 
 
 def require_petsc4py():
@@ -89,3 +104,33 @@ def require_petsc4py():
     from petsc4py import PETSc
 
     return PETSc
+
+
+def _running_world():
+    """COMM_WORLD when MPI has been started in a job of several ranks, else None (never starts MPI)."""
+    if not launched().distributed or "mpi4py.MPI" not in sys.modules:
+        return None
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD if MPI.Is_initialized() and not MPI.Is_finalized() else None
+
+
+def agreed_status(status: int) -> int:
+    """The exit status of the job, the same on every rank: the largest of the ranks' statuses (a
+    failure that every rank met alike, e.g. a refused input, gives its status everywhere)."""
+    comm = _running_world()
+    if comm is None:
+        return status
+    from mpi4py import MPI
+
+    return int(comm.allreduce(status, op=MPI.MAX))
+
+
+def end_job(status: int) -> None:
+    """End every rank of the job now (MPI_Abort) after a failure this rank may have met alone (an
+    internal error, memory): the others would otherwise wait for it forever. Nothing in one process."""
+    comm = _running_world()
+    if comm is not None:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        comm.Abort(status)

@@ -72,6 +72,17 @@ def direct_limit(near_nullspace) -> int:
     return DIRECT_LIMIT_3D if three_d(near_nullspace) else DIRECT_LIMIT
 
 
+def check_distributed(method: str) -> None:
+    """SceneError unless the backend ``method`` (or auto) solves a matrix split across MPI ranks."""
+    backend = backends().get(DISTRIBUTED_BACKEND if method == "auto" else method)
+    if backend is not None and not backend.distributed:
+        raise SceneError(
+            f"solver.linear = {method} solves in one process, but this job runs on several MPI ranks; "
+            f"use --set solver.linear={DISTRIBUTED_BACKEND}, or run without mpiexec",
+            key="solver.linear",
+        )
+
+
 def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000) -> LinearSolver:
     """One solver object for repeated solves with A: ``method`` is a backend's name (amg, direct) or auto.
 
@@ -94,10 +105,6 @@ def linear_solver(A, method="auto", near_nullspace=None, tol=1e-10, maxiter=2000
     if backend is None:
         names = ", ".join(sorted(backends()))
         raise SceneError(f"solver.linear = {method!r} is unknown; use {names} or auto", key="solver.linear")
-    if distributed and not backend.distributed:
-        raise SceneError(
-            f"solver.linear = {method} solves in one process, but this job runs on several MPI ranks; "
-            f"use --set solver.linear={DISTRIBUTED_BACKEND}, or run without mpiexec",
-            key="solver.linear",
-        )
+    if distributed:
+        check_distributed(method)
     return backend(A, near_nullspace=near_nullspace, tol=tol, maxiter=maxiter, **options)
