@@ -26,6 +26,7 @@ from vemkit.exceptions import SceneError
 from vemkit.mesh.partition import cell_partition
 from vemkit.vem.assembly import condense_interior, largest_cell, material_of, specialized
 from vemkit.vem.distributed_matrix import DistributedStiffness
+from vemkit.vem.parallel import require_petsc4py
 from vemkit.vem.pattern import ROW_CHUNKS, chunk_rows
 
 
@@ -114,10 +115,11 @@ def column_layout(layout: DofLayout, Z) -> DofLayout:
     return DofLayout(layout.comm, order, position, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), 1)
 
 
-def cell_entries(geometry, cells, owned, starts, free_index, material, max_nodes, rows, cols, vals):
+def cell_entries(geometry, cells, owned, starts, free_index, position, material, max_nodes, rows, cols, vals):
     """*Template* (parallel). The entries of the local stiffness (3.9) of every cell in ``owned``,
-    rows and columns of its free nodes (serial unknowns d r + a), from ``starts[t]`` on for the
-    t-th cell; each thread a contiguous share of the cells, its work arrays allocated once."""
+    rows and columns of its free nodes (PETSc's numbers ``position[d r + a]`` of the serial unknowns
+    d r + a), from ``starts[t]`` on for the t-th cell; each thread a contiguous share of the cells,
+    its work arrays allocated once."""
     offsets, nodes = cells
     lam, mu, stab, condense = material
     for chunk in numba.prange(ROW_CHUNKS):
@@ -140,30 +142,32 @@ def cell_entries(geometry, cells, owned, starts, free_index, material, max_nodes
                         if s < 0:
                             continue
                         for b in range(DIM):  # noqa: F821
-                            rows[p] = DIM * r + a  # noqa: F821
-                            cols[p] = DIM * s + b  # noqa: F821
+                            rows[p] = position[DIM * r + a]  # noqa: F821
+                            cols[p] = position[DIM * s + b]  # noqa: F821
                             vals[p] = K[DIM * i + a, DIM * j + b]  # noqa: F821
                             p += 1
 
 
-def owned_cell_entries(space, lam, mu, stabilization, dofs, owned) -> tuple:
-    """(rows, cols, values) of the cells ``owned`` (serial unknowns)."""
+def owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout) -> tuple:
+    """(rows, cols, values) of the cells ``owned`` (PETSc's numbering of ``layout``, its integers)."""
     offsets, nodes = cells = space.cell_nodes
     d = space.element.dimension
     free = (dofs.free_index[nodes] >= 0).astype(np.int64)
     per_cell = np.add.reduceat(free, offsets[:-1]) if nodes.size else np.zeros(offsets.size - 1, np.int64)
     sizes = (d * per_cell[owned]) ** 2
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    rows = np.empty(starts[-1], dtype=np.int64)
-    cols = np.empty(starts[-1], dtype=np.int64)
+    integers = require_petsc4py().IntType  # PETSc's: the entries go to it without a copy
+    rows = np.empty(starts[-1], dtype=integers)
+    cols = np.empty(starts[-1], dtype=integers)
     vals = np.empty(starts[-1])
-    kernel = specialized(cell_entries, space.element, parallel=True, chunk_rows=chunk_rows)
+    kernel = specialized(cell_entries, space.element, parallel=True)
     kernel(
         space.element.geometry(space.mesh),
         cells,
         np.ascontiguousarray(owned, dtype=np.int64),
         starts,
         dofs.free_index,
+        layout.position.astype(integers),
         material_of(lam, mu, stabilization, dofs),
         largest_cell(offsets),
         rows,
@@ -190,23 +194,23 @@ def check_distributable(treatment: str, change) -> None:
 
 
 def held_elimination(rows, cols, vals, dofs, layout) -> tuple:
-    """The entries without the held rows and columns (their diagonal kept), the load's change
-    -K_fh g (serial numbering, this rank's part) and the held diagonal (summed over the ranks)."""
-    lift = np.zeros(layout.size)
+    """The entries with those of the held rows and columns set to zero in place (their diagonal
+    kept; no copy of the entries), the load's change -K_fh g (serial numbering, summed over the
+    ranks) and the held diagonal (the same)."""
     fixed = dofs.fixed_dofs
     if fixed.size == 0:
-        return rows, cols, vals, lift, np.zeros(0)
-    held = np.zeros(layout.size, dtype=bool)
-    held[fixed] = True
+        return np.zeros(layout.size), np.zeros(0)
+    held = np.zeros(layout.size, dtype=bool)  # PETSc's numbering, as the entries
+    held[layout.position[fixed]] = True
     values = np.zeros(layout.size)
-    values[fixed] = dofs.fixed_values
+    values[layout.position[fixed]] = dofs.fixed_values
+    lift, diagonal = np.zeros(layout.size), np.zeros(layout.size)
     into_held = held[cols] & ~held[rows]
     np.add.at(lift, rows[into_held], -vals[into_held] * values[cols[into_held]])
-    diagonal = np.zeros(layout.size)
     on_diagonal = held[rows] & (rows == cols)
     np.add.at(diagonal, rows[on_diagonal], vals[on_diagonal])
-    keep = ~(held[rows] | held[cols]) | (rows == cols)
-    return rows[keep], cols[keep], vals[keep], lift, layout.sum(diagonal)[fixed]
+    vals[(held[rows] | held[cols]) & (rows != cols)] = 0.0
+    return layout.sum(lift)[layout.position], layout.sum(diagonal)[layout.position[fixed]]
 
 
 def distributed_stiffness(space, lam, mu, stabilization, dofs, load, comm, treatment="cell"):
@@ -218,10 +222,11 @@ def distributed_stiffness(space, lam, mu, stabilization, dofs, load, comm, treat
     part = comm.bcast(cell_partition(space.mesh, offsets, nodes, comm.Get_size()) if comm.Get_rank() == 0 else None)
     layout = dof_layout(comm, dofs, offsets, nodes, part)
     owned = np.flatnonzero(part == comm.Get_rank())
-    rows, cols, vals = owned_cell_entries(space, lam, mu, stabilization, dofs, owned)
-    rows, cols, vals, lift, held_diagonal = held_elimination(rows, cols, vals, dofs, layout)
-    K = DistributedStiffness.from_entries(layout, layout.position[rows], layout.position[cols], vals)
-    f = load + layout.sum(lift)
+    rows, cols, vals = owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout)
+    lift, held_diagonal = held_elimination(rows, cols, vals, dofs, layout)
+    K = DistributedStiffness.from_entries(layout, rows, cols, vals)
+    del rows, cols, vals
+    f = load + lift
     if dofs.fixed_dofs.size:
         f[dofs.fixed_dofs] = held_diagonal * dofs.fixed_values
     return K, f

@@ -56,8 +56,8 @@ class DistributedStiffness:
         PETSc = require_petsc4py()
         n, d = layout.size, layout.dimension
         M = PETSc.Mat().createAIJ(size=((layout.n_owned, n), (layout.n_owned, n)), bsize=d, comm=layout.comm)
-        M.setPreallocationCOO(rows.astype(PETSc.IntType), cols.astype(PETSc.IntType))
-        M.setValuesCOO(values.astype(PETSc.ScalarType), addv=PETSc.InsertMode.ADD_VALUES)
+        M.setPreallocationCOO(np.asarray(rows, PETSc.IntType), np.asarray(cols, PETSc.IntType))  # no copy
+        M.setValuesCOO(np.asarray(values, PETSc.ScalarType), addv=PETSc.InsertMode.ADD_VALUES)
         M.assemble()
         return cls(layout, M)
 
