@@ -232,6 +232,15 @@ def _logical_and():
     return MPI.LAND
 
 
+def collect_garbage(layout) -> None:
+    """Free the PETSc objects Python dropped. Across ranks petsc4py never destroys them while
+    collecting garbage (a destruction is collective: it could wait forever); it keeps them for
+    this call, which every rank makes at the same point (measured: one K + D, 80 MB, per Newton
+    step otherwise). Nothing to do in one process."""
+    if not isinstance(layout, OneProcess):
+        require_petsc4py().garbage_cleanup(layout.comm)
+
+
 def failure_advice(layout) -> str:
     """What to try when a PETSc solve stalls: another backend in one process; across ranks a
     stronger preconditioner (the other backends hold the whole matrix)."""
