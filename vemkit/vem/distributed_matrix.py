@@ -45,9 +45,10 @@ class DistributedStiffness:
     distributed = True
     dtype = np.dtype(float)
 
-    def __init__(self, layout, petsc_matrix):
+    def __init__(self, layout, petsc_matrix, on_pattern: bool = True):
         self.layout = layout
         self.petsc = petsc_matrix
+        self.on_pattern = on_pattern  # its nonzero pattern is the stiffness's (terms added within it)
         self._local = None
 
     @classmethod
@@ -119,14 +120,37 @@ class DistributedStiffness:
 
     def __add__(self, other):
         """K + D (D scipy, whole on every rank, on K's pattern): each rank adds its rows of D."""
-        PETSc = require_petsc4py()
         M = self.petsc.duplicate(copy=True)
-        term = petsc_rows(self.layout, owned_rows(self.layout, other))
-        try:
-            M.axpy(1.0, term, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        except PETSc.Error:  # D reaches beyond K's pattern
-            M = self.petsc.duplicate(copy=True)
-            M.axpy(1.0, term, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        return DistributedStiffness(self.layout, M)
+        if self.on_pattern and _added_within(M, self.layout, other):
+            return DistributedStiffness(self.layout, M)
+        M.destroy()  # D reaches beyond K's pattern
+        M = self.petsc.duplicate(copy=True)
+        PETSc = require_petsc4py()
+        M.axpy(
+            1.0, petsc_rows(self.layout, owned_rows(self.layout, other)), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+        )
+        return DistributedStiffness(self.layout, M, on_pattern=False)
 
     __radd__ = __add__
+
+    def copy_into(self, target, other) -> bool:
+        """target = this matrix + ``other`` (scipy, whole), in place of a PETSc matrix with the
+        stiffness's pattern (no new matrix); False, target undefined, when either reaches beyond it."""
+        if not self.on_pattern:
+            return False
+        PETSc = require_petsc4py()
+        self.petsc.copy(target, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        return _added_within(target, self.layout, other)
+
+
+def _added_within(M, layout, other) -> bool:
+    """M += other's rows owned here, within M's pattern (True), or False when other reaches beyond it."""
+    PETSc = require_petsc4py()
+    term = petsc_rows(layout, owned_rows(layout, other))
+    try:
+        M.axpy(1.0, term, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    except PETSc.Error:
+        return False
+    finally:
+        term.destroy()
+    return True

@@ -21,12 +21,13 @@ from functools import cache
 from vemkit.exceptions import SceneError
 
 #: (rank, size) environment variables of the launchers: MPICH's Hydra and PMI (also srun's PMI-2),
-#: Open MPI's mpiexec, PMIx (srun --mpi=pmix), and SLURM's own (srun with any MPI plugin)
+#: Open MPI's mpiexec, PMIx (srun --mpi=pmix), and SLURM's own for the tasks of an srun step (not
+#: SLURM_NTASKS, which a batch script running one vemkit per task of a sweep also has)
 LAUNCHER_VARIABLES = (
     ("PMI_RANK", "PMI_SIZE"),
     ("OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"),
     ("PMIX_RANK", "PMIX_SIZE"),
-    ("SLURM_PROCID", "SLURM_NTASKS"),
+    ("SLURM_PROCID", "SLURM_STEP_NUM_TASKS"),
 )
 INSTALL_FIX = "run make install (it installs the mpi extra) or pip install -e '.[mpi]'"
 
@@ -73,6 +74,13 @@ def world():
             f"this job runs on {launched().size} MPI ranks but mpi4py is not installed; {INSTALL_FIX}",
             key="solver.linear",
         ) from None
+    if MPI.COMM_WORLD.Get_size() != launched().size:  # mpiexec of another MPI than mpi4py's
+        raise SceneError(
+            f"the launcher started {launched().size} ranks but MPI sees {MPI.COMM_WORLD.Get_size()}: the mpiexec "
+            "is not the one of the MPI mpi4py was built with; use that MPI's mpiexec (make install builds "
+            "mpi4py against Debian's MPICH: /usr/bin/mpiexec)",
+            key="mpiexec",
+        )
     _share_cores(MPI.COMM_WORLD)
     return MPI.COMM_WORLD
 

@@ -47,7 +47,6 @@ from vemkit.solvers.linear.petsc_setup import (
     scene_options,
     stick_basis_matrix,
 )
-from vemkit.solvers.sparse_ops import as_matrix
 from vemkit.vem.parallel import require_petsc4py
 
 NEWTON_MAXITER = 5000  # Krylov iterations of one Newton step (as the AMG backend's)
@@ -138,7 +137,7 @@ class PETScNewtonSystems(IterativeNewtonSystems):
     def _multigrid(self, A, penalty):
         """GAMG on K + D + penalty, set up again for the new values (its prolongators kept)."""
         base = self.base
-        full = renewed_matrix(self.full, as_matrix(A) + penalty(), base.bs, base.near_nullspace)
+        full = renewed_matrix(self.full, A, penalty(), base.bs, base.near_nullspace)
         if self.inner is None or full is not self.full:
             self.full = full
             self.inner = configured_ksp(full, base.prefix, base.options, defaults=NEWTON_DEFAULTS)

@@ -207,29 +207,24 @@ class ReducedOperator:
         return PETSc.Mat().createPython((columns, columns), ReducedOperator(A, Z), comm=Z.getComm())
 
 
-def renewed_matrix(previous, A, bs: int, near_nullspace):
-    """A (scipy or distributed) as a PETSc matrix: ``previous`` holding A's values when it has A's
-    nonzero pattern (one object over the Newton steps: the GAMG set up for it then keeps its
-    prolongators), else A's own with the rigid motions as near-nullspace."""
+def renewed_matrix(previous, A, term, bs: int, near_nullspace):
+    """A + term (A scipy or distributed, term scipy) as a PETSc matrix: ``previous`` holding its
+    values when it has their nonzero pattern (one object over the Newton steps: the GAMG set up
+    for it then keeps its prolongators), else a new matrix with the rigid motions as near-nullspace."""
     PETSc = require_petsc4py()
-    matrix = petsc_matrix(A, bs)
-    if previous is not None and _same_pattern(previous, matrix):
+    A = as_matrix(A)
+    if previous is not None and getattr(A, "distributed", False) and A.copy_into(previous, term):
+        return previous  # across ranks: A's values copied, the term's rows added, in place
+    matrix = petsc_matrix(A + term, bs)
+    if previous is not None and not getattr(A, "distributed", False) and _same_pattern(previous, matrix):
         matrix.copy(previous, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         return previous
-    return with_near_nullspace(matrix, layout_of(as_matrix(A)), near_nullspace)
+    return with_near_nullspace(matrix, layout_of(A), near_nullspace)
 
 
 def _same_pattern(a, b) -> bool:
-    """Whether two PETSc matrices of one layout have the same nonzero pattern on every rank."""
-    pattern_a, pattern_b = a.getValuesCSR()[:2], b.getValuesCSR()[:2]
-    local = all(np.array_equal(x, y) for x, y in zip(pattern_a, pattern_b))
-    return bool(a.getComm().tompi4py().allreduce(local, op=_logical_and()))
-
-
-def _logical_and():
-    from mpi4py import MPI
-
-    return MPI.LAND
+    """Whether two PETSc matrices of one process have the same nonzero pattern."""
+    return all(np.array_equal(x, y) for x, y in zip(a.getValuesCSR()[:2], b.getValuesCSR()[:2]))
 
 
 def collect_garbage(layout) -> None:
