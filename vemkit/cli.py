@@ -116,7 +116,7 @@ def _check_resources(scene, max_dofs):
     from vemkit.mesh.meshing import of_dimension
     from vemkit.solvers.linear import DISTRIBUTED_BACKEND, backends, check_distributed
     from vemkit.vem.elements import element_for
-    from vemkit.vem.parallel import launched
+    from vemkit.vem.parallel import job_ranks, launched
 
     method = scene.solver_options.get("linear")
     if launched().distributed:  # several MPI ranks: petsc (auto picks it), nothing else
@@ -127,7 +127,7 @@ def _check_resources(scene, max_dofs):
         backend.check_available()
 
     layout = element_for(scene.order, scene.dimension).layout
-    return of_dimension("check_resources", scene.dimension)(scene, max_dofs, layout)
+    return of_dimension("check_resources", scene.dimension)(scene, max_dofs, layout, ranks=job_ranks())
 
 
 def _adapt_inputs(args):

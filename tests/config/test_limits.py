@@ -49,6 +49,19 @@ def test_limits_name_the_estimate_and_the_fix(monkeypatch):
     check_resources(estimate_resources(10, 25), max_dofs=None)  # 400 MiB of base < 0.8 GiB
 
 
+def test_a_solve_split_across_ranks_is_checked_against_its_share_of_the_machine(monkeypatch):
+    """Each rank holds its own Python and libraries and 1/ranks of the rest: 4 of 16 ranks on this
+    machine need 4 x (base + rest / 16)."""
+    estimate = estimate_resources(*estimate_mesh({"family": "square", "n": 2000}))
+    rest = estimate.peak_bytes - limits.BASE_BYTES
+    assert estimate.on_ranks(4, 16).peak_bytes == int(4 * (limits.BASE_BYTES + rest / 16))
+    assert estimate.on_ranks(1, 1) == estimate
+    monkeypatch.setattr(limits, "available_memory", lambda: estimate.peak_bytes // 2)
+    with pytest.raises(ResourceLimitError, match="more than this machine has available"):
+        check_resources(estimate, max_dofs=None)
+    check_resources(estimate, max_dofs=None, ranks=(1, 8))  # an eighth and a Python fit in half
+
+
 def test_the_machine_memory_is_known_here():
     free = limits.available_memory()
     assert free is None or free > 0

@@ -68,6 +68,13 @@ class Resources(NamedTuple):
     def describe(self) -> str:
         return f"about {self.cells:,} cells, {self.dofs:,} DOFs and {_gib(self.peak_bytes)} of memory"
 
+    def on_ranks(self, here: int, ranks: int) -> "Resources":
+        """The memory on this machine of the solve split across ``ranks`` MPI ranks, ``here`` of them
+        on it: each rank its own Python and libraries (BASE_BYTES) and its share of the rest."""
+        if ranks <= 1:
+            return self
+        return self._replace(peak_bytes=int(here * (BASE_BYTES + (self.peak_bytes - BASE_BYTES) / ranks)))
+
 
 def _gib(count: float) -> str:
     return f"{count / 2**30:.1f} GiB" if count >= 2**30 else f"{count / 2**20:.0f} MiB"
@@ -219,9 +226,11 @@ def check_resources(
     max_dofs: int | None = DEFAULT_MAX_DOFS,
     what: str = "the scene",
     fix: str = "a smaller discretization.mesh.n",
+    ranks: tuple[int, int] = (1, 1),
 ) -> None:
     """ResourceLimitError if ``estimate`` exceeds ``max_dofs`` or the machine (message: the
-    estimate, the limit and the fix)."""
+    estimate, the limit and the fix); ``ranks``: (on this machine, in all) of a solve split across
+    MPI ranks (:meth:`Resources.on_ranks`)."""
     if max_dofs is not None and estimate.dofs > max_dofs:
         raise ResourceLimitError(
             f"{what} needs {estimate.describe()}, more than the limit of {max_dofs:,} DOFs; "
@@ -230,6 +239,7 @@ def check_resources(
             estimate=estimate._asdict(),
         )
     free = available_memory()
+    estimate = estimate.on_ranks(*ranks)
     if free is not None and estimate.peak_bytes > MEMORY_FRACTION * free:
         raise ResourceLimitError(
             f"{what} needs {estimate.describe()}, more than this machine has available ({_gib(free)}); use {fix}",
@@ -263,17 +273,20 @@ def scene_resources(scene, layout: dict | None = None) -> Resources | None:
 
 
 def check_scene_resources(
-    scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout: dict | None = None
+    scene, max_dofs: int | None = DEFAULT_MAX_DOFS, layout: dict | None = None, ranks: tuple[int, int] = (1, 1)
 ) -> Resources | None:
     """The prediction of :func:`scene_resources` (``layout``: the element's nodes per entity);
-    ResourceLimitError beyond ``max_dofs`` or the machine's memory."""
+    ResourceLimitError beyond ``max_dofs`` or the machine's memory (``ranks``: :func:`check_resources`)."""
     estimate = scene_resources(scene, layout)
-    return None if estimate is None else check_scene_estimate(scene, estimate, max_dofs)
+    return None if estimate is None else check_scene_estimate(scene, estimate, max_dofs, ranks=ranks)
 
 
-def check_scene_estimate(scene, estimate: Resources, max_dofs: int | None, dimension: int = 2) -> Resources:
+def check_scene_estimate(
+    scene, estimate: Resources, max_dofs: int | None, dimension: int = 2, ranks: tuple[int, int] = (1, 1)
+) -> Resources:
     """ResourceLimitError if the scene's predicted ``estimate`` is beyond ``max_dofs`` or the machine's
-    memory; a mesh file's sides checked against the scene (its header, ``dimension`` 3: a 3D file)."""
+    memory (``ranks``: :func:`check_resources`); a mesh file's sides checked against the scene (its
+    header, ``dimension`` 3: a 3D file)."""
     if scene.volumetric_strain == "nodal_average":
         estimate = nodal_average_estimate(estimate, dimension)
     options = scene.mesh_options
@@ -283,12 +296,17 @@ def check_scene_estimate(scene, estimate: Resources, max_dofs: int | None, dimen
             max_dofs,
             what=f"the mesh file {options['file']} ({estimate.vertices:,} vertices)",
             fix="a coarser mesh",
+            ranks=ranks,
         )
         check_file_sides(scene, mesh_file_header(scene.mesh_file, dimension))
         return estimate
     size = ", ".join(f"{k} = {v}" for k, v in options.items() if k in ("n", "h", "cells", "layers"))
     check_resources(
-        estimate, max_dofs, what=f"the scene ({options['family']} mesh, {size})", fix="a coarser discretization.mesh"
+        estimate,
+        max_dofs,
+        what=f"the scene ({options['family']} mesh, {size})",
+        fix="a coarser discretization.mesh",
+        ranks=ranks,
     )
     return estimate
 

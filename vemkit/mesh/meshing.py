@@ -25,7 +25,8 @@ BY_DIMENSION: dict[str, dict[int, tuple[str, str]]] = {
     "validate": {2: ("vemkit.mesh.checks", "validate_mesh"), 3: ("vemkit.mesh.checks3d", "validate_mesh3d")},
     "read": {2: ("vemkit.mesh.files", "read_mesh"), 3: ("vemkit.mesh.files3d", "read_mesh3d")},
     "build": {2: ("vemkit.mesh.families.by_name", "build_mesh"), 3: ("vemkit.mesh.families3d.build", "build_mesh3d")},
-    # the prediction of a scene's cells, DOFs and memory before its mesh is built (scene, max_dofs, layout)
+    # the prediction of a scene's cells, DOFs and memory before its mesh is built (scene, max_dofs, layout,
+    # ranks=(on this machine, in all) of an MPI job)
     "check_resources": {
         2: ("vemkit.config.limits", "check_scene_resources"),
         3: ("vemkit.mesh.families3d.resources", "check_scene_resources3d"),

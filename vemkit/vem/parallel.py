@@ -85,16 +85,30 @@ def world():
     return MPI.COMM_WORLD
 
 
+def job_ranks() -> tuple[int, int]:
+    """(ranks on this machine, ranks in all) of the job: (1, 1) in a process of its own."""
+    comm = world()
+    if comm is None:
+        return 1, 1
+    return _ranks_here(), comm.Get_size()
+
+
+@cache
+def _ranks_here() -> int:
+    """The ranks of the job on this machine (MPI_COMM_TYPE_SHARED), found once."""
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
+
+
 def _share_cores(comm) -> None:
     """The Numba threads of the ranks on one machine share its cores (unless NUMBA_NUM_THREADS
     says otherwise): 2 ranks on 2 cores run one thread each, not two."""
     if "NUMBA_NUM_THREADS" in os.environ:
         return
     import numba
-    from mpi4py import MPI
 
-    on_this_machine = comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
-    numba.set_num_threads(max(1, min(numba.config.NUMBA_NUM_THREADS, (os.cpu_count() or 1) // on_this_machine)))
+    numba.set_num_threads(max(1, min(numba.config.NUMBA_NUM_THREADS, (os.cpu_count() or 1) // _ranks_here())))
 
 
 def require_petsc4py():

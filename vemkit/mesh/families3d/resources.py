@@ -130,13 +130,13 @@ def scene_resources3d(scene):
     return estimate_resources3d(cells * layers, vertices * (layers + 1), cells * (layers + 1) + edges * layers)
 
 
-def check_scene_resources3d(scene, max_dofs, layout: dict | None = None):
+def check_scene_resources3d(scene, max_dofs, layout: dict | None = None, ranks: tuple[int, int] = (1, 1)):
     """The prediction of :func:`scene_resources3d`, checked as in 2D
     (``vemkit.config.limits.check_scene_estimate``). ``layout`` (the element's nodes per entity) is
     the 2D check's argument: the 3D element has one node per vertex."""
     from vemkit.config.limits import check_scene_estimate
 
-    return check_scene_estimate(scene, scene_resources3d(scene), max_dofs, dimension=3)
+    return check_scene_estimate(scene, scene_resources3d(scene), max_dofs, dimension=3, ranks=ranks)
 
 
 def refinement_resources3d(mesh, marked, circles=None):
