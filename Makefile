@@ -111,7 +111,8 @@ clean-results:
 
 # The SLURM profile on a real one-node SLURM cluster set up on this host (Debian, as root: installs
 # slurm-wlm, slurmdbd, munge, mariadb-server; starts and then stops its own daemons). Not part of
-# `make test`. MODE=no-accounting: the same without slurmdbd (job status through squeue).
+# `make test`. MODE=no-accounting: the same without slurmdbd (job status through squeue); MODE=mpi:
+# workflow/cluster/solve_mpi.sbatch on 2 ranks against a serial solve (no slurmdbd).
 MODE ?= accounting
 .PHONY: cluster-test
 cluster-test: $(STAMP) $(NUMBA_STAMP)

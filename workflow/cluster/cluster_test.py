@@ -3,6 +3,7 @@
 Run as root on Debian (it installs packages and starts daemons):
     .venv/bin/python workflow/cluster/cluster_test.py                       with job accounting (slurmdbd)
     .venv/bin/python workflow/cluster/cluster_test.py --mode no-accounting  without (status through squeue)
+    .venv/bin/python workflow/cluster/cluster_test.py --mode mpi            solve_mpi.sbatch (mpi_check.py)
 
 Steps: install slurm-wlm, slurmdbd, munge, mariadb-server (local_cluster.py); write /etc/slurm/slurm.conf
 (+ slurmdbd.conf) for this host; start munged, mariadbd, slurmdbd, slurmctld, slurmd, each PID recorded in
@@ -10,7 +11,8 @@ Steps: install slurm-wlm, slurmdbd, munge, mariadb-server (local_cluster.py); wr
 matrix (workflow/cluster/cluster-test.yaml) in a copy of the working tree, and `snakemake -j2` on the same
 in another copy; check the jobs' resources as SLURM recorded them against the profile and every netCDF
 file against the local run (run_checks.py); run tests/workflow/test_slurm.py against the cluster; stop
-exactly the daemons started. Every wait is bounded. Re-running is safe: it first stops what an
+exactly the daemons started. Mode mpi starts the cluster without accounting and runs only the MPI job
+script against a serial solve (mpi_check.py). Every wait is bounded. Re-running is safe: it first stops what an
 interrupted run left (by recorded PID), reuses the database, and replaces the SLURM run's copy.
 """
 
@@ -26,6 +28,7 @@ from datetime import datetime
 from pathlib import Path
 
 import local_cluster as cluster
+import mpi_check
 import run_checks as checks
 import yaml
 
@@ -168,7 +171,7 @@ def _leftovers(stopped: list[str]) -> list[str]:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--mode", choices=["accounting", "no-accounting"], default="accounting")
+    parser.add_argument("--mode", choices=["accounting", "no-accounting", "mpi"], default="accounting")
     parser.add_argument(
         "--state", type=Path, default=Path(os.environ.get("VEMKIT_CLUSTER_STATE", "/tmp/vemkit-cluster-test"))
     )
@@ -199,7 +202,10 @@ def main(argv=None) -> int:
         for line in cluster.start_cluster(daemons, state, accounting, values):
             say(line)
         say(f"cluster up after {time.monotonic() - start:.0f} s")
-        exercise(state, accounting, args.timeout, say)
+        if args.mode == "mpi":
+            mpi_check.exercise(state, args.timeout, say)
+        else:
+            exercise(state, accounting, args.timeout, say)
         status = 0
     except (cluster.ClusterError, checks.CheckError, subprocess.TimeoutExpired) as error:
         say(f"FAILED: {error}")
