@@ -76,9 +76,9 @@ def world():
         ) from None
     if MPI.COMM_WORLD.Get_size() != launched().size:  # mpiexec of another MPI than mpi4py's
         raise SceneError(
-            f"the launcher started {launched().size} ranks but MPI sees {MPI.COMM_WORLD.Get_size()}: the mpiexec "
-            "is not the one of the MPI mpi4py was built with; use that MPI's mpiexec (make install builds "
-            "mpi4py against Debian's MPICH: /usr/bin/mpiexec)",
+            f"the launcher started {launched().size} ranks but MPI sees {MPI.COMM_WORLD.Get_size()}: they cannot "
+            "reach each other; start them with the mpiexec of the MPI mpi4py was built with (make install: "
+            "Debian's MPICH, /usr/bin/mpiexec), or under SLURM with srun --mpi=pmi2",
             key="mpiexec",
         )
     _share_cores(MPI.COMM_WORLD)
