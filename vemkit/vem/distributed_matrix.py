@@ -49,7 +49,6 @@ class DistributedStiffness:
         self.layout = layout
         self.petsc = petsc_matrix
         self.on_pattern = on_pattern  # its nonzero pattern is the stiffness's (terms added within it)
-        self._local = None
 
     @classmethod
     def from_entries(cls, layout, rows, cols, values):
@@ -82,13 +81,11 @@ class DistributedStiffness:
     def T(self):  # noqa: N802 - scipy's name; K is symmetric
         return self
 
-    @property
-    def local(self) -> sp.csr_matrix:
-        """This rank's rows as scipy CSR (PETSc's column numbering), copied once."""
-        if self._local is None:
-            indptr, indices, data = self.petsc.getValuesCSR()
-            self._local = sp.csr_matrix((data, indices, indptr), shape=(self.layout.n_owned, self.layout.size))
-        return self._local
+    def local_rows(self) -> sp.csr_matrix:
+        """This rank's rows as scipy CSR (PETSc's column numbering): a copy made for the call, not kept
+        (it would be a second stiffness on every rank)."""
+        indptr, indices, data = self.petsc.getValuesCSR()
+        return sp.csr_matrix((data, indices, indptr), shape=(self.layout.n_owned, self.layout.size))
 
     def vector(self, x):
         """A PETSc vector of this rank's entries of x (whole, serial numbering)."""
@@ -109,7 +106,7 @@ class DistributedStiffness:
 
     def abs_matvec(self, x) -> np.ndarray:
         """|K| x, entrywise absolute values."""
-        local = self.local
+        local = self.local_rows()
         absolute = sp.csr_matrix((np.abs(local.data), local.indices, local.indptr), shape=local.shape)
         return self.layout.gather(absolute @ np.asarray(x, dtype=float)[self.layout.order])
 
@@ -123,7 +120,7 @@ class DistributedStiffness:
         mine = (rows >= self.layout.owned.start) & (rows < self.layout.owned.stop)
         values = np.zeros(i.size)
         if np.any(mine):
-            values[mine] = np.asarray(self.local[rows[mine] - self.layout.owned.start, cols[mine]]).ravel()
+            values[mine] = np.asarray(self.local_rows()[rows[mine] - self.layout.owned.start, cols[mine]]).ravel()
         return self.layout.sum(values)
 
     def __add__(self, other):

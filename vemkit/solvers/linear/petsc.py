@@ -75,7 +75,8 @@ class PETScSolver(LinearSolver):
         self.prefix = f"vemkit{next(_prefixes)}_"
         self.bs = block_size(near_nullspace, self.A.shape[0])
         self.matrix = petsc_matrix(self.A, self.bs, near_nullspace)
-        self.ksp = configured_ksp(self.matrix, self.prefix, self.options, defaults=GAMG_DEFAULTS)
+        self.ksp = None
+        self.ksp = self._multigrid()
         self.iterations = 0
         self.residual = 0.0
 
@@ -83,6 +84,18 @@ class PETScSolver(LinearSolver):
     def check_available(cls) -> None:
         """SceneError with the fix when petsc4py cannot be imported."""
         require_petsc4py()
+
+    def _multigrid(self):
+        """The KSP of K with its GAMG, set up again if :meth:`release` dropped it."""
+        if self.ksp is None:
+            self.ksp = configured_ksp(self.matrix, self.prefix, self.options, defaults=GAMG_DEFAULTS)
+        return self.ksp
+
+    def release(self) -> None:
+        """Drop K's GAMG hierarchy until the next solve (the Newton steps build their own)."""
+        if self.ksp is not None:
+            self.ksp.destroy()
+            self.ksp = None
 
     def solve(self, b, x0=None, tol=None, A=None):
         tol = self.tol if tol is None else tol
@@ -92,7 +105,7 @@ class PETScSolver(LinearSolver):
             return np.zeros_like(b)
         collect_garbage(self.layout)  # the matrices of earlier solves
         operator = self.matrix if A is None or A is self.A else petsc_matrix(A, self.bs)
-        self.ksp.setOperators(operator, self.matrix)  # K's preconditioner kept for another matrix
+        self._multigrid().setOperators(operator, self.matrix)  # K's preconditioner kept for another matrix
         x, self.iterations, converged = krylov_solve(self.ksp, b, x0, tol, 0.0, self.maxiter, self.layout)
         used = self.A if A is None else A
         self.residual = float(np.linalg.norm(b - used @ x) / bnorm)
@@ -137,6 +150,7 @@ class PETScNewtonSystems(IterativeNewtonSystems):
     def _multigrid(self, A, penalty):
         """GAMG on K + D + penalty, set up again for the new values (its prolongators kept)."""
         base = self.base
+        base.release()  # K's hierarchy is not used by the steps: its memory for theirs
         full = renewed_matrix(self.full, A, penalty(), base.bs, base.near_nullspace)
         if self.inner is None or full is not self.full:
             self.full = full
