@@ -33,7 +33,7 @@ from vemkit.mesh.components import mesh_pieces
 from vemkit.mesh.mesh import Mesh
 from vemkit.mesh.meshing import scene_mesh
 from vemkit.vem.condensation import condense_load, interior_load, recover_interior
-from vemkit.vem.distributed_assembly import distributed_stiffness
+from vemkit.vem.distributed_assembly import distributed_stiffness, splits
 from vemkit.vem.dofs import DofMap, apply_fixed_dofs
 from vemkit.vem.elasticity import lame_parameters, rigid_body_modes
 from vemkit.vem.space import VirtualElementSpace
@@ -209,8 +209,9 @@ def discrete_problem(
     model: plane_stress (the paper's C) or plane_strain (``vemkit.config.material``).
     volumetric_strain: cell (the paper's), nodal_average (k = 1, ``vemkit.vem.volumetric``) or auto
     (the scene key's default: nodal_average for k = 1, plane strain or 3D, nu > 0.45; ``vemkit.config.volumetric``).
-    comm: an MPI communicator of several ranks (``vemkit.vem.parallel.world``): the stiffness is
-    split across them, each rank assembling its own cells (``vemkit.vem.distributed_assembly``).
+    comm: an MPI communicator (``vemkit.vem.parallel.solve_communicator``): the stiffness is split
+    across its ranks, each assembling its own cells, as PETSc's matrix (``vemkit.vem.distributed_assembly``);
+    on one rank only where the split covers the formulation (else the scipy matrix, as without comm).
     """
     check_parts(mesh, list(dirichlet) + list(neumann or {}) + list(pressure or {}) + list(contact))
     space = VirtualElementSpace(mesh, order)
@@ -218,6 +219,9 @@ def discrete_problem(
     lam, mu = lame_parameters(E, nu, model)
     volumetric_strain = resolved_volumetric_strain(volumetric_strain, space.order, model, nu)
     dofs = constrained(space, dirichlet)
+    # the Gamma_C edge nodes (k = 2 midpoints) as unknowns; none for an element without edge nodes
+    change = midpoint_change(space, dofs, midpoint_edges(space, contact, dofs))
+    comm = comm if comm is not None and splits(comm, volumetric_strain, change) else None
     K = stiffness_matrix(space, lam, mu, stabilization, dofs, volumetric_strain) if comm is None else None
     projection = body_force_projection or space.element.default_body_force_projection
     full_load = problem_load(space, neumann, pressure, body_force, projection, lam, mu)
@@ -226,8 +230,7 @@ def discrete_problem(
         interior = interior_load(space, full_load)
     else:
         f, interior = dofs.restrict(full_load), None
-    # the Gamma_C edge nodes (k = 2 midpoints) as unknowns; none for an element without edge nodes
-    dofs = dofs.with_change(midpoint_change(space, dofs, midpoint_edges(space, contact, dofs)))
+    dofs = dofs.with_change(change)
     if comm is None:
         K, f = change_variables(K, f, dofs.change)
         K, f = apply_fixed_dofs(K, f, dofs)

@@ -177,6 +177,16 @@ def owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout) -> tu
     return rows, cols, vals
 
 
+def splits(comm, treatment: str, change) -> bool:
+    """Whether the stiffness is assembled across the ranks of ``comm``: on several ranks always
+    (else a SceneError, :func:`check_distributable`); on one where the formulation allows it (one
+    process then keeps the scipy assembly of what the split does not cover)."""
+    if comm.Get_size() > 1:
+        check_distributable(treatment, change)
+        return True
+    return treatment == "cell" and change is None
+
+
 def check_distributable(treatment: str, change) -> None:
     """SceneError for what couples cells beyond one element's matrix (module docstring)."""
     if treatment != "cell":

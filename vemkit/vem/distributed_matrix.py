@@ -138,6 +138,10 @@ class DistributedStiffness:
 
     __radd__ = __add__
 
+    def formed(self, other):
+        """This matrix + ``other`` (scipy, whole) as one PETSc matrix."""
+        return self + other
+
     def copy_into(self, target, other) -> bool:
         """target = this matrix + ``other`` (scipy, whole), in place of a PETSc matrix with the
         stiffness's pattern (no new matrix); False, target undefined, when either reaches beyond it."""
@@ -159,3 +163,59 @@ def _added_within(M, layout, other) -> bool:
     finally:
         term.destroy()
     return True
+
+
+class DistributedSum:
+    """K + D kept as its two terms (D scipy, whole on every rank: a few rows per contact vertex), as
+    a Newton step's matrix: products K x + D x, PETSc's view a shell of the two, no copy of K."""
+
+    distributed = True
+    dtype = np.dtype(float)
+
+    def __init__(self, stiffness: DistributedStiffness, term):
+        self.stiffness, self.term = stiffness, term.tocsr()
+        self.layout = stiffness.layout
+        self._petsc = None
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.stiffness.shape
+
+    def __matmul__(self, x):
+        return self.stiffness @ x + self.term @ np.asarray(x, dtype=float)
+
+    dot = __matmul__
+
+    def __add__(self, other):
+        return DistributedSum(self.stiffness, self.term + other)
+
+    def copy_into(self, target, other) -> bool:
+        """target = K + D + other in place (:meth:`DistributedStiffness.copy_into`)."""
+        return self.stiffness.copy_into(target, self.term + other)
+
+    def formed(self, other):
+        """K + D + other as one PETSc matrix (a :class:`DistributedStiffness`)."""
+        return self.stiffness.formed(self.term + other)
+
+    @property
+    def petsc(self):
+        """PETSc's shell matrix y = K x + D x (D's rows owned here, a small matrix)."""
+        if self._petsc is None:
+            PETSc = require_petsc4py()
+            rows = petsc_rows(self.layout, owned_rows(self.layout, self.term))
+            size = (self.layout.n_owned, self.layout.size)
+            context = _SumOfMatrices(self.stiffness.petsc, rows)
+            self._petsc = PETSc.Mat().createPython((size, size), context, comm=self.layout.comm)
+            self._petsc.setUp()
+        return self._petsc
+
+
+class _SumOfMatrices:
+    """petsc4py's python-context matrix y = A x + B x."""
+
+    def __init__(self, A, B):
+        self.A, self.B = A, B
+
+    def mult(self, mat, x, y):
+        self.A.mult(x, y)
+        self.B.multAdd(x, y, y)

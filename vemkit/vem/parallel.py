@@ -85,6 +85,20 @@ def world():
     return MPI.COMM_WORLD
 
 
+def solve_communicator(linear: str):
+    """The communicator a solve splits its problem across: the job's (:func:`world`) on several
+    ranks; in one process MPI's COMM_SELF when ``linear`` (``solver.linear``) is petsc, so that one
+    process runs the same split as N ranks (the petsc backend's matrix is PETSc's from the start);
+    None otherwise (scipy's matrix)."""
+    comm = world()
+    if comm is not None or linear != "petsc":
+        return comm
+    require_petsc4py()  # MPI started by PETSc's initialization, on COMM_WORLD = this process
+    from mpi4py import MPI
+
+    return MPI.COMM_SELF
+
+
 def job_ranks() -> tuple[int, int]:
     """(ranks on this machine, ranks in all) of the job: (1, 1) in a process of its own."""
     comm = world()

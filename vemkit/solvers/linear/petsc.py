@@ -47,6 +47,7 @@ from vemkit.solvers.linear.petsc_setup import (
     scene_options,
     stick_basis_matrix,
 )
+from vemkit.vem.distributed_matrix import DistributedSum
 from vemkit.vem.parallel import require_petsc4py
 
 NEWTON_MAXITER = 5000  # Krylov iterations of one Newton step (as the AMG backend's)
@@ -137,11 +138,13 @@ class PETScNewtonSystems(IterativeNewtonSystems):
         self.inner = None  # the KSP whose PC (GAMG on self.full) preconditions the steps
 
     def operator(self, K, *terms):
-        """K + the terms, formed (PETSc takes a matrix; across ranks each adds its rows)."""
+        """K + the terms: split across ranks, the two kept apart (products K x + D x, no copy of K);
+        in one scipy matrix, formed."""
+        split = getattr(K, "distributed", False)
         A = K
         for term in terms:
-            A = A + term
-        return A if getattr(A, "distributed", False) else A.tocsr()
+            A = DistributedSum(K, term) if split and A is K else A + term
+        return A if split else A.tocsr()
 
     def fallback(self) -> NewtonSystems | None:
         """Direct solves in one process; none across ranks (SuperLU holds the whole matrix)."""

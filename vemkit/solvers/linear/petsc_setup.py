@@ -213,10 +213,12 @@ def renewed_matrix(previous, A, term, bs: int, near_nullspace):
     for it then keeps its prolongators), else a new matrix with the rigid motions as near-nullspace."""
     PETSc = require_petsc4py()
     A = as_matrix(A)
-    if previous is not None and getattr(A, "distributed", False) and A.copy_into(previous, term):
-        return previous  # across ranks: A's values copied, the term's rows added, in place
+    if getattr(A, "distributed", False):  # split: K's values copied and the terms' rows added in place
+        if previous is not None and A.copy_into(previous, term):
+            return previous
+        return with_near_nullspace(A.formed(term).petsc, A.layout, near_nullspace)
     matrix = petsc_matrix(A + term, bs)
-    if previous is not None and not getattr(A, "distributed", False) and _same_pattern(previous, matrix):
+    if previous is not None and _same_pattern(previous, matrix):
         matrix.copy(previous, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         return previous
     return with_near_nullspace(matrix, layout_of(A), near_nullspace)
