@@ -4,9 +4,10 @@ The cells are split by METIS (``vemkit.mesh.partition``); a free node belongs to
 lowest-numbered cell, and the unknowns are renumbered rank after rank, node by node
 (:class:`DofLayout`: PETSc's contiguous ownership, d components per node, so the matrix keeps its
 d x d blocks). Each rank computes the local matrices of its cells with the element's Numba kernels
-(``cell_entries``, specialized per element as ``vemkit.vem.assembly``'s templates are) and hands
-PETSc the entries as COO triplets (``MatSetPreallocationCOO``/``MatSetValuesCOO``); PETSc sends the
-entries of rows another rank owns to their owner and sums them there. Held components
+(``cell_entries``, specialized per element as ``vemkit.vem.assembly``'s templates are), a share of
+them at a time (:data:`SHARE_ENTRIES`), and sums them into the rows they touch (``rank_rows``); the
+rows another rank owns are sent to it and added there (``to_owners``, one MPI all-to-all: the
+partition's interface), and PETSc's MPIAIJ matrix is made of each rank's own rows. Held components
 (``DofMap.fixed_dofs``) get the symmetric elimination of ``vemkit.vem.dofs.apply_fixed_dofs``
 entry by entry: their rows and columns dropped but for the diagonal, K_fh g moved to the load.
 
@@ -21,13 +22,17 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+import scipy.sparse as sp
 
 from vemkit.exceptions import SceneError
 from vemkit.mesh.partition import cell_partition
 from vemkit.vem.assembly import condense_interior, largest_cell, material_of, specialized
 from vemkit.vem.distributed_matrix import DistributedStiffness
-from vemkit.vem.parallel import require_petsc4py
 from vemkit.vem.pattern import ROW_CHUNKS, chunk_rows
+
+#: entries of cell matrices computed at a time (16 bytes each with their row and column): a rank's
+#: cells in shares of at most this many, summed into its rows share by share
+SHARE_ENTRIES = 1 << 24
 
 
 @dataclass(frozen=True)
@@ -148,15 +153,19 @@ def cell_entries(geometry, cells, owned, starts, free_index, position, material,
                             p += 1
 
 
-def owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout) -> tuple:
-    """(rows, cols, values) of the cells ``owned`` (PETSc's numbering of ``layout``, its integers)."""
-    offsets, nodes = cells = space.cell_nodes
-    d = space.element.dimension
+def cell_entry_counts(space, dofs, owned) -> np.ndarray:
+    """The entries of each owned cell's matrix: (d x its free nodes)^2."""
+    offsets, nodes = space.cell_nodes
     free = (dofs.free_index[nodes] >= 0).astype(np.int64)
     per_cell = np.add.reduceat(free, offsets[:-1]) if nodes.size else np.zeros(offsets.size - 1, np.int64)
-    sizes = (d * per_cell[owned]) ** 2
-    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    integers = require_petsc4py().IntType  # PETSc's: the entries go to it without a copy
+    return (space.element.dimension * per_cell[owned]) ** 2
+
+
+def owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout) -> tuple:
+    """(rows, cols, values) of the cells ``owned`` (PETSc's numbering of ``layout``)."""
+    offsets, nodes = cells = space.cell_nodes
+    starts = np.concatenate([[0], np.cumsum(cell_entry_counts(space, dofs, owned))]).astype(np.int64)
+    integers = np.int32 if layout.size < 2**31 else np.int64
     rows = np.empty(starts[-1], dtype=integers)
     cols = np.empty(starts[-1], dtype=integers)
     vals = np.empty(starts[-1])
@@ -203,24 +212,71 @@ def check_distributable(treatment: str, change) -> None:
         )
 
 
-def held_elimination(rows, cols, vals, dofs, layout) -> tuple:
-    """The entries with those of the held rows and columns set to zero in place (their diagonal
-    kept; no copy of the entries), the load's change -K_fh g (serial numbering, summed over the
-    ranks) and the held diagonal (the same)."""
-    fixed = dofs.fixed_dofs
-    if fixed.size == 0:
-        return np.zeros(layout.size), np.zeros(0)
-    held = np.zeros(layout.size, dtype=bool)  # PETSc's numbering, as the entries
-    held[layout.position[fixed]] = True
-    values = np.zeros(layout.size)
-    values[layout.position[fixed]] = dofs.fixed_values
-    lift, diagonal = np.zeros(layout.size), np.zeros(layout.size)
+def held_elimination(rows, cols, vals, held, values, lift, diagonal) -> None:
+    """The symmetric elimination of the held unknowns on one share of the entries (PETSc's
+    numbering): -K_fh g added to ``lift``, the held diagonal to ``diagonal`` (this rank's parts), the
+    held rows' and columns' other entries set to zero in place (no copy of the entries)."""
     into_held = held[cols] & ~held[rows]
     np.add.at(lift, rows[into_held], -vals[into_held] * values[cols[into_held]])
     on_diagonal = held[rows] & (rows == cols)
     np.add.at(diagonal, rows[on_diagonal], vals[on_diagonal])
     vals[(held[rows] | held[cols]) & (rows != cols)] = 0.0
-    return layout.sum(lift)[layout.position], layout.sum(diagonal)[layout.position[fixed]]
+
+
+def cell_shares(entries: np.ndarray) -> list:
+    """The owned cells in consecutive shares of at most :data:`SHARE_ENTRIES` entries (one cell at least)."""
+    ends = np.cumsum(entries)
+    cuts = np.searchsorted(ends, np.arange(1, int(ends[-1] // SHARE_ENTRIES) + 1) * SHARE_ENTRIES) if ends.size else []
+    bounds = np.unique(np.concatenate([[0], np.asarray(cuts, dtype=np.int64) + 1, [entries.size]]))
+    return [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+
+
+def rank_rows(space, lam, mu, stabilization, dofs, owned, layout):
+    """(the rows this rank's cells touch, summed: scipy CSR n x n in PETSc's numbering; the held
+    elimination's lift and diagonal, this rank's parts), the cells computed share by share."""
+    n = layout.size
+    held, values = np.zeros(n, dtype=bool), np.zeros(n)
+    held[layout.position[dofs.fixed_dofs]] = True
+    values[layout.position[dofs.fixed_dofs]] = dofs.fixed_values
+    lift, diagonal, rows_sum = np.zeros(n), np.zeros(n), sp.csr_matrix((n, n))
+    for share in cell_shares(cell_entry_counts(space, dofs, owned)):
+        rows, cols, vals = owned_cell_entries(space, lam, mu, stabilization, dofs, owned[share], layout)
+        if dofs.fixed_dofs.size:
+            held_elimination(rows, cols, vals, held, values, lift, diagonal)
+        part = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))  # duplicates summed
+        del rows, cols, vals
+        rows_sum = rows_sum + part
+    return rows_sum, lift, diagonal
+
+
+def to_owners(layout, rows_sum) -> sp.csr_matrix:
+    """This rank's rows (n_owned x n, global columns) with the other ranks' contributions to them
+    added: each rank sends the rows it touched but does not own to their owner (MPI all-to-all)."""
+    from mpi4py import MPI
+
+    comm, rank, starts = layout.comm, layout.rank, layout.starts
+    indptr = rows_sum.indptr
+    ranges = indptr[starts]  # the entries of rank q's rows: ranges[q]:ranges[q + 1] (rows contiguous)
+    counts = np.diff(ranges).astype(np.int64)
+    counts[rank] = 0
+    sent = np.concatenate([np.arange(ranges[q], ranges[q + 1]) for q in range(comm.Get_size()) if q != rank] or [[]])
+    sent = sent.astype(np.int64)
+    row_of = np.repeat(np.arange(layout.size), np.diff(indptr))[sent] if sent.size else np.zeros(0, np.int64)
+    received = comm.alltoall(counts.tolist())
+    displs, rdispls = np.concatenate([[0], np.cumsum(counts)[:-1]]), np.concatenate([[0], np.cumsum(received)[:-1]])
+    out = [np.empty(int(sum(received)), dtype=dtype) for dtype in (np.int64, np.int64, np.float64)]
+    for data, buffer, kind in zip(
+        (row_of, rows_sum.indices[sent].astype(np.int64), rows_sum.data[sent]),
+        out,
+        (MPI.INT64_T, MPI.INT64_T, MPI.DOUBLE),
+    ):
+        comm.Alltoallv([np.ascontiguousarray(data), (counts, displs), kind], [buffer, (received, rdispls), kind])
+    lo, hi = int(starts[rank]), int(starts[rank + 1])
+    own = rows_sum[lo:hi]
+    incoming = sp.csr_matrix((out[2], (out[0] - lo, out[1])), shape=(hi - lo, layout.size))
+    total = (own + incoming).tocsr()
+    total.sort_indices()
+    return total
 
 
 def distributed_stiffness(space, lam, mu, stabilization, dofs, load, comm, treatment="cell"):
@@ -232,11 +288,9 @@ def distributed_stiffness(space, lam, mu, stabilization, dofs, load, comm, treat
     part = comm.bcast(cell_partition(space.mesh, offsets, nodes, comm.Get_size()) if comm.Get_rank() == 0 else None)
     layout = dof_layout(comm, dofs, offsets, nodes, part)
     owned = np.flatnonzero(part == comm.Get_rank())
-    rows, cols, vals = owned_cell_entries(space, lam, mu, stabilization, dofs, owned, layout)
-    lift, held_diagonal = held_elimination(rows, cols, vals, dofs, layout)
-    K = DistributedStiffness.from_entries(layout, rows, cols, vals)
-    del rows, cols, vals
-    f = load + lift
+    rows_sum, lift, diagonal = rank_rows(space, lam, mu, stabilization, dofs, owned, layout)
+    K = DistributedStiffness.from_rows(layout, to_owners(layout, rows_sum))
+    f = load + layout.sum(lift)[layout.position]
     if dofs.fixed_dofs.size:
-        f[dofs.fixed_dofs] = held_diagonal * dofs.fixed_values
+        f[dofs.fixed_dofs] = layout.sum(diagonal)[layout.position[dofs.fixed_dofs]] * dofs.fixed_values
     return K, f
