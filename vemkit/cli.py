@@ -76,11 +76,12 @@ def cmd_solve(args) -> int:
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite, write_file, write_solution_vtu
     from vemkit.studies.scene_solve import solve_scene
+    from vemkit.solvers.linear import takes_split_problem
     from vemkit.vem.parallel import launched, solve_communicator
 
     speaks = launched().speaks  # several MPI ranks: one solve, rank 0 prints and writes
     progress = ProgressLine(speaks and not args.quiet and sys.stderr.isatty(), scene.solver_options["method"])
-    comm = solve_communicator(scene.solver_options.get("linear"))
+    comm = solve_communicator(takes_split_problem(scene.solver_options.get("linear")))
     try:
         problem, solution, ds = solve_scene(scene, progress=progress, verify=True, dataset=False, comm=comm)
     finally:

@@ -85,13 +85,13 @@ def world():
     return MPI.COMM_WORLD
 
 
-def solve_communicator(linear: str):
+def solve_communicator(split_in_one_process: bool):
     """The communicator a solve splits its problem across: the job's (:func:`world`) on several
-    ranks; in one process MPI's COMM_SELF when ``linear`` (``solver.linear``) is petsc, so that one
-    process runs the same split as N ranks (the petsc backend's matrix is PETSc's from the start);
-    None otherwise (scipy's matrix)."""
+    ranks; in one process MPI's COMM_SELF when the linear solver takes a split problem
+    (``split_in_one_process``: ``vemkit.solvers.linear.takes_split_problem``), so that one process
+    runs the same split as N ranks; None otherwise (scipy's matrix)."""
     comm = world()
-    if comm is not None or linear != "petsc":
+    if comm is not None or not split_in_one_process:
         return comm
     require_petsc4py()  # MPI started by PETSc's initialization, on COMM_WORLD = this process
     from mpi4py import MPI

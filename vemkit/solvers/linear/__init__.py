@@ -72,6 +72,13 @@ def direct_limit(near_nullspace) -> int:
     return DIRECT_LIMIT_3D if three_d(near_nullspace) else DIRECT_LIMIT
 
 
+def takes_split_problem(method: str) -> bool:
+    """Whether the backend ``method`` (a solver.linear value) solves a problem split across MPI
+    ranks (its matrix then PETSc's from the assembly on, also in one process)."""
+    backend = backends().get(method)
+    return backend is not None and backend.distributed
+
+
 def check_distributed(method: str) -> None:
     """SceneError unless the backend ``method`` (or auto) solves a matrix split across MPI ranks."""
     backend = backends().get(DISTRIBUTED_BACKEND if method == "auto" else method)
