@@ -75,8 +75,8 @@ def cmd_solve(args) -> int:
     from vemkit.io.command_line import ProgressLine, write_failures
     from vemkit.io.output_files import atomic_outputs
     from vemkit.io.solution_file import check_finite, write_file, write_solution_vtu
-    from vemkit.studies.scene_solve import solve_scene
     from vemkit.solvers.linear import takes_split_problem
+    from vemkit.studies.scene_solve import solve_scene
     from vemkit.vem.parallel import launched, solve_communicator
 
     speaks = launched().speaks  # several MPI ranks: one solve, rank 0 prints and writes
