@@ -259,9 +259,14 @@ def to_owners(layout, rows_sum) -> sp.csr_matrix:
     ranges = indptr[starts]  # the entries of rank q's rows: ranges[q]:ranges[q + 1] (rows contiguous)
     counts = np.diff(ranges).astype(np.int64)
     counts[rank] = 0
-    sent = np.concatenate([np.arange(ranges[q], ranges[q + 1]) for q in range(comm.Get_size()) if q != rank] or [[]])
-    sent = sent.astype(np.int64)
-    row_of = np.repeat(np.arange(layout.size), np.diff(indptr))[sent] if sent.size else np.zeros(0, np.int64)
+    others = [q for q in range(comm.Get_size()) if q != rank]
+    sent = np.concatenate(
+        [np.arange(ranges[q], ranges[q + 1], dtype=np.int64) for q in others] or [np.zeros(0, np.int64)]
+    )
+    row_of = np.concatenate(  # the row of every sent entry
+        [np.repeat(np.arange(starts[q], starts[q + 1]), np.diff(indptr[starts[q] : starts[q + 1] + 1])) for q in others]
+        or [np.zeros(0, np.int64)]
+    )
     received = comm.alltoall(counts.tolist())
     displs, rdispls = np.concatenate([[0], np.cumsum(counts)[:-1]]), np.concatenate([[0], np.cumsum(received)[:-1]])
     out = [np.empty(int(sum(received)), dtype=dtype) for dtype in (np.int64, np.int64, np.float64)]
