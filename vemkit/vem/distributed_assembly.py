@@ -216,11 +216,14 @@ def held_elimination(rows, cols, vals, held, values, lift, diagonal) -> None:
     """The symmetric elimination of the held unknowns on one share of the entries (PETSc's
     numbering): -K_fh g added to ``lift``, the held diagonal to ``diagonal`` (this rank's parts), the
     held rows' and columns' other entries set to zero in place (no copy of the entries)."""
-    into_held = held[cols] & ~held[rows]
-    np.add.at(lift, rows[into_held], -vals[into_held] * values[cols[into_held]])
-    on_diagonal = held[rows] & (rows == cols)
-    np.add.at(diagonal, rows[on_diagonal], vals[on_diagonal])
-    vals[(held[rows] | held[cols]) & (rows != cols)] = 0.0
+    row_held, col_held = held[rows], held[cols]
+    touched = np.flatnonzero(row_held | col_held)  # a few entries: work on them alone
+    r, c, row_held, col_held = rows[touched], cols[touched], row_held[touched], col_held[touched]
+    into_held = col_held & ~row_held
+    np.add.at(lift, r[into_held], -vals[touched[into_held]] * values[c[into_held]])
+    on_diagonal = row_held & (r == c)
+    np.add.at(diagonal, r[on_diagonal], vals[touched[on_diagonal]])
+    vals[touched[r != c]] = 0.0
 
 
 def cell_shares(entries: np.ndarray) -> list:
