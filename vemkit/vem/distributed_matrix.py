@@ -34,7 +34,10 @@ def petsc_rows(layout, rows: sp.csr_matrix, columns=None, bs: int = 1):
     PETSc = require_petsc4py()
     columns = (layout.n_owned, layout.size) if columns is None else columns
     csr = (rows.indptr.astype(PETSc.IntType), rows.indices.astype(PETSc.IntType), rows.data.astype(PETSc.ScalarType))
-    M = PETSc.Mat().createAIJ(size=((rows.shape[0], layout.size), columns), bsize=bs, csr=csr, comm=layout.comm)
+    M = PETSc.Mat().create(comm=layout.comm)
+    M.setSizes(((rows.shape[0], layout.size), columns), bsize=bs)
+    M.setType(PETSc.Mat.Type.MPIAIJ)
+    M.setPreallocationCSR(csr)
     M.assemble()
     return M
 
