@@ -33,6 +33,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.solvers.linear.cycle import transfers_in_precision, v_cycle
 from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, nodal_smoothers
+from vemkit.solvers.sparse_ops import to_blocks
 
 
 def _lookup(A, D):
@@ -180,7 +181,7 @@ class _NodalLevelOperator:
 
     def _blocks(self, K):
         values = sp.csr_matrix((K.data.astype(self.precision), K.indices, K.indptr), shape=K.shape)
-        blocks = values.tobsr(blocksize=(3, 3))
+        blocks = to_blocks(values, 3, 3)
         blocks.sort_indices()
         return blocks
 
@@ -219,7 +220,7 @@ class BoundaryUpdatedHierarchy:
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
         self.transfers = [transfers_in_precision(level, precision) for level in self.levels[:-1]]  # on P's index arrays
         if nodal and self.levels[0].P.shape[1] % 6 == 0:  # six rigid modes: the finest P in 3 x 6 blocks
-            finest = BlockTransfer(self.transfers[0][0].tobsr(blocksize=(3, 6)))
+            finest = BlockTransfer(to_blocks(self.transfers[0][0], 3, 6))
             self.transfers[0] = (finest, finest.T)
         support = None if support is None else _summed(support)
         self.operators = [_LevelOperator(level.A, precision) for level in self.levels[1 if nodal else 0 :]]
@@ -257,10 +258,11 @@ class BoundaryUpdatedHierarchy:
         )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def _prolong(indptr, indices, data, coarse, fine):
-    """fine = P coarse, P BSR with 3 x 6 blocks (``data`` flat), ``fine`` zeroed."""
-    for node in range(indptr.shape[0] - 1):
+    """fine = P coarse, P BSR with 3 x 6 blocks (``data`` flat), ``fine`` zeroed (its vertices split
+    over the threads: the same sums)."""
+    for node in numba.prange(indptr.shape[0] - 1):
         row = 3 * node
         y0, y1, y2 = fine[row], fine[row + 1], fine[row + 2]
         for p in range(indptr[node], indptr[node + 1]):

@@ -109,9 +109,10 @@ def _block_sweep(indptr, indices, data, x, b, inverses, forward):
         x[row + 2] += block[2, 0] * r0 + block[2, 1] * r1 + block[2, 2] * r2
 
 
-@numba.njit(cache=True)
+# the vertices split over the Numba threads: each row's sum in the serial order, the same bits
+@numba.njit(cache=True, parallel=True)
 def _block_residual(indptr, indices, data, x, b, r):
-    for node in range(indptr.shape[0] - 1):
+    for node in numba.prange(indptr.shape[0] - 1):
         row = 3 * node
         r0, r1, r2 = b[row], b[row + 1], b[row + 2]
         for p in range(indptr[node], indptr[node + 1]):
