@@ -33,6 +33,7 @@ import scipy.sparse.linalg as spla
 
 from vemkit.solvers.linear.cycle import transfers_in_precision, v_cycle
 from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, nodal_smoothers
+from vemkit.solvers.reversed_sweep import ReversedRows
 from vemkit.solvers.sparse_ops import to_blocks
 
 
@@ -206,12 +207,15 @@ class BoundaryUpdatedHierarchy:
     """The V-cycle of a hierarchy of K (vemkit.solvers.linear.AMGSolver's, levels already in CSR) as
     the preconditioner of K + D, for any boundary term D (see the module docstring)."""
 
-    def __init__(self, hierarchy, support=None, nodal=False, precision=np.float64):
+    def __init__(self, hierarchy, support=None, nodal=False, precision=np.float64, reversed_backward=False):
         """``support``: a matrix whose pattern holds every D to come (e.g. the full d x d blocks of all
         contact vertices), so that the finest level's pattern is widened once, here. ``nodal``: smooth
         the finest level by vertices of three dofs (vemkit.solvers.nodal_smoother; else the
         hierarchy's own smoothers). ``precision``: the floating type of the cycle (its operators,
-        transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way)."""
+        transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way).
+        ``reversed_backward``: the hierarchy's postsmoothers below the finest level are pyamg's backward
+        Gauss-Seidel, swept instead on a copy of the level's rows last first (the same x, read front to
+        back: vemkit.solvers.reversed_sweep)."""
         self.levels = hierarchy.levels
         nodal = nodal and len(self.levels) > 1  # one level: its LU, no smoother
         self.precision = precision
@@ -228,6 +232,11 @@ class BoundaryUpdatedHierarchy:
             self.operators.insert(0, _NodalLevelOperator(self.levels[0].A, support, precision))
         elif support is not None and pattern_positions(self.operators[0].base, support) is None:
             self.operators[0].widen(support)
+        first = 1 if nodal else 0
+        self.reversed = [
+            ReversedRows(self.operators[index].current) if reversed_backward and index >= first else None
+            for index in range(len(self.levels) - 1)
+        ]
 
     def preconditioner(self, D):
         """A LinearOperator: one V-cycle for K + D (D square CSR, supported near the boundary)."""
@@ -242,6 +251,9 @@ class BoundaryUpdatedHierarchy:
                     inverses = self.nodal_blocks.with_term(D).astype(self.precision)
                     here.presmoother, here.postsmoother = nodal_smoothers(inverses)
                     here.residual = block_residual
+                elif self.reversed[index] is not None:
+                    self.reversed[index].refresh(here.A)
+                    here.postsmoother = self.reversed[index].backward_sweep
                 D = coarse_term(level.P, D)
             levels.append(here)
         lu = spla.splu(levels[-1].A.tocsc())
