@@ -75,7 +75,9 @@ def matvec(A, x) -> np.ndarray:
     return out
 
 
-BLOCK_CHUNKS = 64  # block-row chunks of the parallel conversion (its scratch arrays once per chunk)
+#: block rows per pair of chunks of the parallel conversion (an even number of chunks, at most 64): each
+#: chunk fills its scratch arrays, two of the block columns' count, once
+BLOCK_CHUNK_ROWS = 16_384
 
 
 @numba.njit(cache=True)
@@ -101,13 +103,13 @@ def _block_row(indptr, indices, R, C, bi, stamp, where, first, data, b_indices, 
 
 
 @numba.njit(cache=True, parallel=True)
-def _blocks(indptr, indices, data, R, C, n_block_columns, b_indptr, b_indices, b_data):
+def _blocks(indptr, indices, data, R, C, n_block_columns, b_indptr, b_indices, b_data, chunks):
     """Counts the blocks of each block row into b_indptr[1:] (``data`` empty), or fills them."""
     rows = b_indptr.shape[0] - 1
-    for chunk in numba.prange(BLOCK_CHUNKS):
+    for chunk in numba.prange(chunks):
         stamp = np.full(n_block_columns, -1, dtype=np.int64)
         where = np.empty(n_block_columns, dtype=np.int64)
-        for bi in range(chunk * rows // BLOCK_CHUNKS, (chunk + 1) * rows // BLOCK_CHUNKS):
+        for bi in range(chunk * rows // chunks, (chunk + 1) * rows // chunks):
             first = b_indptr[bi] if data.size else 0
             count = _block_row(indptr, indices, R, C, bi, stamp, where, first, data, b_indices, b_data)
             if not data.size:
@@ -124,12 +126,13 @@ def to_blocks(A, R: int, C: int):
         raise InputError(f"a {rows} x {columns} matrix has no {R} x {C} blocks; give a blocksize dividing its shape")
     n_block_columns = columns // C
     indptr = np.zeros(rows // R + 1, dtype=np.int64)
-    _blocks(A.indptr, A.indices, A.data[:0], R, C, n_block_columns, indptr, indptr[:0], A.data[:0])
+    chunks = min(64, 2 * max(1, rows // R // BLOCK_CHUNK_ROWS))
+    _blocks(A.indptr, A.indices, A.data[:0], R, C, n_block_columns, indptr, indptr[:0], A.data[:0], chunks)
     np.cumsum(indptr, out=indptr)
     index_type = np.int32 if max(int(indptr[-1]), n_block_columns) < np.iinfo(np.int32).max else np.int64
     indices = np.empty(int(indptr[-1]), dtype=index_type)
     data = np.zeros((indices.size, R, C), dtype=A.dtype)
-    _blocks(A.indptr, A.indices, A.data, R, C, n_block_columns, indptr, indices, data.reshape(-1))
+    _blocks(A.indptr, A.indices, A.data, R, C, n_block_columns, indptr, indices, data.reshape(-1), chunks)
     return sp.bsr_matrix((data, indices, indptr.astype(index_type)), shape=A.shape)
 
 
