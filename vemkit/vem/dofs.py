@@ -213,10 +213,13 @@ def apply_fixed_dofs(stiffness: sp.csr_matrix, load: np.ndarray, dofs: DofMap):
     load = load - stiffness[:, fixed] @ g
     K = stiffness.tocsr()
     K.sum_duplicates()  # canonical: sorted, one entry per position (a no-op for the assembled matrix)
-    diagonal = K.diagonal()[fixed]
     held = np.zeros(K.shape[0], dtype=np.bool_)
     held[fixed] = True
     K = sp.csr_matrix(_held_out(K.indptr, K.indices, K.data, held), shape=K.shape)
     K.has_canonical_format = True
+    # a held row keeps its diagonal entry only (none where K stores none): K's diagonal there
+    stored = K.indptr[fixed + 1] > K.indptr[fixed]
+    diagonal = np.zeros(fixed.size, dtype=K.dtype)
+    diagonal[stored] = K.data[K.indptr[fixed[stored]]]
     load[fixed] = diagonal * g
     return K, load
