@@ -33,6 +33,17 @@ def test_the_sweep_is_pyamgs_backward_gauss_seidel(dtype):
         reversed_rows.refresh(A)
 
 
+def test_a_refresh_of_the_changed_positions_only_is_a_whole_refresh():
+    rng = np.random.default_rng(5)
+    A = _matrix(80, 6, np.float32)
+    partial, whole = ReversedRows(A), ReversedRows(A)
+    changed = np.unique(rng.integers(0, A.nnz, 50))
+    A.data[changed] += 1.0
+    partial.refresh(A, changed)
+    whole.refresh(A)
+    assert np.array_equal(partial.data, whole.data)
+
+
 def test_a_new_pattern_is_copied_again():
     A, B = _matrix(60, 3, np.float32), _matrix(60, 4, np.float32)
     reversed_rows = ReversedRows(A)

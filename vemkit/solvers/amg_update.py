@@ -243,6 +243,7 @@ class BoundaryUpdatedHierarchy:
         D = _summed(D)
         levels = []
         for index, level in enumerate(self.levels):
+            before = self.operators[index].touched  # the positions of the last D, restored by the update
             here = _Level(self.operators[index].update(D))
             if index < len(self.levels) - 1:
                 here.P, here.R = self.transfers[index]
@@ -252,7 +253,7 @@ class BoundaryUpdatedHierarchy:
                     here.presmoother, here.postsmoother = nodal_smoothers(inverses)
                     here.residual = block_residual
                 elif self.reversed[index] is not None:
-                    self.reversed[index].refresh(here.A)
+                    self.reversed[index].refresh(here.A, np.union1d(before, self.operators[index].touched))
                     here.postsmoother = self.reversed[index].backward_sweep
                 D = coarse_term(level.P, D)
             levels.append(here)

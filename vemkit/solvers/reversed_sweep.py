@@ -8,7 +8,8 @@ float32) 26 ms against 12 ms forward. :class:`ReversedRows` holds the rows in th
 sweep visits them, each row's entries in its own order, so the sweep reads its arrays front to back
 (~9 ms): the same sums in the same order, x_i = (b_i - sum_{j != i} a_ij x_j) / a_ii, x_i left
 where a_ii = 0 (tests/solvers/test_reversed_sweep.py). The copy costs the level's index arrays and
-values once more (at 10^6 DOFs 92 MB); its values follow the level's at each Newton step (:meth:`refresh`).
+values once more (at 10^6 DOFs 92 MB); its values follow the level's at each Newton step where
+they changed (:meth:`refresh`).
 """
 
 from __future__ import annotations
@@ -63,12 +64,16 @@ class ReversedRows:
         self.rows = np.arange(n - 1, -1, -1, dtype=np.int64)
         self.refresh(A)
 
-    def refresh(self, A):
-        """The values of A (its rows copied again when A's pattern is another, e.g. a widened level)."""
+    def refresh(self, A, changed=None):
+        """The values of A: all of them, or only those at the positions ``changed`` in A.data (the
+        rest as at the last refresh); its rows copied again when A's pattern is another (a widened level)."""
         if A.indptr is not self.pattern:
             self._build(A)
-            return
-        _reversed_copy(A.indptr, A.data, self.indptr, self.data)
+        elif changed is None:
+            _reversed_copy(A.indptr, A.data, self.indptr, self.data)
+        elif changed.size:
+            rows = np.searchsorted(A.indptr, changed, side="right") - 1
+            self.data[self.indptr[A.shape[0] - 1 - rows] + changed - A.indptr[rows]] = A.data[changed]
 
     def backward_sweep(self, A, x, b):
         """One backward Gauss-Seidel sweep on x in place: pyamg's ``gauss_seidel(A, x, b, sweep="backward")``
