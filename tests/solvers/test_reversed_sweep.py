@@ -37,9 +37,10 @@ def test_a_refresh_of_the_changed_positions_only_is_a_whole_refresh():
     rng = np.random.default_rng(5)
     A = _matrix(80, 6, np.float32)
     partial, whole = ReversedRows(A), ReversedRows(A)
-    changed = np.unique(rng.integers(0, A.nnz, 50))
+    changed, more = np.unique(rng.integers(0, A.nnz, 50)), np.unique(rng.integers(0, A.nnz, 30))
     A.data[changed] += 1.0
-    partial.refresh(A, changed)
+    A.data[more] -= 2.0
+    partial.refresh(A, changed, more)
     whole.refresh(A)
     assert np.array_equal(partial.data, whole.data)
 

@@ -253,7 +253,7 @@ class BoundaryUpdatedHierarchy:
                     here.presmoother, here.postsmoother = nodal_smoothers(inverses)
                     here.residual = block_residual
                 elif self.reversed[index] is not None:
-                    self.reversed[index].refresh(here.A, np.union1d(before, self.operators[index].touched))
+                    self.reversed[index].refresh(here.A, before, self.operators[index].touched)
                     here.postsmoother = self.reversed[index].backward_sweep
                 D = coarse_term(level.P, D)
             levels.append(here)

@@ -64,16 +64,18 @@ class ReversedRows:
         self.rows = np.arange(n - 1, -1, -1, dtype=np.int64)
         self.refresh(A)
 
-    def refresh(self, A, changed=None):
-        """The values of A: all of them, or only those at the positions ``changed`` in A.data (the
-        rest as at the last refresh); its rows copied again when A's pattern is another (a widened level)."""
+    def refresh(self, A, *changed):
+        """The values of A: all of them, or only those at the positions in the arrays ``changed`` (into
+        A.data; the rest as at the last refresh); its rows copied again when A's pattern is another
+        (a widened level)."""
         if A.indptr is not self.pattern:
-            self._build(A)
-        elif changed is None:
+            self._build(A)  # all of its values too
+            return
+        if not changed:
             _reversed_copy(A.indptr, A.data, self.indptr, self.data)
-        elif changed.size:
-            rows = np.searchsorted(A.indptr, changed, side="right") - 1
-            self.data[self.indptr[A.shape[0] - 1 - rows] + changed - A.indptr[rows]] = A.data[changed]
+        for positions in changed:
+            rows = np.searchsorted(A.indptr, positions, side="right") - 1
+            self.data[self.indptr[A.shape[0] - 1 - rows] + positions - A.indptr[rows]] = A.data[positions]
 
     def backward_sweep(self, A, x, b):
         """One backward Gauss-Seidel sweep on x in place: pyamg's ``gauss_seidel(A, x, b, sweep="backward")``
