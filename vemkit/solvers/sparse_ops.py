@@ -118,8 +118,9 @@ def _blocks(indptr, indices, data, R, C, n_block_columns, b_indptr, b_indices, b
 
 def to_blocks(A, R: int, C: int):
     """The CSR matrix A as BSR with R x C blocks: scipy's ``A.tobsr(blocksize=(R, C))`` (the same
-    arrays: the blocks of a block row in the order its rows meet them), on the Numba threads (at
-    10^6 DOFs in 3D 1.7 s by scipy for K's 3 x 3 blocks)."""
+    arrays: the blocks of a block row in the order its rows meet them), on the Numba threads (K's
+    3 x 3 blocks at 10^6 DOFs in 3D, best of four: 0.42 s by scipy, 0.38 s here; the set-up converts
+    K in row blocks, its P and the Newton cycle's K and P: ~2.4 s by scipy in all)."""
     A = A.tocsr()
     rows, columns = A.shape
     if rows % R or columns % C:
