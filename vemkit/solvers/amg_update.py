@@ -33,6 +33,8 @@ import scipy.sparse.linalg as spla
 
 from vemkit.solvers.linear.cycle import transfers_in_precision, v_cycle
 from vemkit.solvers.nodal_smoother import NodalBlocks, block_residual, nodal_smoothers
+from vemkit.solvers.reversed_sweep import ReversedRows
+from vemkit.solvers.sparse_ops import to_blocks
 
 
 def _lookup(A, D):
@@ -180,7 +182,7 @@ class _NodalLevelOperator:
 
     def _blocks(self, K):
         values = sp.csr_matrix((K.data.astype(self.precision), K.indices, K.indptr), shape=K.shape)
-        blocks = values.tobsr(blocksize=(3, 3))
+        blocks = to_blocks(values, 3, 3)
         blocks.sort_indices()
         return blocks
 
@@ -205,12 +207,15 @@ class BoundaryUpdatedHierarchy:
     """The V-cycle of a hierarchy of K (vemkit.solvers.linear.AMGSolver's, levels already in CSR) as
     the preconditioner of K + D, for any boundary term D (see the module docstring)."""
 
-    def __init__(self, hierarchy, support=None, nodal=False, precision=np.float64):
+    def __init__(self, hierarchy, support=None, nodal=False, precision=np.float64, reversed_backward=False):
         """``support``: a matrix whose pattern holds every D to come (e.g. the full d x d blocks of all
         contact vertices), so that the finest level's pattern is widened once, here. ``nodal``: smooth
         the finest level by vertices of three dofs (vemkit.solvers.nodal_smoother; else the
         hierarchy's own smoothers). ``precision``: the floating type of the cycle (its operators,
-        transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way)."""
+        transfers, smoothers and coarse LU; D's Galerkin products are formed in float64 either way).
+        ``reversed_backward``: the hierarchy's postsmoothers below the finest level are pyamg's backward
+        Gauss-Seidel, swept instead on a copy of the level's rows last first (the same x, read front to
+        back: vemkit.solvers.reversed_sweep)."""
         self.levels = hierarchy.levels
         nodal = nodal and len(self.levels) > 1  # one level: its LU, no smoother
         self.precision = precision
@@ -219,7 +224,7 @@ class BoundaryUpdatedHierarchy:
         self.postsmoother = [level.postsmoother for level in self.levels[:-1]]
         self.transfers = [transfers_in_precision(level, precision) for level in self.levels[:-1]]  # on P's index arrays
         if nodal and self.levels[0].P.shape[1] % 6 == 0:  # six rigid modes: the finest P in 3 x 6 blocks
-            finest = BlockTransfer(self.transfers[0][0].tobsr(blocksize=(3, 6)))
+            finest = BlockTransfer(to_blocks(self.transfers[0][0], 3, 6))
             self.transfers[0] = (finest, finest.T)
         support = None if support is None else _summed(support)
         self.operators = [_LevelOperator(level.A, precision) for level in self.levels[1 if nodal else 0 :]]
@@ -227,12 +232,18 @@ class BoundaryUpdatedHierarchy:
             self.operators.insert(0, _NodalLevelOperator(self.levels[0].A, support, precision))
         elif support is not None and pattern_positions(self.operators[0].base, support) is None:
             self.operators[0].widen(support)
+        first = 1 if nodal else 0
+        self.reversed = [
+            ReversedRows(self.operators[index].current) if reversed_backward and index >= first else None
+            for index in range(len(self.levels) - 1)
+        ]
 
     def preconditioner(self, D):
         """A LinearOperator: one V-cycle for K + D (D square CSR, supported near the boundary)."""
         D = _summed(D)
         levels = []
         for index, level in enumerate(self.levels):
+            before = self.operators[index].touched  # the positions of the last D, restored by the update
             here = _Level(self.operators[index].update(D))
             if index < len(self.levels) - 1:
                 here.P, here.R = self.transfers[index]
@@ -241,6 +252,9 @@ class BoundaryUpdatedHierarchy:
                     inverses = self.nodal_blocks.with_term(D).astype(self.precision)
                     here.presmoother, here.postsmoother = nodal_smoothers(inverses)
                     here.residual = block_residual
+                elif self.reversed[index] is not None:
+                    self.reversed[index].refresh(here.A, before, self.operators[index].touched)
+                    here.postsmoother = self.reversed[index].backward_sweep
                 D = coarse_term(level.P, D)
             levels.append(here)
         lu = spla.splu(levels[-1].A.tocsc())
@@ -257,10 +271,11 @@ class BoundaryUpdatedHierarchy:
         )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def _prolong(indptr, indices, data, coarse, fine):
-    """fine = P coarse, P BSR with 3 x 6 blocks (``data`` flat), ``fine`` zeroed."""
-    for node in range(indptr.shape[0] - 1):
+    """fine = P coarse, P BSR with 3 x 6 blocks (``data`` flat), ``fine`` zeroed (its vertices split
+    over the threads: the same sums)."""
+    for node in numba.prange(indptr.shape[0] - 1):
         row = 3 * node
         y0, y1, y2 = fine[row], fine[row + 1], fine[row + 2]
         for p in range(indptr[node], indptr[node + 1]):

@@ -26,20 +26,23 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def _diagonal_blocks(indptr, indices, data, blocks):
-    for node in range(blocks.shape[0]):
+def _diagonal_blocks(indptr, indices, data, nodes, blocks):
+    for k in range(nodes.shape[0]):
+        node = nodes[k]
         for local in range(3):
             row = 3 * node + local
             for p in range(indptr[row], indptr[row + 1]):
                 offset = indices[p] - 3 * node
                 if 0 <= offset < 3:
-                    blocks[node, local, offset] += data[p]
+                    blocks[k, local, offset] += data[p]
 
 
-def diagonal_blocks(A) -> np.ndarray:
-    """(n / 3, 3, 3): the 3 x 3 diagonal blocks of the CSR matrix A (duplicates summed)."""
-    blocks = np.zeros((A.shape[0] // 3, 3, 3))
-    _diagonal_blocks(A.indptr, A.indices, A.data, blocks)
+def diagonal_blocks(A, nodes=None) -> np.ndarray:
+    """(n / 3, 3, 3): the 3 x 3 diagonal blocks of the CSR matrix A (duplicates summed); only those of
+    ``nodes`` (len(nodes), 3, 3) when given."""
+    nodes = np.arange(A.shape[0] // 3) if nodes is None else np.asarray(nodes, dtype=np.int64)
+    blocks = np.zeros((nodes.size, 3, 3))
+    _diagonal_blocks(A.indptr, A.indices, A.data, nodes, blocks)
     return blocks
 
 
@@ -56,7 +59,7 @@ class NodalBlocks:
         touched = np.unique(np.flatnonzero(np.diff(D.indptr)) // 3)
         inverses = self.inverses.copy()
         if touched.size:
-            inverses[touched] = np.linalg.inv(self.blocks[touched] + diagonal_blocks(D)[touched])
+            inverses[touched] = np.linalg.inv(self.blocks[touched] + diagonal_blocks(D, touched))
         return inverses
 
 
@@ -109,9 +112,10 @@ def _block_sweep(indptr, indices, data, x, b, inverses, forward):
         x[row + 2] += block[2, 0] * r0 + block[2, 1] * r1 + block[2, 2] * r2
 
 
-@numba.njit(cache=True)
+# the vertices split over the Numba threads: each row's sum in the serial order, the same bits
+@numba.njit(cache=True, parallel=True)
 def _block_residual(indptr, indices, data, x, b, r):
-    for node in range(indptr.shape[0] - 1):
+    for node in numba.prange(indptr.shape[0] - 1):
         row = 3 * node
         r0, r1, r2 = b[row], b[row + 1], b[row + 2]
         for p in range(indptr[node], indptr[node + 1]):

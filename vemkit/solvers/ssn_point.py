@@ -12,7 +12,7 @@ import numpy as np
 
 from vemkit.contact import ball
 from vemkit.solvers.solution import relative_slip, residual_scale
-from vemkit.solvers.sparse_ops import abs_matvec
+from vemkit.solvers.sparse_ops import abs_matvec, matvec
 
 BOUND_FLOOR = 1e-3  # coupled_gamma: a vertex's friction bound counted as at least this times b_ref
 ROUNDING_FLOOR = 100.0  # accept a residual this many times eps * || |K| |u| + |f| + |J| |u| || (see converged)
@@ -43,7 +43,7 @@ def evaluate(newton, u, lam) -> Point:
     zero = newton.zero
     t = cb.normal_displacement(u) - cb.gap
     slip = relative_slip(cb, u, newton.slip_reference)
-    Ku = K @ u
+    Ku = matvec(K, u)
     normal_force = cb.normal_force(u, law)
     friction_force = cb.scatter(zero, cb.times(cb.weight * law.friction_bound(t), lam), n)
     gradient = Ku + normal_force - f

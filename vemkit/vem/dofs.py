@@ -174,27 +174,32 @@ def cell_order_numbering(mesh: Mesh, offsets: np.ndarray, nodes: np.ndarray, n_n
 
 
 @numba.njit(cache=True)
+def _kept(i, j, value, held):
+    """Whether entry (i, j) stays: a held row keeps its diagonal only, a free row its entries off the
+    held columns that are not stored zeros."""
+    return (j == i) if held[i] else (not held[j] and value != 0.0)
+
+
+@numba.njit(cache=True, parallel=True)
 def _held_out(indptr, indices, data, held):
     """The CSR arrays of A without the rows and columns of the held dofs, a held row keeping only its
     diagonal entry, and without A's stored zeros (as zeroing, eliminate_zeros and adding the diagonal
-    back would give, in one pass)."""
+    back would give), its rows counted and then copied on the threads."""
     n = indptr.shape[0] - 1
     out_indptr = np.zeros(n + 1, dtype=np.int64)
-    for i in range(n):
+    for i in numba.prange(n):
         count = 0
         for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            if (j == i) if held[i] else (not held[j] and data[p] != 0.0):
-                count += 1
-        out_indptr[i + 1] = out_indptr[i] + count
+            count += _kept(i, indices[p], data[p], held)
+        out_indptr[i + 1] = count
+    out_indptr = np.cumsum(out_indptr)
     out_indices = np.empty(out_indptr[n], dtype=indices.dtype)
     out_data = np.empty(out_indptr[n], dtype=data.dtype)
-    for i in range(n):
+    for i in numba.prange(n):
         q = out_indptr[i]
         for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            if (j == i) if held[i] else (not held[j] and data[p] != 0.0):
-                out_indices[q] = j
+            if _kept(i, indices[p], data[p], held):
+                out_indices[q] = indices[p]
                 out_data[q] = data[p]
                 q += 1
     return out_data, out_indices, out_indptr
@@ -208,10 +213,13 @@ def apply_fixed_dofs(stiffness: sp.csr_matrix, load: np.ndarray, dofs: DofMap):
     load = load - stiffness[:, fixed] @ g
     K = stiffness.tocsr()
     K.sum_duplicates()  # canonical: sorted, one entry per position (a no-op for the assembled matrix)
-    diagonal = K.diagonal()[fixed]
     held = np.zeros(K.shape[0], dtype=np.bool_)
     held[fixed] = True
     K = sp.csr_matrix(_held_out(K.indptr, K.indices, K.data, held), shape=K.shape)
     K.has_canonical_format = True
+    # a held row keeps its diagonal entry only (none where K stores none): K's diagonal there
+    stored = K.indptr[fixed + 1] > K.indptr[fixed]
+    diagonal = np.zeros(fixed.size, dtype=K.dtype)
+    diagonal[stored] = K.data[K.indptr[fixed[stored]]]
     load[fixed] = diagonal * g
     return K, load

@@ -199,7 +199,9 @@ class AMGSolver(LinearSolver):
         ``vemkit.solvers.amg_update``): the aggregates and prolongators kept, the operators updated."""
         from vemkit.solvers.amg_update import BoundaryUpdatedHierarchy
 
-        return BoundaryUpdatedHierarchy(self.hierarchy, support, nodal=True, precision=CYCLE_PRECISION)
+        return BoundaryUpdatedHierarchy(
+            self.hierarchy, support, nodal=True, precision=CYCLE_PRECISION, reversed_backward=True
+        )
 
 
 class AMGNewtonSystems(IterativeNewtonSystems):

@@ -9,13 +9,15 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from vemkit.solvers.sparse_ops import matvec
+
 
 def v_cycle(levels, coarse_solver, level, b):
     """One V-cycle from x = 0 on ``level`` (the smoothers and transfers of the hierarchy)."""
     here = levels[level]
     x = np.zeros_like(b)
     here.presmoother(here.A, x, b)
-    residual = b - here.A @ x if here.residual is None else here.residual(here.A, x, b)
+    residual = b - matvec(here.A, x) if here.residual is None else here.residual(here.A, x, b)
     coarse_b = here.R @ residual
     if level == len(levels) - 2:
         coarse_x = coarse_solver(levels[-1].A, coarse_b)
@@ -95,7 +97,7 @@ def v_cycle_preconditioner(hierarchy, precision=CYCLE_PRECISION, release=False):
     def coarse(A, b):  # the coarsest LU in float64 (a few thousand unknowns)
         return coarse_solver(A, b.astype(float)).astype(precision)
 
-    def matvec(b):
+    def one_cycle(b):
         return v_cycle(cycle, coarse, 0, np.ravel(b).astype(precision)).astype(float)
 
-    return spla.LinearOperator(levels[0].A.shape, dtype=float, matvec=matvec)
+    return spla.LinearOperator(levels[0].A.shape, dtype=float, matvec=one_cycle)
