@@ -215,6 +215,7 @@ def main(argv=None) -> int:
         stopped = daemons.stop_all()
         left = _leftovers(stopped)
         say(f"stopped (by PID): {', '.join(stopped) or 'nothing'}; still running: {left or 'none'}")
+        say(f"configuration removed: {', '.join(cluster.remove_configuration()) or 'none'}")
         status = status or bool(left)
     say(
         f"cluster-test ({args.mode}): {'PASSED' if status == 0 else 'FAILED'} in {time.monotonic() - start:.0f} s;"

@@ -141,6 +141,19 @@ def write_configuration(state: Path, accounting: bool) -> dict:
     return values
 
 
+def remove_configuration() -> list[str]:
+    """Remove the slurm.conf and slurmdbd.conf this test wrote (the marker says so): left behind,
+    every `scontrol`/`sinfo` on the host waits 9 s for a controller that is gone, and so does every
+    snakemake run, which asks `scontrol show config` when SLURM is installed."""
+    removed = []
+    for name in ("slurm.conf", "slurmdbd.conf"):
+        path = SLURM_ETC / name
+        if path.exists() and MARKER in path.read_text(errors="replace"):
+            path.unlink()
+            removed.append(str(path))
+    return removed
+
+
 # -- daemons --------------------------------------------------------------------------------------
 def _alive_as(pid: int, exe: str) -> bool:
     """Is pid still the process started from exe (not a later process that reuses the number)?"""
