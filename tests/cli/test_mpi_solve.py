@@ -19,30 +19,15 @@ import numpy as np
 import pytest
 import xarray as xr
 
-sys.path[:0] = [str(Path(__file__).resolve().parents[1])]
+TESTS = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(TESTS), str(TESTS / "solvers")]
 from mpi_jobs import require_mpi, vemkit_job  # noqa: E402
+from test_petsc_backend import BOX, CASES, PAPER, SETTINGS  # noqa: E402  (the one-process PETSc cases)
 
 from vemkit.cli import main  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2] / "config" / "scenes"
-PAPER, BOX = ROOT / "paper.yaml", ROOT / "3d" / "sheared_box.yaml"
-#: tight solves: two ways of solving meet far below the 1e-8 asked of them
-SETTINGS = {
-    "ssn": ["solver.method=ssn", "solver.tol=1e-12"],
-    "uzawa": [
-        "solver.method=uzawa",
-        "solver.tol=1e-12",
-        "solver.stop=both",
-        "solver.eps_u=1e-13",
-        "solver.eps_lambda=1e-13",
-        "solver.max_iterations=20000",
-    ],
-}
-CASES = {
-    "paper": (PAPER, ["discretization.mesh.n=8"]),
-    "box-hex": (BOX, ["discretization.mesh.family=hex", "discretization.mesh.n=4"]),
-    "box-voronoi": (BOX, ["discretization.mesh.family=voronoi", "discretization.mesh.n=4"]),
-}
+#: the one-process PETSc backend's cases and tight settings (two ways of solving meet far below 1e-8)
+CASES = dict(zip(["paper", "box-hex", "box-voronoi"], CASES))
 
 
 def _sets(values):

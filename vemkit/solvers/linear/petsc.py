@@ -77,7 +77,7 @@ class PETScSolver(LinearSolver):
         self.bs = block_size(near_nullspace, self.A.shape[0])
         self.matrix = petsc_matrix(self.A, self.bs, near_nullspace)
         self.ksp = None
-        self.ksp = self._multigrid()
+        self._multigrid()  # K's KSP and GAMG, set up now
         self.iterations = 0
         self.residual = 0.0
 
